@@ -1,0 +1,332 @@
+//! Instructions and their intensity operands.
+
+use crate::header::{TraceHeader, MAX_CHANNELS};
+use crate::opcode::{OperandKind, Opcode};
+use std::fmt;
+
+/// An intensity vector: one `f64` per channel (1 for grey, 3 for RGB).
+///
+/// Equality is bit-exact (`-0.0 != 0.0`), so that round trips are checked exactly.
+#[derive(Clone, Copy)]
+pub struct Intensity {
+    len: u8,
+    values: [f64; MAX_CHANNELS],
+}
+
+impl Intensity {
+    /// The empty vector, used for value slots an opcode does not carry.
+    pub const NONE: Intensity = Intensity {
+        len: 0,
+        values: [0.0; MAX_CHANNELS],
+    };
+
+    /// A vector from a slice of 1 to [`MAX_CHANNELS`] values.
+    ///
+    /// # Panics
+    /// If `values` is empty or longer than [`MAX_CHANNELS`]; parsers check this first.
+    pub fn new(values: &[f64]) -> Intensity {
+        assert!(
+            !values.is_empty() && values.len() <= MAX_CHANNELS,
+            "an intensity has 1..={MAX_CHANNELS} channels"
+        );
+        let mut v = [0.0; MAX_CHANNELS];
+        v[..values.len()].copy_from_slice(values);
+        Intensity {
+            len: values.len() as u8,
+            values: v,
+        }
+    }
+
+    /// A grey (one-channel) intensity.
+    pub fn grey(v: f64) -> Intensity {
+        Intensity::new(&[v])
+    }
+
+    /// The same value in each of `channels` channels.
+    pub fn splat(v: f64, channels: usize) -> Intensity {
+        Intensity::new(&vec![v; channels])
+    }
+
+    /// The values, one per channel.
+    pub fn as_slice(&self) -> &[f64] {
+        &self.values[..usize::from(self.len)]
+    }
+
+    /// The number of channels.
+    pub fn len(&self) -> usize {
+        usize::from(self.len)
+    }
+
+    /// True for [`Intensity::NONE`].
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+}
+
+impl PartialEq for Intensity {
+    fn eq(&self, other: &Self) -> bool {
+        self.len == other.len
+            && self
+                .as_slice()
+                .iter()
+                .zip(other.as_slice())
+                .all(|(a, b)| a.to_bits() == b.to_bits())
+    }
+}
+
+impl Eq for Intensity {}
+
+impl fmt::Debug for Intensity {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_list().entries(self.as_slice()).finish()
+    }
+}
+
+/// One X-processor instruction.
+///
+/// A uniform record: `x` and `dx` are zero and value slots empty where the opcode has no
+/// such operand ([`Opcode::operands`]). Build them with the constructors, which keep that
+/// invariant.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub struct Instruction {
+    /// The opcode.
+    pub op: Opcode,
+    /// First processor addressed.
+    pub x: u32,
+    /// Range length (`Count`) or period (`Period`).
+    pub dx: u32,
+    /// `[I, dI, ddI]`; slots the opcode does not carry are [`Intensity::NONE`].
+    pub values: [Intensity; 3],
+}
+
+impl Instruction {
+    fn with(op: Opcode, x: u32, dx: u32, i: Intensity, di: Intensity, ddi: Intensity) -> Self {
+        Instruction {
+            op,
+            x,
+            dx,
+            values: [i, di, ddi],
+        }
+    }
+    /// `SetI(x, I)`.
+    pub fn set_i(x: u32, i: Intensity) -> Self {
+        Self::with(Opcode::SetI, x, 0, i, Intensity::NONE, Intensity::NONE)
+    }
+    /// `SetdI(x, dI)`.
+    pub fn set_di(x: u32, di: Intensity) -> Self {
+        Self::with(Opcode::SetdI, x, 0, Intensity::NONE, di, Intensity::NONE)
+    }
+    /// `SetddI(x, ddI)`.
+    pub fn set_ddi(x: u32, ddi: Intensity) -> Self {
+        Self::with(Opcode::SetddI, x, 0, Intensity::NONE, Intensity::NONE, ddi)
+    }
+    /// `SetPI(x, period, I)`.
+    pub fn set_pi(x: u32, period: u32, i: Intensity) -> Self {
+        Self::with(Opcode::SetPI, x, period, i, Intensity::NONE, Intensity::NONE)
+    }
+    /// `SetPdI(x, period, dI)`.
+    pub fn set_pdi(x: u32, period: u32, di: Intensity) -> Self {
+        Self::with(Opcode::SetPdI, x, period, Intensity::NONE, di, Intensity::NONE)
+    }
+    /// `SetPddI(x, period, ddI)`.
+    pub fn set_pddi(x: u32, period: u32, ddi: Intensity) -> Self {
+        Self::with(Opcode::SetPddI, x, period, Intensity::NONE, Intensity::NONE, ddi)
+    }
+    /// `Eval0(x, dx, I)`.
+    pub fn eval0(x: u32, dx: u32, i: Intensity) -> Self {
+        Self::with(Opcode::Eval0, x, dx, i, Intensity::NONE, Intensity::NONE)
+    }
+    /// `Eval1(x, dx, I)`.
+    pub fn eval1(x: u32, dx: u32, i: Intensity) -> Self {
+        Self::with(Opcode::Eval1, x, dx, i, Intensity::NONE, Intensity::NONE)
+    }
+    /// `Eval2(x, dx, I, dI)`.
+    pub fn eval2(x: u32, dx: u32, i: Intensity, di: Intensity) -> Self {
+        Self::with(Opcode::Eval2, x, dx, i, di, Intensity::NONE)
+    }
+    /// `Eval3(x, dx, I, dI, ddI)`.
+    pub fn eval3(x: u32, dx: u32, i: Intensity, di: Intensity, ddi: Intensity) -> Self {
+        Self::with(Opcode::Eval3, x, dx, i, di, ddi)
+    }
+    /// `Dis(x, dx)`.
+    pub fn dis(x: u32, dx: u32) -> Self {
+        Self::with(Opcode::Dis, x, dx, Intensity::NONE, Intensity::NONE, Intensity::NONE)
+    }
+    /// `Acc_mode()`.
+    pub fn acc_mode() -> Self {
+        Self::without_operands(Opcode::AccMode)
+    }
+    /// `Refresh()`.
+    pub fn refresh() -> Self {
+        Self::without_operands(Opcode::Refresh)
+    }
+    /// `Nop()`.
+    pub fn nop() -> Self {
+        Self::without_operands(Opcode::Nop)
+    }
+    fn without_operands(op: Opcode) -> Self {
+        Self::with(op, 0, 0, Intensity::NONE, Intensity::NONE, Intensity::NONE)
+    }
+
+    /// `I` (empty if the opcode has none).
+    pub fn i(&self) -> &Intensity {
+        &self.values[0]
+    }
+    /// `dI` (empty if the opcode has none).
+    pub fn di(&self) -> &Intensity {
+        &self.values[1]
+    }
+    /// `ddI` (empty if the opcode has none).
+    pub fn ddi(&self) -> &Intensity {
+        &self.values[2]
+    }
+
+    /// The processors this instruction addresses, as `(first, end)` of a half-open range,
+    /// for range and single-processor opcodes; `None` for periodic sets and global ones.
+    pub fn span(&self) -> Option<(u32, u32)> {
+        let ops = self.op.operands();
+        match ops {
+            [OperandKind::X, OperandKind::Count, ..] => Some((self.x, self.x + self.dx)),
+            [OperandKind::X, OperandKind::Period, ..] => None,
+            [OperandKind::X, ..] => Some((self.x, self.x + 1)),
+            _ => None,
+        }
+    }
+
+    /// Checks the operands against a trace header: ranges inside the array, periods at
+    /// least 1, every carried intensity with the trace's channel count and finite values.
+    pub fn check(&self, header: &TraceHeader) -> Result<(), OperandError> {
+        let width = header.width;
+        for kind in self.op.operands() {
+            match kind {
+                OperandKind::X => {
+                    if self.x >= width {
+                        return Err(OperandError::Range(format!(
+                            "x = {} is outside the array (width {width}: 0..={})",
+                            self.x,
+                            width - 1
+                        )));
+                    }
+                }
+                OperandKind::Count => {
+                    if u64::from(self.x) + u64::from(self.dx) > u64::from(width) {
+                        return Err(OperandError::Range(format!(
+                            "range [x, x+dx) = [{}, {}) reaches past the array's end ({width})",
+                            self.x,
+                            u64::from(self.x) + u64::from(self.dx)
+                        )));
+                    }
+                }
+                OperandKind::Period => {
+                    if self.dx == 0 {
+                        return Err(OperandError::Range(
+                            "period dx = 0; a periodic set needs dx >= 1".into(),
+                        ));
+                    }
+                }
+                OperandKind::I | OperandKind::DI | OperandKind::DDI => {
+                    let slot = kind.value_slot().expect("value operand");
+                    let v = &self.values[slot];
+                    if v.len() != header.channel_count() {
+                        return Err(OperandError::Channels(format!(
+                            "{} has {} channel(s), the trace has {}",
+                            kind.name(),
+                            v.len(),
+                            header.channels
+                        )));
+                    }
+                    if let Some(bad) = v.as_slice().iter().find(|f| !f.is_finite()) {
+                        return Err(OperandError::NonFinite(format!(
+                            "{} holds {bad}; values must be finite",
+                            kind.name()
+                        )));
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+impl fmt::Debug for Instruction {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&crate::text::format_instruction(self))
+    }
+}
+
+impl fmt::Display for Instruction {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&crate::text::format_instruction(self))
+    }
+}
+
+/// Why an instruction's operands do not fit its trace.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum OperandError {
+    /// A position or range outside the array, or a zero period.
+    Range(String),
+    /// An intensity with the wrong number of channels.
+    Channels(String),
+    /// NaN or an infinity.
+    NonFinite(String),
+}
+
+impl OperandError {
+    /// The message.
+    pub fn message(&self) -> &str {
+        match self {
+            OperandError::Range(m) | OperandError::Channels(m) | OperandError::NonFinite(m) => m,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn grey_header(width: u32) -> TraceHeader {
+        TraceHeader::new(width, 4, 1).unwrap()
+    }
+
+    #[test]
+    fn ranges_are_half_open_and_checked() {
+        let h = grey_header(16);
+        assert!(Instruction::eval1(0, 16, Intensity::grey(1.0)).check(&h).is_ok());
+        assert!(Instruction::eval1(15, 1, Intensity::grey(1.0)).check(&h).is_ok());
+        assert!(Instruction::eval1(15, 0, Intensity::grey(1.0)).check(&h).is_ok());
+        assert!(matches!(
+            Instruction::eval1(15, 2, Intensity::grey(1.0)).check(&h),
+            Err(OperandError::Range(_))
+        ));
+        assert!(matches!(
+            Instruction::set_i(16, Intensity::grey(1.0)).check(&h),
+            Err(OperandError::Range(_))
+        ));
+        assert!(matches!(
+            Instruction::set_pi(3, 0, Intensity::grey(1.0)).check(&h),
+            Err(OperandError::Range(_))
+        ));
+        assert_eq!(Instruction::eval2(3, 4, Intensity::grey(0.0), Intensity::grey(0.0)).span(), Some((3, 7)));
+        assert_eq!(Instruction::set_di(5, Intensity::grey(0.0)).span(), Some((5, 6)));
+        assert_eq!(Instruction::refresh().span(), None);
+    }
+
+    #[test]
+    fn channels_and_finiteness_are_checked() {
+        let h = grey_header(8);
+        assert!(matches!(
+            Instruction::eval1(0, 1, Intensity::new(&[1.0, 2.0, 3.0])).check(&h),
+            Err(OperandError::Channels(_))
+        ));
+        assert!(matches!(
+            Instruction::eval1(0, 1, Intensity::grey(f64::NAN)).check(&h),
+            Err(OperandError::NonFinite(_))
+        ));
+    }
+
+    #[test]
+    fn intensity_equality_is_bit_exact() {
+        assert_ne!(Intensity::grey(0.0), Intensity::grey(-0.0));
+        assert_eq!(Intensity::grey(0.1), Intensity::grey(0.1));
+    }
+}

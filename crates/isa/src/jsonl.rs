@@ -1,0 +1,289 @@
+//! The `.jsonl` encoding: JSON Lines, one object per line.
+//!
+//! ```text
+//! {"format":"cwisim-trace","version":1,"width":16,"lines":4,"channels":1}
+//! {"op":"Eval2","x":0,"dx":8,"I":[0.25],"dI":[0.125]}
+//! {"op":"Refresh"}
+//! ```
+//!
+//! Keys are the operand names of [`Opcode::operands`]; intensities are always arrays,
+//! one number per channel. Floats round-trip exactly (serde_json's `float_roundtrip`).
+
+use crate::error::{operand_error, ErrorKind, Location, TraceError};
+use crate::header::TraceHeader;
+use crate::instruction::{Instruction, Intensity};
+use crate::io::{LineReader, TraceRead, TraceWrite};
+use crate::opcode::{OperandKind, Opcode};
+use crate::text::{header_from_u64, TEXT_MAGIC};
+use serde::ser::SerializeMap;
+use serde::{Deserialize, Serialize, Serializer};
+use std::io::{self, BufRead, Write};
+
+impl Serialize for Instruction {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let kinds = self.op.operands();
+        let mut m = s.serialize_map(Some(kinds.len() + 1))?;
+        m.serialize_entry("op", self.op.name())?;
+        for kind in kinds {
+            match kind {
+                OperandKind::X => m.serialize_entry("x", &self.x)?,
+                OperandKind::Count | OperandKind::Period => m.serialize_entry("dx", &self.dx)?,
+                _ => m.serialize_entry(
+                    kind.name(),
+                    self.values[kind.value_slot().expect("value")].as_slice(),
+                )?,
+            }
+        }
+        m.end()
+    }
+}
+
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct HeaderRecord {
+    format: String,
+    version: u64,
+    width: u64,
+    lines: u64,
+    channels: u64,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Record {
+    op: String,
+    x: Option<u64>,
+    dx: Option<u64>,
+    #[serde(rename = "I")]
+    i: Option<Vec<f64>>,
+    #[serde(rename = "dI")]
+    di: Option<Vec<f64>>,
+    #[serde(rename = "ddI")]
+    ddi: Option<Vec<f64>>,
+}
+
+/// Writes a `.jsonl` trace.
+pub struct JsonlWriter<W: Write> {
+    out: W,
+}
+
+impl<W: Write> JsonlWriter<W> {
+    /// Starts a trace: writes the header object.
+    pub fn new(mut out: W, header: &TraceHeader) -> io::Result<Self> {
+        let rec = HeaderRecord {
+            format: TEXT_MAGIC.into(),
+            version: header.version.into(),
+            width: header.width.into(),
+            lines: header.lines.into(),
+            channels: header.channels.into(),
+        };
+        serde_json::to_writer(&mut out, &rec)?;
+        out.write_all(b"\n")?;
+        Ok(JsonlWriter { out })
+    }
+}
+
+impl<W: Write> TraceWrite for JsonlWriter<W> {
+    fn write(&mut self, instr: &Instruction) -> io::Result<()> {
+        serde_json::to_writer(&mut self.out, instr)?;
+        self.out.write_all(b"\n")
+    }
+
+    fn finish(&mut self) -> io::Result<()> {
+        self.out.flush()
+    }
+}
+
+/// Reads a `.jsonl` trace.
+pub struct JsonlReader<R: BufRead> {
+    lines: LineReader<R>,
+    header: TraceHeader,
+    location: Location,
+}
+
+fn json_error(e: &serde_json::Error, line: u64) -> TraceError {
+    let kind = if e.is_eof() {
+        ErrorKind::Truncated
+    } else {
+        ErrorKind::Syntax
+    };
+    // serde_json's message ends with " at line L column C"; we give our own location.
+    let msg = e.to_string();
+    let msg = msg.rsplit_once(" at line ").map_or(msg.as_str(), |(m, _)| m);
+    TraceError::new(
+        kind,
+        Location::Line {
+            line,
+            column: e.column().max(1) as u64,
+        },
+        format!("invalid JSON record: {msg}"),
+    )
+}
+
+impl<R: BufRead> JsonlReader<R> {
+    /// Opens a trace: reads the header object on the first line.
+    pub fn new(input: R) -> Result<Self, TraceError> {
+        let mut lines = LineReader::new(input);
+        let at1 = Location::Line { line: 1, column: 1 };
+        let Some((_, first)) = lines.next_line()? else {
+            return Err(TraceError::new(
+                ErrorKind::Truncated,
+                at1,
+                "the file is empty; expected the header object {\"format\":\"cwisim-trace\",\"version\":1,…}",
+            ));
+        };
+        let rec: HeaderRecord = serde_json::from_str(first).map_err(|e| {
+            let mut err = json_error(&e, 1);
+            err.kind = ErrorKind::Header;
+            err.message = format!("expected the header object {{\"format\":\"cwisim-trace\",\"version\",\"width\",\"lines\",\"channels\"}}: {}", err.message);
+            err
+        })?;
+        if rec.format != TEXT_MAGIC {
+            return Err(TraceError::new(
+                ErrorKind::Header,
+                at1,
+                format!("header \"format\" is \"{}\", expected \"{TEXT_MAGIC}\"", rec.format),
+            ));
+        }
+        let header = header_from_u64(rec.version, rec.width, rec.lines, rec.channels)
+            .map_err(|m| TraceError::new(ErrorKind::Header, at1, m))?;
+        Ok(JsonlReader {
+            lines,
+            header,
+            location: at1,
+        })
+    }
+}
+
+fn parse_record(line: &str, line_no: u64, header: &TraceHeader) -> Result<Instruction, TraceError> {
+    let at = Location::Line { line: line_no, column: 1 };
+    let rec: Record = serde_json::from_str(line).map_err(|e| json_error(&e, line_no))?;
+    let Some(op) = Opcode::from_name(&rec.op) else {
+        let hint = Opcode::suggest(&rec.op)
+            .map(|op| format!("; did you mean \"{}\"?", op.name()))
+            .unwrap_or_default();
+        return Err(TraceError::new(ErrorKind::UnknownOpcode, at, format!("unknown opcode \"{}\"{hint}", rec.op)));
+    };
+    let kinds = op.operands();
+    let present = [
+        ("x", rec.x.is_some()),
+        ("dx", rec.dx.is_some()),
+        ("I", rec.i.is_some()),
+        ("dI", rec.di.is_some()),
+        ("ddI", rec.ddi.is_some()),
+    ];
+    for (name, is_present) in present {
+        let wanted = kinds.iter().any(|k| k.name() == name);
+        if wanted && !is_present {
+            return Err(TraceError::new(
+                ErrorKind::Syntax,
+                at,
+                format!("`{}` lacks operand \"{name}\"", op.signature()),
+            ));
+        }
+        if !wanted && is_present {
+            return Err(TraceError::new(
+                ErrorKind::Syntax,
+                at,
+                format!("`{}` has no operand \"{name}\"", op.signature()),
+            ));
+        }
+    }
+    let narrow = |name: &str, v: Option<u64>| -> Result<u32, TraceError> {
+        let v = v.unwrap_or(0);
+        u32::try_from(v).map_err(|_| TraceError::new(ErrorKind::Range, at, format!("\"{name}\" = {v} does not fit in 32 bits")))
+    };
+    let channels = header.channel_count();
+    let vector = |name: &str, v: Option<Vec<f64>>| -> Result<Intensity, TraceError> {
+        match v {
+            None => Ok(Intensity::NONE),
+            Some(v) if v.len() != channels => Err(TraceError::new(
+                ErrorKind::Channels,
+                at,
+                format!("\"{name}\" has {} channel value(s), the trace has {channels}", v.len()),
+            )),
+            Some(v) => Ok(Intensity::new(&v)),
+        }
+    };
+    let instr = Instruction {
+        op,
+        x: narrow("x", rec.x)?,
+        dx: narrow("dx", rec.dx)?,
+        values: [vector("I", rec.i)?, vector("dI", rec.di)?, vector("ddI", rec.ddi)?],
+    };
+    instr.check(header).map_err(|e| operand_error(e, at, op))?;
+    Ok(instr)
+}
+
+impl<R: BufRead> TraceRead for JsonlReader<R> {
+    fn header(&self) -> &TraceHeader {
+        &self.header
+    }
+
+    fn next_instruction(&mut self) -> Result<Option<Instruction>, TraceError> {
+        let Some((line_no, line)) = self.lines.next_line()? else {
+            return Ok(None);
+        };
+        if line.trim().is_empty() {
+            return Err(TraceError::new(
+                ErrorKind::Syntax,
+                Location::Line { line: line_no, column: 1 },
+                "empty line; JSON Lines holds one JSON object on every line",
+            ));
+        }
+        let instr = parse_record(line, line_no, &self.header)?;
+        self.location = Location::Line { line: line_no, column: 1 };
+        Ok(Some(instr))
+    }
+
+    fn location(&self) -> Location {
+        self.location
+    }
+
+    fn bytes_read(&self) -> u64 {
+        self.lines.bytes()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::io::read_all;
+
+    const HEAD: &str = "{\"format\":\"cwisim-trace\",\"version\":1,\"width\":8,\"lines\":2,\"channels\":1}\n";
+
+    fn read(body: &str) -> Result<Vec<Instruction>, TraceError> {
+        let src = format!("{HEAD}{body}");
+        let mut r = JsonlReader::new(src.as_bytes())?;
+        read_all(&mut r)
+    }
+
+    #[test]
+    fn writes_the_documented_form() {
+        let mut buf = Vec::new();
+        let h = TraceHeader::new(8, 2, 1).unwrap();
+        let mut w = JsonlWriter::new(&mut buf, &h).unwrap();
+        w.write(&Instruction::eval2(0, 4, Intensity::grey(0.25), Intensity::grey(-0.0))).unwrap();
+        w.write(&Instruction::refresh()).unwrap();
+        let s = String::from_utf8(buf).unwrap();
+        assert_eq!(
+            s,
+            format!("{HEAD}{{\"op\":\"Eval2\",\"x\":0,\"dx\":4,\"I\":[0.25],\"dI\":[-0.0]}}\n{{\"op\":\"Refresh\"}}\n")
+        );
+        assert_eq!(read(&s[HEAD.len()..]).unwrap()[0].di().as_slice()[0].to_bits(), (-0.0f64).to_bits());
+    }
+
+    #[test]
+    fn rejects_missing_extra_and_unknown() {
+        assert_eq!(read("{\"op\":\"Eval1\",\"x\":0,\"I\":[1]}\n").unwrap_err().kind, ErrorKind::Syntax);
+        assert_eq!(read("{\"op\":\"Refresh\",\"x\":0}\n").unwrap_err().kind, ErrorKind::Syntax);
+        assert_eq!(read("{\"op\":\"Refresh\",\"y\":0}\n").unwrap_err().kind, ErrorKind::Syntax);
+        assert_eq!(read("{\"op\":\"Blit\"}\n").unwrap_err().kind, ErrorKind::UnknownOpcode);
+        assert_eq!(read("{\"op\":\"Eval1\",\"x\":0,\"dx\":1,\"I\":[1,2]}\n").unwrap_err().kind, ErrorKind::Channels);
+        assert_eq!(read("{\"op\":\"Eval1\",\"x\":0,\"dx\":9,\"I\":[1]}\n").unwrap_err().kind, ErrorKind::Range);
+        let e = read("{\"op\":\"Eval1\",\"x\":0,\"dx\":1,\"I\":[1e999]}\n").unwrap_err();
+        assert_eq!(e.location, Location::Line { line: 2, column: 37 });
+        let e = read("{\"op\":\"Eval1\",\"x\":0,\"dx\":1,\n").unwrap_err();
+        assert_eq!(e.kind, ErrorKind::Truncated);
+    }
+}

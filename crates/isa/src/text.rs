@@ -1,0 +1,419 @@
+//! The `.cwt` text encoding: one instruction per line, `#` comments, made for reading,
+//! diffing and snapshot tests.
+//!
+//! ```text
+//! # comments run from '#' to the end of the line
+//! cwisim-trace version=1 width=16 lines=4 channels=1
+//! Eval2 0 8 0.25 0.125
+//! Refresh
+//! ```
+//!
+//! Operands follow [`Opcode::operands`]. An intensity is its channel values joined by
+//! commas without spaces (`0.5,0.25,1.0` for RGB). Values are written in Rust's shortest
+//! round-trip form, so text → value → text is exact.
+
+use crate::error::{operand_error, ErrorKind, Location, TraceError};
+use crate::header::{TraceHeader, FORMAT_VERSION};
+use crate::instruction::{Instruction, Intensity};
+use crate::io::{LineReader, TraceRead, TraceWrite};
+use crate::opcode::{OperandKind, Opcode};
+use std::fmt::Write as _;
+use std::io::{self, BufRead, Write};
+
+/// The first word of a text trace's header line.
+pub const TEXT_MAGIC: &str = "cwisim-trace";
+
+/// The header line, e.g. `cwisim-trace version=1 width=16 lines=4 channels=1`.
+pub fn format_header(h: &TraceHeader) -> String {
+    format!(
+        "{TEXT_MAGIC} version={} width={} lines={} channels={}",
+        h.version, h.width, h.lines, h.channels
+    )
+}
+
+/// One value in its shortest exact form (`0.5`, `1.0`, `-0.0`, `1e-7`).
+pub fn format_value(v: f64) -> String {
+    format!("{v:?}")
+}
+
+/// One intensity: channel values joined by commas.
+pub fn format_intensity(v: &Intensity) -> String {
+    let mut s = String::new();
+    for (k, x) in v.as_slice().iter().enumerate() {
+        if k > 0 {
+            s.push(',');
+        }
+        let _ = write!(s, "{x:?}");
+    }
+    s
+}
+
+/// One instruction as a line of text (without newline).
+pub fn format_instruction(instr: &Instruction) -> String {
+    let mut s = String::from(instr.op.name());
+    for kind in instr.op.operands() {
+        s.push(' ');
+        match kind {
+            OperandKind::X => {
+                let _ = write!(s, "{}", instr.x);
+            }
+            OperandKind::Count | OperandKind::Period => {
+                let _ = write!(s, "{}", instr.dx);
+            }
+            _ => s.push_str(&format_intensity(&instr.values[kind.value_slot().expect("value")])),
+        }
+    }
+    s
+}
+
+/// Writes a `.cwt` trace.
+pub struct TextWriter<W: Write> {
+    out: W,
+}
+
+impl<W: Write> TextWriter<W> {
+    /// Starts a trace: writes the header line.
+    pub fn new(mut out: W, header: &TraceHeader) -> io::Result<Self> {
+        writeln!(out, "{}", format_header(header))?;
+        Ok(TextWriter { out })
+    }
+}
+
+impl<W: Write> TraceWrite for TextWriter<W> {
+    fn write(&mut self, instr: &Instruction) -> io::Result<()> {
+        writeln!(self.out, "{}", format_instruction(instr))
+    }
+
+    fn comment(&mut self, text: &str) -> io::Result<()> {
+        for line in text.lines() {
+            writeln!(self.out, "# {line}")?;
+        }
+        Ok(())
+    }
+
+    fn finish(&mut self) -> io::Result<()> {
+        self.out.flush()
+    }
+}
+
+/// Reads a `.cwt` trace.
+pub struct TextReader<R: BufRead> {
+    lines: LineReader<R>,
+    header: TraceHeader,
+    location: Location,
+}
+
+struct Token<'a> {
+    text: &'a str,
+    column: u64,
+}
+
+fn tokens(content: &str) -> Vec<Token<'_>> {
+    let mut out = Vec::new();
+    let mut start = None;
+    for (i, c) in content.char_indices() {
+        if c.is_ascii_whitespace() {
+            if let Some(s) = start.take() {
+                out.push(Token {
+                    text: &content[s..i],
+                    column: s as u64 + 1,
+                });
+            }
+        } else if start.is_none() {
+            start = Some(i);
+        }
+    }
+    if let Some(s) = start {
+        out.push(Token {
+            text: &content[s..],
+            column: s as u64 + 1,
+        });
+    }
+    out
+}
+
+fn strip_comment(line: &str) -> &str {
+    match line.find('#') {
+        Some(i) => &line[..i],
+        None => line,
+    }
+}
+
+impl<R: BufRead> TextReader<R> {
+    /// Opens a trace: reads up to and including the header line.
+    pub fn new(input: R) -> Result<Self, TraceError> {
+        let mut lines = LineReader::new(input);
+        loop {
+            let Some((line_no, line)) = lines.next_line()? else {
+                return Err(TraceError::new(
+                    ErrorKind::Truncated,
+                    Location::Line { line: 1, column: 1 },
+                    format!("the file ends before the header line `{TEXT_MAGIC} version={FORMAT_VERSION} width=W lines=H channels=C`"),
+                ));
+            };
+            let toks = tokens(strip_comment(line));
+            if toks.is_empty() {
+                continue;
+            }
+            let header = parse_header(&toks, line_no)?;
+            return Ok(TextReader {
+                lines,
+                header,
+                location: Location::Line { line: 1, column: 1 },
+            });
+        }
+    }
+}
+
+fn parse_header(toks: &[Token<'_>], line: u64) -> Result<TraceHeader, TraceError> {
+    let at = |column| Location::Line { line, column };
+    if toks[0].text != TEXT_MAGIC {
+        return Err(TraceError::new(
+            ErrorKind::Header,
+            at(toks[0].column),
+            format!(
+                "expected the header `{TEXT_MAGIC} version={FORMAT_VERSION} width=W lines=H channels=C` first, found `{}`",
+                toks[0].text
+            ),
+        ));
+    }
+    let mut fields: [Option<u64>; 4] = [None; 4];
+    const KEYS: [&str; 4] = ["version", "width", "lines", "channels"];
+    for t in &toks[1..] {
+        let Some((key, value)) = t.text.split_once('=') else {
+            return Err(TraceError::new(
+                ErrorKind::Header,
+                at(t.column),
+                format!("expected `key=value` in the header, found `{}`", t.text),
+            ));
+        };
+        let Some(k) = KEYS.iter().position(|k| *k == key) else {
+            return Err(TraceError::new(
+                ErrorKind::Header,
+                at(t.column),
+                format!("unknown header key `{key}`; expected one of version, width, lines, channels"),
+            ));
+        };
+        if fields[k].is_some() {
+            return Err(TraceError::new(ErrorKind::Header, at(t.column), format!("header key `{key}` given twice")));
+        }
+        let v: u64 = value.parse().map_err(|_| {
+            TraceError::new(
+                ErrorKind::Header,
+                at(t.column + key.len() as u64 + 1),
+                format!("expected an unsigned integer for `{key}`, found `{value}`"),
+            )
+        })?;
+        fields[k] = Some(v);
+    }
+    for (k, f) in fields.iter().enumerate() {
+        if f.is_none() {
+            return Err(TraceError::new(
+                ErrorKind::Header,
+                at(1),
+                format!("the header lacks `{}=`", KEYS[k]),
+            ));
+        }
+    }
+    let [version, width, lines, channels] = fields.map(|f| f.expect("checked"));
+    header_from_u64(version, width, lines, channels).map_err(|m| TraceError::new(ErrorKind::Header, at(1), m))
+}
+
+/// Builds and checks a header from wide integers, so that absurd sizes get a message
+/// rather than a wrap-around.
+pub(crate) fn header_from_u64(version: u64, width: u64, lines: u64, channels: u64) -> Result<TraceHeader, String> {
+    let narrow = |name: &str, v: u64, max: u64| {
+        if v > max {
+            Err(format!("{name} {v} is absurd (the limit is far below {max})"))
+        } else {
+            Ok(v)
+        }
+    };
+    let h = TraceHeader {
+        version: narrow("version", version, u64::from(u16::MAX))? as u16,
+        width: narrow("width", width, u64::from(u32::MAX))? as u32,
+        lines: narrow("lines", lines, u64::from(u32::MAX))? as u32,
+        channels: narrow("channels", channels, u64::from(u8::MAX))? as u8,
+    };
+    h.check()?;
+    Ok(h)
+}
+
+/// Parses one instruction line (comment already stripped) against a header.
+pub fn parse_instruction(content: &str, line: u64, header: &TraceHeader) -> Result<Option<Instruction>, TraceError> {
+    let toks = tokens(content);
+    if toks.is_empty() {
+        return Ok(None);
+    }
+    let at = |column| Location::Line { line, column };
+    let name = toks[0].text;
+    let Some(op) = Opcode::from_name(name) else {
+        let hint = Opcode::suggest(name)
+            .map(|op| format!("; did you mean `{}`?", op.name()))
+            .unwrap_or_default();
+        return Err(TraceError::new(
+            ErrorKind::UnknownOpcode,
+            at(toks[0].column),
+            format!("unknown opcode `{name}`{hint}"),
+        ));
+    };
+    let kinds = op.operands();
+    let given = toks.len() - 1;
+    if given != kinds.len() {
+        let column = toks.get(kinds.len() + 1).map_or(content.len() as u64 + 1, |t| t.column);
+        return Err(TraceError::new(
+            ErrorKind::Syntax,
+            at(column),
+            format!(
+                "`{}` takes {} operand(s), found {given}",
+                op.signature(),
+                kinds.len()
+            ),
+        ));
+    }
+    let mut instr = Instruction {
+        op,
+        x: 0,
+        dx: 0,
+        values: [Intensity::NONE; 3],
+    };
+    let channels = header.channel_count();
+    for (kind, tok) in kinds.iter().zip(&toks[1..]) {
+        match kind {
+            OperandKind::X | OperandKind::Count | OperandKind::Period => {
+                let v = parse_u32(tok.text, kind.name()).map_err(|m| TraceError::new(ErrorKind::Syntax, at(tok.column), m))?;
+                if *kind == OperandKind::X {
+                    instr.x = v;
+                } else {
+                    instr.dx = v;
+                }
+            }
+            _ => {
+                let parts: Vec<&str> = tok.text.split(',').collect();
+                if parts.len() != channels {
+                    return Err(TraceError::new(
+                        ErrorKind::Channels,
+                        at(tok.column),
+                        format!(
+                            "{} has {} channel value(s) `{}`, the trace has {channels} (join channels with commas, no spaces)",
+                            kind.name(),
+                            parts.len(),
+                            tok.text
+                        ),
+                    ));
+                }
+                let mut vals = [0.0; crate::header::MAX_CHANNELS];
+                let mut col = tok.column;
+                for (k, p) in parts.iter().enumerate() {
+                    vals[k] = parse_f64(p, kind.name()).map_err(|(kind, m)| TraceError::new(kind, at(col), m))?;
+                    col += p.len() as u64 + 1;
+                }
+                instr.values[kind.value_slot().expect("value")] = Intensity::new(&vals[..channels]);
+            }
+        }
+    }
+    instr
+        .check(header)
+        .map_err(|e| operand_error(e, at(toks[1].column), op))?;
+    Ok(Some(instr))
+}
+
+fn parse_u32(text: &str, name: &str) -> Result<u32, String> {
+    if !text.bytes().all(|b| b.is_ascii_digit()) {
+        return Err(format!("expected an unsigned integer for `{name}`, found `{text}`"));
+    }
+    text.parse::<u32>()
+        .map_err(|_| format!("`{name}` = {text} does not fit in 32 bits"))
+}
+
+fn parse_f64(text: &str, name: &str) -> Result<f64, (ErrorKind, String)> {
+    let looks_numeric = !text.is_empty()
+        && text
+            .bytes()
+            .all(|b| b.is_ascii_digit() || matches!(b, b'.' | b'-' | b'+' | b'e' | b'E'));
+    if !looks_numeric {
+        let kind = if text.to_ascii_lowercase().trim_start_matches(['-', '+']).starts_with("inf")
+            || text.eq_ignore_ascii_case("nan")
+        {
+            ErrorKind::NonFinite
+        } else {
+            ErrorKind::Syntax
+        };
+        return Err((kind, format!("expected a finite number for `{name}`, found `{text}`")));
+    }
+    let v: f64 = text
+        .parse()
+        .map_err(|_| (ErrorKind::Syntax, format!("expected a finite number for `{name}`, found `{text}`")))?;
+    if !v.is_finite() {
+        return Err((ErrorKind::NonFinite, format!("`{name}` = {text} overflows f64")));
+    }
+    Ok(v)
+}
+
+impl<R: BufRead> TraceRead for TextReader<R> {
+    fn header(&self) -> &TraceHeader {
+        &self.header
+    }
+
+    fn next_instruction(&mut self) -> Result<Option<Instruction>, TraceError> {
+        loop {
+            let Some((line_no, line)) = self.lines.next_line()? else {
+                return Ok(None);
+            };
+            if let Some(instr) = parse_instruction(strip_comment(line), line_no, &self.header)? {
+                self.location = Location::Line { line: line_no, column: 1 };
+                return Ok(Some(instr));
+            }
+        }
+    }
+
+    fn location(&self) -> Location {
+        self.location
+    }
+
+    fn bytes_read(&self) -> u64 {
+        self.lines.bytes()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::io::read_all;
+
+    fn read(src: &str) -> Result<(TraceHeader, Vec<Instruction>), TraceError> {
+        let mut r = TextReader::new(src.as_bytes())?;
+        let v = read_all(&mut r)?;
+        Ok((*r.header(), v))
+    }
+
+    #[test]
+    fn reads_comments_blank_lines_and_rgb() {
+        let (h, v) = read(
+            "# a trace\n\ncwisim-trace version=1 width=8 lines=2 channels=3 # trailing\nEval2 0 4 1.0,0.5,0.0 -0.25,0,1e-3\n  Refresh  \n",
+        )
+        .unwrap();
+        assert_eq!(h.width, 8);
+        assert_eq!(v.len(), 2);
+        assert_eq!(v[0].di().as_slice(), &[-0.25, 0.0, 1e-3]);
+        assert_eq!(format_instruction(&v[0]), "Eval2 0 4 1.0,0.5,0.0 -0.25,0.0,0.001");
+    }
+
+    #[test]
+    fn errors_are_located() {
+        let e = read("cwisim-trace version=1 width=8 lines=2 channels=1\nEval2 0 4 1.0\n").unwrap_err();
+        assert_eq!(e.kind, ErrorKind::Syntax);
+        assert_eq!(e.location, Location::Line { line: 2, column: 14 });
+        let e = read("cwisim-trace version=1 width=8 lines=2 channels=1\nEval1 -1 4 1.0\n").unwrap_err();
+        assert_eq!(e.location, Location::Line { line: 2, column: 7 });
+        assert!(e.message.contains("unsigned integer"), "{}", e.message);
+        let e = read("cwisim-trace version=1 width=8 lines=2 channels=1\nEval1 0 4 NaN\n").unwrap_err();
+        assert_eq!(e.kind, ErrorKind::NonFinite);
+        let e = read("cwisim-trace version=1 width=8 lines=2 channels=1\neval1 0 4 1\n").unwrap_err();
+        assert!(e.message.contains("did you mean `Eval1`"), "{}", e.message);
+        let e = read("cwisim-trace version=1 width=99999999999 lines=2 channels=1\n").unwrap_err();
+        assert_eq!(e.kind, ErrorKind::Header);
+        let e = read("").unwrap_err();
+        assert_eq!(e.kind, ErrorKind::Truncated);
+    }
+}

@@ -1,0 +1,96 @@
+//! The engine interface, the choice of timing model, and replaying a trace.
+
+use crate::fast::FastEngine;
+use crate::machine::{Machine, MachineError};
+use crate::output::{Image, ImageSink, LineSink};
+use crate::sample::Sample;
+use crate::stats::RunStats;
+use crate::stepped::SteppedEngine;
+use cwisim_isa::{Instruction, TraceError, TraceHeader, TraceRead};
+
+/// An X-processor array that executes instructions in order and shifts out scanlines.
+pub trait Engine<T: Sample> {
+    /// Issues one instruction (already checked against the trace header).
+    fn execute(&mut self, instr: &Instruction, sink: &mut dyn LineSink<T>);
+    /// Drains the array and returns the statistics.
+    fn finish(self: Box<Self>, sink: &mut dyn LineSink<T>) -> RunStats;
+}
+
+/// Which implementation of the timing model to run. Both give identical scanlines and
+/// identical cycle counts.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Timing {
+    /// Closed-form timing, work proportional to the instructions' ranges.
+    #[default]
+    Fast,
+    /// Every processor advanced every cycle (the reference).
+    Stepped,
+}
+
+/// An engine of the chosen kind for a trace.
+pub fn engine<T: Sample>(
+    header: &TraceHeader,
+    machine: &Machine,
+    timing: Timing,
+) -> Result<Box<dyn Engine<T>>, MachineError> {
+    let timeline = machine.timeline(header)?;
+    Ok(match timing {
+        Timing::Fast => Box::new(FastEngine::<T>::new(header, timeline)),
+        Timing::Stepped => Box::new(SteppedEngine::<T>::new(header, timeline)),
+    })
+}
+
+/// Why a replay stopped.
+#[derive(Debug, thiserror::Error)]
+pub enum ReplayError {
+    /// The trace is malformed.
+    #[error(transparent)]
+    Trace(#[from] TraceError),
+    /// The machine description is unusable.
+    #[error(transparent)]
+    Machine(#[from] MachineError),
+}
+
+/// Replays a trace from a reader into `sink`, calling `progress` with the bytes read every
+/// few thousand instructions.
+pub fn replay<T: Sample>(
+    reader: &mut dyn TraceRead,
+    machine: &Machine,
+    timing: Timing,
+    sink: &mut dyn LineSink<T>,
+    progress: &mut dyn FnMut(u64),
+) -> Result<RunStats, ReplayError> {
+    let header = *reader.header();
+    let mut eng = engine::<T>(&header, machine, timing)?;
+    let mut n: u64 = 0;
+    while let Some(instr) = reader.next_instruction()? {
+        eng.execute(&instr, sink);
+        n += 1;
+        if n % 4096 == 0 {
+            progress(reader.bytes_read());
+        }
+    }
+    progress(reader.bytes_read());
+    Ok(eng.finish(sink))
+}
+
+/// Runs instructions held in memory and collects the image (in `f64`).
+///
+/// # Panics
+/// If an instruction does not fit `header` (use [`Instruction::check`] first) or the
+/// image would exceed [`ImageSink::DEFAULT_LIMIT_BYTES`].
+pub fn run<T: Sample>(
+    header: &TraceHeader,
+    instrs: &[Instruction],
+    machine: &Machine,
+    timing: Timing,
+) -> Result<(Image, RunStats), MachineError> {
+    let mut eng = engine::<T>(header, machine, timing)?;
+    let mut sink = ImageSink::new(header.width as usize, header.channel_count(), ImageSink::DEFAULT_LIMIT_BYTES);
+    for i in instrs {
+        debug_assert!(i.check(header).is_ok(), "{i} does not fit the header");
+        eng.execute(i, &mut sink);
+    }
+    let stats = eng.finish(&mut sink);
+    Ok((sink.finish().expect("image within the default limit"), stats))
+}

@@ -1,0 +1,46 @@
+//! # cwisim-xproc — the CWI X-processor array
+//!
+//! A one-dimensional array of X-processors, one per pixel column, that executes the
+//! scanline commands of `cwisim-isa`: it interpolates by forward differencing,
+//! accumulates, and shifts out one scanline per `Refresh`.
+//!
+//! * Exact semantics (`docs/ISA.md`): preload registers, `Eval0` locks, `Dis` masks,
+//!   `Acc_mode`, all per processor and channel. The register type is a parameter
+//!   ([`Sample`]); `f64` is the reference.
+//! * Cycle-level timing (`docs/TIMING.md`) from an explicit [`Machine`] model: an
+//!   instruction bus feeding a systolic chain, one processor per hop, and a display that
+//!   takes one scanline per line period. Two implementations: [`Timing::Stepped`]
+//!   advances every processor every cycle; [`Timing::Fast`] computes the same scanlines
+//!   and the same cycle of every event in closed form, with cost proportional to the work
+//!   in the trace.
+//! * Per-scanline statistics ([`RunStats`]): instructions by opcode, bus and stall
+//!   cycles, processor updates, readiness against the display deadline.
+//!
+//! ```
+//! use cwisim_isa::{Instruction, Intensity, TraceHeader};
+//! use cwisim_xproc::{run, Machine, Timing};
+//! let h = TraceHeader::new(8, 1, 1).unwrap();
+//! let trace = [
+//!     Instruction::eval2(2, 4, Intensity::grey(0.5), Intensity::grey(0.125)),
+//!     Instruction::refresh(),
+//! ];
+//! let (image, stats) = run::<f64>(&h, &trace, &Machine::default(), Timing::Fast).unwrap();
+//! assert_eq!(image.data, [0.0, 0.0, 0.5, 0.625, 0.75, 0.875, 0.0, 0.0]);
+//! assert_eq!(stats.totals.lines, 1);
+//! ```
+
+#![warn(missing_docs)]
+
+pub mod engine;
+pub mod fast;
+pub mod machine;
+pub mod output;
+pub mod sample;
+pub mod stats;
+pub mod stepped;
+
+pub use engine::{engine, replay, run, Engine, ReplayError, Timing};
+pub use machine::{Machine, MachineError, Timeline};
+pub use output::{Image, ImageLimit, ImageSink, LineOut, LineSink, NullSink};
+pub use sample::Sample;
+pub use stats::{LineStats, OpcodeCounts, RunStats, Totals};

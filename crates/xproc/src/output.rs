@@ -1,0 +1,117 @@
+//! Where scanlines go when a `Refresh` shifts them out.
+
+use crate::sample::Sample;
+
+/// One scanline as the array shifts it out.
+///
+/// Only `span` may hold non-zero values; every pixel outside it is exactly `+0.0`. This
+/// lets an engine skip processors that no instruction reached.
+pub struct LineOut<'a, T> {
+    /// Scanline number over the whole trace (frame × lines per frame + row).
+    pub index: u64,
+    /// Pixel columns `[span.0, span.1)` that `values` covers.
+    pub span: (usize, usize),
+    /// `(span.1 - span.0) × channels` values, pixel-major.
+    pub values: &'a [T],
+}
+
+/// Receives scanlines in order.
+pub trait LineSink<T: Sample> {
+    /// One finished scanline.
+    fn line(&mut self, line: LineOut<'_, T>);
+}
+
+/// Discards scanlines (for statistics-only runs).
+pub struct NullSink;
+
+impl<T: Sample> LineSink<T> for NullSink {
+    fn line(&mut self, _line: LineOut<'_, T>) {}
+}
+
+/// Every scanline of a run as `f64`, shape `(lines, width, channels)`, C order.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Image {
+    /// Pixel columns.
+    pub width: usize,
+    /// Values per pixel.
+    pub channels: usize,
+    /// Scanlines output so far.
+    pub lines: usize,
+    /// `lines × width × channels` values.
+    pub data: Vec<f64>,
+}
+
+/// The output would exceed the collector's limit.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("the output image would exceed {limit_bytes} bytes at scanline {line} ({width} × {channels} f64 values per scanline); write statistics only, or raise the limit")]
+pub struct ImageLimit {
+    /// The limit.
+    pub limit_bytes: u64,
+    /// The scanline that crossed it.
+    pub line: u64,
+    /// Width.
+    pub width: usize,
+    /// Channels.
+    pub channels: usize,
+}
+
+/// Collects scanlines into an [`Image`], up to a size limit.
+pub struct ImageSink {
+    image: Image,
+    limit_bytes: u64,
+    overflow: Option<ImageLimit>,
+}
+
+impl ImageSink {
+    /// Default limit on the collected image: 4 GiB of f64 values.
+    pub const DEFAULT_LIMIT_BYTES: u64 = 4 << 30;
+
+    /// A collector for an array of `width` processors and `channels` channels.
+    pub fn new(width: usize, channels: usize, limit_bytes: u64) -> Self {
+        ImageSink {
+            image: Image {
+                width,
+                channels,
+                lines: 0,
+                data: Vec::new(),
+            },
+            limit_bytes,
+            overflow: None,
+        }
+    }
+
+    /// The image, or the limit it ran into.
+    pub fn finish(self) -> Result<Image, ImageLimit> {
+        match self.overflow {
+            Some(e) => Err(e),
+            None => Ok(self.image),
+        }
+    }
+}
+
+impl<T: Sample> LineSink<T> for ImageSink {
+    fn line(&mut self, line: LineOut<'_, T>) {
+        if self.overflow.is_some() {
+            return;
+        }
+        let row = self.image.width * self.image.channels;
+        let bytes = (self.image.lines as u64 + 1) * row as u64 * 8;
+        if bytes > self.limit_bytes {
+            self.overflow = Some(ImageLimit {
+                limit_bytes: self.limit_bytes,
+                line: line.index,
+                width: self.image.width,
+                channels: self.image.channels,
+            });
+            return;
+        }
+        let start = self.image.data.len();
+        self.image.data.resize(start + row, 0.0);
+        let c = self.image.channels;
+        let dst = &mut self.image.data[start + line.span.0 * c..start + line.span.1 * c];
+        for (d, s) in dst.iter_mut().zip(line.values) {
+            *d = s.to_f64();
+        }
+        self.image.lines += 1;
+    }
+}

@@ -1,0 +1,218 @@
+//! Per-scanline and per-run statistics, recorded the same way by both engines.
+
+use cwisim_isa::Opcode;
+use serde::ser::SerializeMap;
+use serde::{Serialize, Serializer};
+
+/// A counter per opcode; serializes as `{"SetI": n, …}` in opcode order.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct OpcodeCounts(pub [u64; Opcode::COUNT]);
+
+impl OpcodeCounts {
+    /// The count for one opcode.
+    pub fn get(&self, op: Opcode) -> u64 {
+        self.0[op.index()]
+    }
+    /// All counts added up.
+    pub fn total(&self) -> u64 {
+        self.0.iter().sum()
+    }
+    fn add(&mut self, other: &OpcodeCounts) {
+        for (a, b) in self.0.iter_mut().zip(other.0) {
+            *a += b;
+        }
+    }
+}
+
+impl Serialize for OpcodeCounts {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let mut m = s.serialize_map(Some(Opcode::COUNT))?;
+        for op in Opcode::ALL {
+            m.serialize_entry(op.name(), &self.get(*op))?;
+        }
+        m.end()
+    }
+}
+
+/// What one scanline cost: the instructions from the previous `Refresh` (exclusive) to
+/// its own `Refresh` (inclusive).
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct LineStats {
+    /// Scanline number over the whole trace.
+    pub line: u64,
+    /// Frame number.
+    pub frame: u64,
+    /// Row within the frame.
+    pub row: u64,
+    /// Instructions, by opcode.
+    pub opcodes: OpcodeCounts,
+    /// Instructions in all.
+    pub instructions: u64,
+    /// Processor-instruction pairs that Set/Eval/Dis addressed.
+    pub processor_updates: u64,
+    /// Channel contributions dropped because negative accumulation was off (`Acc_mode`).
+    pub dropped_negative: u64,
+    /// Processor contributions suppressed by an `Eval0` lock or a `Dis` mask.
+    pub suppressed: u64,
+    /// Bus cycles spent issuing this line's instructions.
+    pub busy_cycles: u64,
+    /// Cycles the bus waited: for the display to free the output registers (before a
+    /// `Refresh`) or for the first processor to take the previous token.
+    pub stall_cycles: u64,
+    /// Cycle the line's first instruction started to issue.
+    pub first_issue: u64,
+    /// Cycle the `Refresh` token left the last processor: the scanline is complete.
+    pub ready: u64,
+    /// Cycle the display takes the scanline.
+    pub deadline: u64,
+    /// `deadline - ready`; negative is an overrun (a visible fault).
+    pub slack: i64,
+}
+
+/// Totals of a run.
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct Totals {
+    /// Instructions, by opcode (including any after the last `Refresh`).
+    pub opcodes: OpcodeCounts,
+    /// Instructions in all.
+    pub instructions: u64,
+    /// Scanlines output.
+    pub lines: u64,
+    /// Complete frames output.
+    pub frames: u64,
+    /// Scanlines of a last, incomplete frame.
+    pub partial_frame_lines: u64,
+    /// Scanlines not ready by their deadline.
+    pub late_lines: u64,
+    /// The smallest slack of any scanline (negative: the worst overrun).
+    pub worst_slack: Option<i64>,
+    /// The scanline with that slack.
+    pub worst_line: Option<u64>,
+    /// Processor updates in all.
+    pub processor_updates: u64,
+    /// Negative contributions dropped in all.
+    pub dropped_negative: u64,
+    /// Contributions suppressed by locks and masks in all.
+    pub suppressed: u64,
+    /// Instructions after the last `Refresh`: executed but never output.
+    pub unrefreshed_instructions: u64,
+    /// Cycle the last token left the array (0 for an empty trace).
+    pub cycles: u64,
+}
+
+/// Everything a run reports.
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct RunStats {
+    /// Line period in cycles.
+    pub line_period: u64,
+    /// Cycles a token needs to cross the array.
+    pub traversal_cycles: u64,
+    /// Totals.
+    pub totals: Totals,
+    /// One record per scanline output.
+    pub lines: Vec<LineStats>,
+}
+
+/// Collects events from an engine into [`RunStats`]. Events name the scanline they
+/// belong to, since in the cycle-stepped engine work on one scanline finishes while the
+/// next one is already being issued.
+pub(crate) struct Recorder {
+    lines: Vec<LineStats>,
+    lines_per_frame: u64,
+    last_entry: u64,
+    stats: RunStats,
+}
+
+impl Recorder {
+    pub(crate) fn new(timeline: &crate::machine::Timeline) -> Self {
+        Recorder {
+            lines: Vec::new(),
+            lines_per_frame: timeline.lines_per_frame,
+            last_entry: 0,
+            stats: RunStats {
+                line_period: timeline.line_period,
+                traversal_cycles: timeline.traversal(),
+                ..RunStats::default()
+            },
+        }
+    }
+
+    fn line_mut(&mut self, line: u64) -> &mut LineStats {
+        let i = line as usize;
+        while self.lines.len() <= i {
+            let n = self.lines.len() as u64;
+            self.lines.push(LineStats {
+                line: n,
+                frame: n / self.lines_per_frame,
+                row: n % self.lines_per_frame,
+                ..LineStats::default()
+            });
+        }
+        &mut self.lines[i]
+    }
+
+    /// An instruction of scanline `line` started issuing at `begin` and entered the first
+    /// processor at `entry` after `cost` bus cycles.
+    pub(crate) fn issue(&mut self, line: u64, op: Opcode, begin: u64, entry: u64, cost: u64) {
+        let stall = entry - self.last_entry - cost;
+        self.last_entry = entry;
+        let l = self.line_mut(line);
+        if l.instructions == 0 {
+            l.first_issue = begin;
+        }
+        l.instructions += 1;
+        l.opcodes.0[op.index()] += 1;
+        l.busy_cycles += cost;
+        l.stall_cycles += stall;
+    }
+
+    /// Work an instruction of scanline `line` did in the processors.
+    pub(crate) fn work(&mut self, line: u64, updates: u64, dropped_negative: u64, suppressed: u64) {
+        let l = self.line_mut(line);
+        l.processor_updates += updates;
+        l.dropped_negative += dropped_negative;
+        l.suppressed += suppressed;
+    }
+
+    /// Scanline `line` is complete at `ready`; the display takes it at `deadline`.
+    pub(crate) fn ready(&mut self, line: u64, ready: u64, deadline: u64) {
+        let l = self.line_mut(line);
+        l.ready = ready;
+        l.deadline = deadline;
+        l.slack = deadline as i64 - ready as i64;
+    }
+
+    /// The totals, once every token has left the array at cycle `end`; `refreshed` is
+    /// the number of scanlines output.
+    pub(crate) fn finish(mut self, refreshed: u64, end: u64) -> RunStats {
+        let mut t = Totals {
+            cycles: end,
+            ..Totals::default()
+        };
+        for (i, l) in self.lines.iter().enumerate() {
+            t.opcodes.add(&l.opcodes);
+            t.instructions += l.instructions;
+            t.processor_updates += l.processor_updates;
+            t.dropped_negative += l.dropped_negative;
+            t.suppressed += l.suppressed;
+            if (i as u64) < refreshed {
+                if l.slack < 0 {
+                    t.late_lines += 1;
+                }
+                if t.worst_slack.is_none_or(|w| l.slack < w) {
+                    t.worst_slack = Some(l.slack);
+                    t.worst_line = Some(l.line);
+                }
+            } else {
+                t.unrefreshed_instructions += l.instructions;
+            }
+        }
+        self.lines.truncate(refreshed as usize);
+        t.lines = refreshed;
+        t.frames = refreshed / self.lines_per_frame;
+        t.partial_frame_lines = refreshed % self.lines_per_frame;
+        self.stats.totals = t;
+        self.stats.lines = self.lines;
+        self.stats
+    }
+}
