@@ -37,11 +37,16 @@ pub fn machine_for(trace: &Path) -> Machine {
 }
 
 /// Replays a trace file (any encoding) on `machine`.
-pub fn replay_file(path: &Path, machine: &Machine, timing: Timing) -> (TraceHeader, Image, RunStats) {
+pub fn replay_file(
+    path: &Path,
+    machine: &Machine,
+    timing: Timing,
+) -> (TraceHeader, Image, RunStats) {
     let mut reader = FileReader::open(path).unwrap_or_else(|e| panic!("{e}"));
     let header = *reader.header();
     let mut sink = ImageSink::new(header.width as usize, header.channel_count(), 1 << 30);
-    let stats = replay::<f64>(&mut reader, machine, timing, &mut sink, &mut |_| {}).unwrap_or_else(|e| panic!("{e}"));
+    let stats = replay::<f64>(&mut reader, machine, timing, &mut sink, &mut |_| {})
+        .unwrap_or_else(|e| panic!("{e}"));
     (header, sink.finish().expect("small image"), stats)
 }
 
@@ -80,7 +85,12 @@ pub fn render_replay(header: &TraceHeader, image: &Image, stats: &RunStats) -> S
         );
         let px: Vec<String> = values
             .chunks(image.channels)
-            .map(|p| p.iter().map(|v| format!("{v:?}")).collect::<Vec<_>>().join(","))
+            .map(|p| {
+                p.iter()
+                    .map(|v| format!("{v:?}"))
+                    .collect::<Vec<_>>()
+                    .join(",")
+            })
             .collect();
         let _ = writeln!(s, "  {}", px.join(" "));
     }

@@ -16,7 +16,10 @@ fn examples_replay_to_their_expected_output() {
         let (_, image_s, stats_s) = replay_file(trace, &machine, Timing::Stepped);
         assert_eq!(image, image_s, "{}: engines differ", trace.display());
         assert_eq!(stats, stats_s, "{}: engines differ", trace.display());
-        check_or_bless(&trace.with_extension("expected"), &render_replay(&header, &image, &stats));
+        check_or_bless(
+            &trace.with_extension("expected"),
+            &render_replay(&header, &image, &stats),
+        );
     }
 }
 

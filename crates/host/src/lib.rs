@@ -1,1 +1,35 @@
-//! placeholder
+//! # cwisim-host — the `cwisim` command-line tool
+//!
+//! The host side of the simulator: it reads trace files (`cwisim-isa`), replays them on the
+//! simulated X-processor array (`cwisim-xproc`), and writes what the array shifted out as
+//! a PNG picture or an exact NumPy array, with per-run statistics in text or JSON.
+//!
+//! * [`cli`] — the `cwisim` command line (`run`, `convert`, `machine`) and
+//!   [`cli::run_cli`], which runs it in-process on any output streams.
+//! * [`commands`] — one module per subcommand.
+//! * [`demo`] — the embedded demo trace `cwisim run` replays when given no file.
+//! * [`output`] — NumPy `.npy` and PNG encoding of an [`Image`](cwisim_xproc::Image).
+//! * [`report`] — the human statistics summary and the `--stats-json` document.
+//! * [`files`] — writing outputs all-or-nothing, and telling whether two paths are one file.
+//! * [`progress`] — the progress bar `run` shows on a terminal.
+//! * [`error`] — [`CliError`], every way a command can fail, with its exit code.
+//!
+//! ```no_run
+//! let mut out = Vec::new();
+//! let mut err = Vec::new();
+//! let code = cwisim_host::cli::run_cli(["cwisim", "run", "t.cwt", "--npy", "t.npy"].map(Into::into), &mut out, &mut err);
+//! assert_eq!(code, 0);
+//! ```
+
+#![warn(missing_docs)]
+
+pub mod cli;
+pub mod commands;
+pub mod demo;
+pub mod error;
+pub mod files;
+pub mod output;
+pub mod progress;
+pub mod report;
+
+pub use error::CliError;

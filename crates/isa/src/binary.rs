@@ -22,7 +22,7 @@ use crate::error::{operand_error, ErrorKind, Location, TraceError};
 use crate::header::{TraceHeader, MAX_CHANNELS};
 use crate::instruction::{Instruction, Intensity};
 use crate::io::{TraceRead, TraceWrite};
-use crate::opcode::{OperandKind, Opcode};
+use crate::opcode::{Opcode, OperandKind};
 use crate::text::header_from_u64;
 use std::io::{self, Read, Write};
 
@@ -30,6 +30,7 @@ use std::io::{self, Read, Write};
 pub const MAGIC: &[u8; 8] = b"CWBTRACE";
 /// The byte that starts the end marker.
 pub const END_MARKER: u8 = 0xFF;
+const END_WHAT: &str = "the end marker";
 /// Size of the fixed header.
 pub const HEADER_BYTES: u64 = 20;
 
@@ -114,13 +115,17 @@ impl<R: Read> BinaryReader<R> {
     /// Opens a trace: reads and checks the fixed header.
     pub fn new(mut input: R) -> Result<Self, TraceError> {
         let mut head = [0u8; HEADER_BYTES as usize];
-        let got = read_full(&mut input, &mut head).map_err(|e| TraceError::io(Location::Byte(0), &e))?;
+        let got =
+            read_full(&mut input, &mut head).map_err(|e| TraceError::io(Location::Byte(0), &e))?;
         let magic_seen = &head[..got.min(8)];
         if magic_seen != &MAGIC[..magic_seen.len()] {
             return Err(TraceError::new(
                 ErrorKind::Corrupt,
                 Location::Byte(0),
-                format!("bad magic {magic_seen:02X?}; a .cwb trace starts with \"CWBTRACE\""),
+                format!(
+                    "bad magic \"{}\"; a .cwb trace starts with \"CWBTRACE\"",
+                    magic_seen.escape_ascii()
+                ),
             ));
         }
         if got < head.len() {
@@ -142,7 +147,15 @@ impl<R: Read> BinaryReader<R> {
         let width = u32::from_le_bytes(head[12..16].try_into().expect("4 bytes"));
         let lines = u32::from_le_bytes(head[16..20].try_into().expect("4 bytes"));
         let header = header_from_u64(version.into(), width.into(), lines.into(), channels.into())
-            .map_err(|m| TraceError::new(ErrorKind::Header, Location::Byte(8), m))?;
+            .map_err(|f| {
+            let offset = match f.field {
+                "version" => 8,
+                "channels" => 10,
+                "width" => 12,
+                _ => 16,
+            };
+            TraceError::new(ErrorKind::Header, Location::Byte(offset), f.message)
+        })?;
         Ok(BinaryReader {
             input,
             header,
@@ -158,13 +171,18 @@ impl<R: Read> BinaryReader<R> {
         TraceError::new(
             ErrorKind::Truncated,
             Location::Byte(self.offset),
-            format!("the file ends inside {what} (record {} starting at byte {})", self.count + 1, self.record_start),
+            format!(
+                "the file ends inside {what} (record {} starting at byte {})",
+                self.count + 1,
+                self.record_start
+            ),
         )
     }
 
     /// Reads exactly `buf.len()` bytes (into the checksum when `checked`).
     fn take(&mut self, buf: &mut [u8], what: &str, checked: bool) -> Result<(), TraceError> {
-        let got = read_full(&mut self.input, buf).map_err(|e| TraceError::io(Location::Byte(self.offset), &e))?;
+        let got = read_full(&mut self.input, buf)
+            .map_err(|e| TraceError::io(Location::Byte(self.offset), &e))?;
         if checked {
             self.crc.update(&buf[..got]);
         }
@@ -191,7 +209,11 @@ impl<R: Read> BinaryReader<R> {
                     ));
                 }
                 return u32::try_from(v).map_err(|_| {
-                    TraceError::new(ErrorKind::Corrupt, Location::Byte(start), format!("varint `{name}` = {v} does not fit in 32 bits"))
+                    TraceError::new(
+                        ErrorKind::Corrupt,
+                        Location::Byte(start),
+                        format!("varint `{name}` = {v} does not fit in 32 bits"),
+                    )
                 });
             }
         }
@@ -204,14 +226,17 @@ impl<R: Read> BinaryReader<R> {
 
     fn footer(&mut self) -> Result<(), TraceError> {
         let mut tail = [0u8; 12];
-        self.take(&mut tail, "the end marker", false)?;
+        self.take(&mut tail, END_WHAT, false)?;
         let count = u64::from_le_bytes(tail[..8].try_into().expect("8 bytes"));
         let crc = u32::from_le_bytes(tail[8..].try_into().expect("4 bytes"));
         if count != self.count {
             return Err(TraceError::new(
                 ErrorKind::Corrupt,
                 Location::Byte(self.record_start + 1),
-                format!("the end marker counts {count} instructions, the file holds {}", self.count),
+                format!(
+                    "the end marker counts {count} instructions, the file holds {}",
+                    self.count
+                ),
             ));
         }
         let actual = std::mem::take(&mut self.crc).finalize();
@@ -223,7 +248,8 @@ impl<R: Read> BinaryReader<R> {
             ));
         }
         let mut extra = [0u8; 1];
-        let got = read_full(&mut self.input, &mut extra).map_err(|e| TraceError::io(Location::Byte(self.offset), &e))?;
+        let got = read_full(&mut self.input, &mut extra)
+            .map_err(|e| TraceError::io(Location::Byte(self.offset), &e))?;
         if got != 0 {
             return Err(TraceError::new(
                 ErrorKind::Corrupt,
@@ -259,7 +285,8 @@ impl<R: Read> TraceRead for BinaryReader<R> {
         }
         self.record_start = self.offset;
         let mut code = [0u8];
-        let got = read_full(&mut self.input, &mut code).map_err(|e| TraceError::io(Location::Byte(self.offset), &e))?;
+        let got = read_full(&mut self.input, &mut code)
+            .map_err(|e| TraceError::io(Location::Byte(self.offset), &e))?;
         if got == 0 {
             return Err(TraceError::new(
                 ErrorKind::Truncated,
@@ -278,7 +305,11 @@ impl<R: Read> TraceRead for BinaryReader<R> {
             return Err(TraceError::new(
                 ErrorKind::UnknownOpcode,
                 Location::Byte(self.record_start),
-                format!("unknown opcode byte {:#04x}; expected 0x01..=0x{:02X} or the end marker 0xFF", code[0], Opcode::COUNT),
+                format!(
+                    "unknown opcode byte {:#04x}; expected 0x01..=0x{:02X} or the end marker 0xFF",
+                    code[0],
+                    Opcode::COUNT
+                ),
             ));
         };
         let mut instr = Instruction {
@@ -300,7 +331,8 @@ impl<R: Read> TraceRead for BinaryReader<R> {
                     for (k, v) in vals.iter_mut().take(channels).enumerate() {
                         *v = f64::from_le_bytes(raw[8 * k..8 * k + 8].try_into().expect("8 bytes"));
                     }
-                    instr.values[kind.value_slot().expect("value")] = Intensity::new(&vals[..channels]);
+                    instr.values[kind.value_slot().expect("value")] =
+                        Intensity::new(&vals[..channels]);
                 }
             }
         }
@@ -343,7 +375,10 @@ mod tests {
 
     #[test]
     fn round_trips_and_is_compact() {
-        let v = vec![Instruction::eval2(3, 200, Intensity::grey(0.5), Intensity::grey(-1e-9)), Instruction::refresh()];
+        let v = vec![
+            Instruction::eval2(3, 200, Intensity::grey(0.5), Intensity::grey(-1e-9)),
+            Instruction::refresh(),
+        ];
         let bytes = encode(&v);
         // header 20 + (1 + 1 + 2 + 16) + 1 + footer 13
         assert_eq!(bytes.len(), 20 + 20 + 1 + 13);
@@ -352,7 +387,10 @@ mod tests {
 
     #[test]
     fn tells_truncated_from_corrupt() {
-        let bytes = encode(&[Instruction::eval1(0, 4, Intensity::grey(1.0)), Instruction::refresh()]);
+        let bytes = encode(&[
+            Instruction::eval1(0, 4, Intensity::grey(1.0)),
+            Instruction::refresh(),
+        ]);
         for cut in 0..bytes.len() {
             let e = decode(&bytes[..cut]).unwrap_err();
             assert_eq!(e.kind, ErrorKind::Truncated, "cut {cut}: {e}");
@@ -366,6 +404,9 @@ mod tests {
         let mut bad_op = bytes.clone();
         bad_op[20] = 0x42;
         let e = decode(&bad_op).unwrap_err();
-        assert_eq!((e.kind, e.location), (ErrorKind::UnknownOpcode, Location::Byte(20)));
+        assert_eq!(
+            (e.kind, e.location),
+            (ErrorKind::UnknownOpcode, Location::Byte(20))
+        );
     }
 }

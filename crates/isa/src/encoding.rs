@@ -56,7 +56,11 @@ impl Encoding {
     }
 
     /// A writer of this encoding over any byte sink.
-    pub fn writer<'a, W: Write + 'a>(self, out: W, header: &TraceHeader) -> io::Result<Box<dyn TraceWrite + 'a>> {
+    pub fn writer<'a, W: Write + 'a>(
+        self,
+        out: W,
+        header: &TraceHeader,
+    ) -> io::Result<Box<dyn TraceWrite + 'a>> {
         Ok(match self {
             Encoding::Text => Box::new(TextWriter::new(out, header)?),
             Encoding::JsonLines => Box::new(JsonlWriter::new(out, header)?),
@@ -77,7 +81,8 @@ impl FileReader {
     pub fn open(path: &Path) -> Result<FileReader, TraceError> {
         let enc = Encoding::from_path(path)?;
         let file = File::open(path).map_err(|e| {
-            TraceError::new(ErrorKind::Io, Location::File, format!("cannot open: {e}")).in_file(path)
+            TraceError::new(ErrorKind::Io, Location::File, format!("cannot open: {e}"))
+                .in_file(path)
         })?;
         let size = file.metadata().map(|m| m.len()).unwrap_or(0);
         let inner = enc.reader(file).map_err(|e| e.in_file(path))?;
@@ -104,7 +109,9 @@ impl TraceRead for FileReader {
         self.inner.header()
     }
     fn next_instruction(&mut self) -> Result<Option<crate::Instruction>, TraceError> {
-        self.inner.next_instruction().map_err(|e| e.in_file(&self.path))
+        self.inner
+            .next_instruction()
+            .map_err(|e| e.in_file(&self.path))
     }
     fn location(&self) -> Location {
         self.inner.location()
@@ -117,8 +124,10 @@ impl TraceRead for FileReader {
 /// Creates `path` and a writer of the encoding its extension names.
 pub fn create_trace(path: &Path, header: &TraceHeader) -> Result<Box<dyn TraceWrite>, TraceError> {
     let enc = Encoding::from_path(path)?;
-    let file = File::create(path)
-        .map_err(|e| TraceError::new(ErrorKind::Io, Location::File, format!("cannot create: {e}")).in_file(path))?;
-    enc.writer(BufWriter::new(file), header)
-        .map_err(|e| TraceError::new(ErrorKind::Io, Location::File, format!("cannot write: {e}")).in_file(path))
+    let file = File::create(path).map_err(|e| {
+        TraceError::new(ErrorKind::Io, Location::File, format!("cannot create: {e}")).in_file(path)
+    })?;
+    enc.writer(BufWriter::new(file), header).map_err(|e| {
+        TraceError::new(ErrorKind::Io, Location::File, format!("cannot write: {e}")).in_file(path)
+    })
 }

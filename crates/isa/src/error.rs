@@ -136,12 +136,18 @@ mod tests {
 
     #[test]
     fn messages_name_the_place() {
-        let e = TraceError::new(ErrorKind::Syntax, Location::Line { line: 3, column: 7 }, "expected x")
-            .in_file(Path::new("t.cwt"));
+        let e = TraceError::new(
+            ErrorKind::Syntax,
+            Location::Line { line: 3, column: 7 },
+            "expected x",
+        )
+        .in_file(Path::new("t.cwt"));
         assert_eq!(e.to_string(), "t.cwt:3:7: expected x");
-        let e = TraceError::new(ErrorKind::Truncated, Location::Byte(42), "cut").in_file(Path::new("t.cwb"));
+        let e = TraceError::new(ErrorKind::Truncated, Location::Byte(42), "cut")
+            .in_file(Path::new("t.cwb"));
         assert_eq!(e.to_string(), "t.cwb: byte 42: cut");
-        let e = TraceError::new(ErrorKind::Encoding, Location::File, "unknown").in_file(Path::new("t.txt"));
+        let e = TraceError::new(ErrorKind::Encoding, Location::File, "unknown")
+            .in_file(Path::new("t.txt"));
         assert_eq!(e.to_string(), "t.txt: unknown");
     }
 }

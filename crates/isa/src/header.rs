@@ -26,7 +26,7 @@ pub struct TraceHeader {
 
 impl TraceHeader {
     /// A header of the current version, checked against the limits.
-    pub fn new(width: u32, lines: u32, channels: u8) -> Result<Self, String> {
+    pub fn new(width: u32, lines: u32, channels: u8) -> Result<Self, HeaderFault> {
         let h = TraceHeader {
             version: FORMAT_VERSION,
             width,
@@ -37,31 +37,38 @@ impl TraceHeader {
         Ok(h)
     }
 
-    /// Checks every field against the limits; the message says which field and why.
-    pub fn check(&self) -> Result<(), String> {
+    /// Checks every field against the limits; the fault names the field and says why.
+    pub fn check(&self) -> Result<(), HeaderFault> {
+        let fault = |field, message| Err(HeaderFault { field, message });
         if self.version != FORMAT_VERSION {
-            return Err(format!(
-                "unsupported trace format version {}; this build reads version {FORMAT_VERSION}",
-                self.version
-            ));
+            return fault(
+                "version",
+                format!(
+                    "unsupported trace format version {}; this build reads version {FORMAT_VERSION}",
+                    self.version
+                ),
+            );
         }
         if self.width == 0 || self.width > MAX_WIDTH {
-            return Err(format!(
-                "width {} is outside 1..={MAX_WIDTH} processors",
-                self.width
-            ));
+            return fault(
+                "width",
+                format!("width {} is outside 1..={MAX_WIDTH} processors", self.width),
+            );
         }
         if self.lines == 0 || self.lines > MAX_LINES {
-            return Err(format!(
-                "lines {} is outside 1..={MAX_LINES} scanlines per frame",
-                self.lines
-            ));
+            return fault(
+                "lines",
+                format!(
+                    "lines {} is outside 1..={MAX_LINES} scanlines per frame",
+                    self.lines
+                ),
+            );
         }
         if self.channels == 0 || usize::from(self.channels) > MAX_CHANNELS {
-            return Err(format!(
-                "channels {} is outside 1..={MAX_CHANNELS}",
-                self.channels
-            ));
+            return fault(
+                "channels",
+                format!("channels {} is outside 1..={MAX_CHANNELS}", self.channels),
+            );
         }
         Ok(())
     }
@@ -71,3 +78,20 @@ impl TraceHeader {
         usize::from(self.channels)
     }
 }
+
+/// A header field outside its limits.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct HeaderFault {
+    /// `version`, `width`, `lines` or `channels`.
+    pub field: &'static str,
+    /// What is wrong with it.
+    pub message: String,
+}
+
+impl std::fmt::Display for HeaderFault {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for HeaderFault {}

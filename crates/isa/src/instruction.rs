@@ -1,7 +1,7 @@
 //! Instructions and their intensity operands.
 
 use crate::header::{TraceHeader, MAX_CHANNELS};
-use crate::opcode::{OperandKind, Opcode};
+use crate::opcode::{Opcode, OperandKind};
 use std::fmt;
 
 /// An intensity vector: one `f64` per channel (1 for grey, 3 for RGB).
@@ -122,15 +122,36 @@ impl Instruction {
     }
     /// `SetPI(x, period, I)`.
     pub fn set_pi(x: u32, period: u32, i: Intensity) -> Self {
-        Self::with(Opcode::SetPI, x, period, i, Intensity::NONE, Intensity::NONE)
+        Self::with(
+            Opcode::SetPI,
+            x,
+            period,
+            i,
+            Intensity::NONE,
+            Intensity::NONE,
+        )
     }
     /// `SetPdI(x, period, dI)`.
     pub fn set_pdi(x: u32, period: u32, di: Intensity) -> Self {
-        Self::with(Opcode::SetPdI, x, period, Intensity::NONE, di, Intensity::NONE)
+        Self::with(
+            Opcode::SetPdI,
+            x,
+            period,
+            Intensity::NONE,
+            di,
+            Intensity::NONE,
+        )
     }
     /// `SetPddI(x, period, ddI)`.
     pub fn set_pddi(x: u32, period: u32, ddi: Intensity) -> Self {
-        Self::with(Opcode::SetPddI, x, period, Intensity::NONE, Intensity::NONE, ddi)
+        Self::with(
+            Opcode::SetPddI,
+            x,
+            period,
+            Intensity::NONE,
+            Intensity::NONE,
+            ddi,
+        )
     }
     /// `Eval0(x, dx, I)`.
     pub fn eval0(x: u32, dx: u32, i: Intensity) -> Self {
@@ -150,7 +171,14 @@ impl Instruction {
     }
     /// `Dis(x, dx)`.
     pub fn dis(x: u32, dx: u32) -> Self {
-        Self::with(Opcode::Dis, x, dx, Intensity::NONE, Intensity::NONE, Intensity::NONE)
+        Self::with(
+            Opcode::Dis,
+            x,
+            dx,
+            Intensity::NONE,
+            Intensity::NONE,
+            Intensity::NONE,
+        )
     }
     /// `Acc_mode()`.
     pub fn acc_mode() -> Self {
@@ -291,9 +319,15 @@ mod tests {
     #[test]
     fn ranges_are_half_open_and_checked() {
         let h = grey_header(16);
-        assert!(Instruction::eval1(0, 16, Intensity::grey(1.0)).check(&h).is_ok());
-        assert!(Instruction::eval1(15, 1, Intensity::grey(1.0)).check(&h).is_ok());
-        assert!(Instruction::eval1(15, 0, Intensity::grey(1.0)).check(&h).is_ok());
+        assert!(Instruction::eval1(0, 16, Intensity::grey(1.0))
+            .check(&h)
+            .is_ok());
+        assert!(Instruction::eval1(15, 1, Intensity::grey(1.0))
+            .check(&h)
+            .is_ok());
+        assert!(Instruction::eval1(15, 0, Intensity::grey(1.0))
+            .check(&h)
+            .is_ok());
         assert!(matches!(
             Instruction::eval1(15, 2, Intensity::grey(1.0)).check(&h),
             Err(OperandError::Range(_))
@@ -306,8 +340,14 @@ mod tests {
             Instruction::set_pi(3, 0, Intensity::grey(1.0)).check(&h),
             Err(OperandError::Range(_))
         ));
-        assert_eq!(Instruction::eval2(3, 4, Intensity::grey(0.0), Intensity::grey(0.0)).span(), Some((3, 7)));
-        assert_eq!(Instruction::set_di(5, Intensity::grey(0.0)).span(), Some((5, 6)));
+        assert_eq!(
+            Instruction::eval2(3, 4, Intensity::grey(0.0), Intensity::grey(0.0)).span(),
+            Some((3, 7))
+        );
+        assert_eq!(
+            Instruction::set_di(5, Intensity::grey(0.0)).span(),
+            Some((5, 6))
+        );
         assert_eq!(Instruction::refresh().span(), None);
     }
 

@@ -74,7 +74,13 @@ impl<R: BufRead> LineReader<R> {
                 Ok(b) => b,
                 Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
                 Err(e) => {
-                    return Err(TraceError::io(Location::Line { line: start_line, column: 1 }, &e))
+                    return Err(TraceError::io(
+                        Location::Line {
+                            line: start_line,
+                            column: 1,
+                        },
+                        &e,
+                    ))
                 }
             };
             if buf.is_empty() {
@@ -90,7 +96,10 @@ impl<R: BufRead> LineReader<R> {
             if self.raw.len() > MAX_LINE_BYTES + 2 {
                 return Err(TraceError::new(
                     ErrorKind::Limit,
-                    Location::Line { line: start_line, column: 1 },
+                    Location::Line {
+                        line: start_line,
+                        column: 1,
+                    },
                     format!("line is longer than the {MAX_LINE_BYTES}-byte limit"),
                 ));
             }

@@ -13,7 +13,7 @@ use crate::error::{operand_error, ErrorKind, Location, TraceError};
 use crate::header::TraceHeader;
 use crate::instruction::{Instruction, Intensity};
 use crate::io::{LineReader, TraceRead, TraceWrite};
-use crate::opcode::{OperandKind, Opcode};
+use crate::opcode::{Opcode, OperandKind};
 use crate::text::{header_from_u64, TEXT_MAGIC};
 use serde::ser::SerializeMap;
 use serde::{Deserialize, Serialize, Serializer};
@@ -109,7 +109,9 @@ fn json_error(e: &serde_json::Error, line: u64) -> TraceError {
     };
     // serde_json's message ends with " at line L column C"; we give our own location.
     let msg = e.to_string();
-    let msg = msg.rsplit_once(" at line ").map_or(msg.as_str(), |(m, _)| m);
+    let msg = msg
+        .rsplit_once(" at line ")
+        .map_or(msg.as_str(), |(m, _)| m);
     TraceError::new(
         kind,
         Location::Line {
@@ -142,11 +144,20 @@ impl<R: BufRead> JsonlReader<R> {
             return Err(TraceError::new(
                 ErrorKind::Header,
                 at1,
-                format!("header \"format\" is \"{}\", expected \"{TEXT_MAGIC}\"", rec.format),
+                format!(
+                    "header \"format\" is \"{}\", expected \"{TEXT_MAGIC}\"",
+                    rec.format
+                ),
             ));
         }
-        let header = header_from_u64(rec.version, rec.width, rec.lines, rec.channels)
-            .map_err(|m| TraceError::new(ErrorKind::Header, at1, m))?;
+        let header =
+            header_from_u64(rec.version, rec.width, rec.lines, rec.channels).map_err(|f| {
+                TraceError::new(
+                    ErrorKind::Header,
+                    at1,
+                    format!("header \"{}\": {}", f.field, f.message),
+                )
+            })?;
         Ok(JsonlReader {
             lines,
             header,
@@ -156,13 +167,20 @@ impl<R: BufRead> JsonlReader<R> {
 }
 
 fn parse_record(line: &str, line_no: u64, header: &TraceHeader) -> Result<Instruction, TraceError> {
-    let at = Location::Line { line: line_no, column: 1 };
+    let at = Location::Line {
+        line: line_no,
+        column: 1,
+    };
     let rec: Record = serde_json::from_str(line).map_err(|e| json_error(&e, line_no))?;
     let Some(op) = Opcode::from_name(&rec.op) else {
         let hint = Opcode::suggest(&rec.op)
             .map(|op| format!("; did you mean \"{}\"?", op.name()))
             .unwrap_or_default();
-        return Err(TraceError::new(ErrorKind::UnknownOpcode, at, format!("unknown opcode \"{}\"{hint}", rec.op)));
+        return Err(TraceError::new(
+            ErrorKind::UnknownOpcode,
+            at,
+            format!("unknown opcode \"{}\"{hint}", rec.op),
+        ));
     };
     let kinds = op.operands();
     let present = [
@@ -191,7 +209,13 @@ fn parse_record(line: &str, line_no: u64, header: &TraceHeader) -> Result<Instru
     }
     let narrow = |name: &str, v: Option<u64>| -> Result<u32, TraceError> {
         let v = v.unwrap_or(0);
-        u32::try_from(v).map_err(|_| TraceError::new(ErrorKind::Range, at, format!("\"{name}\" = {v} does not fit in 32 bits")))
+        u32::try_from(v).map_err(|_| {
+            TraceError::new(
+                ErrorKind::Range,
+                at,
+                format!("\"{name}\" = {v} does not fit in 32 bits"),
+            )
+        })
     };
     let channels = header.channel_count();
     let vector = |name: &str, v: Option<Vec<f64>>| -> Result<Intensity, TraceError> {
@@ -200,7 +224,10 @@ fn parse_record(line: &str, line_no: u64, header: &TraceHeader) -> Result<Instru
             Some(v) if v.len() != channels => Err(TraceError::new(
                 ErrorKind::Channels,
                 at,
-                format!("\"{name}\" has {} channel value(s), the trace has {channels}", v.len()),
+                format!(
+                    "\"{name}\" has {} channel value(s), the trace has {channels}",
+                    v.len()
+                ),
             )),
             Some(v) => Ok(Intensity::new(&v)),
         }
@@ -209,7 +236,11 @@ fn parse_record(line: &str, line_no: u64, header: &TraceHeader) -> Result<Instru
         op,
         x: narrow("x", rec.x)?,
         dx: narrow("dx", rec.dx)?,
-        values: [vector("I", rec.i)?, vector("dI", rec.di)?, vector("ddI", rec.ddi)?],
+        values: [
+            vector("I", rec.i)?,
+            vector("dI", rec.di)?,
+            vector("ddI", rec.ddi)?,
+        ],
     };
     instr.check(header).map_err(|e| operand_error(e, at, op))?;
     Ok(instr)
@@ -227,12 +258,18 @@ impl<R: BufRead> TraceRead for JsonlReader<R> {
         if line.trim().is_empty() {
             return Err(TraceError::new(
                 ErrorKind::Syntax,
-                Location::Line { line: line_no, column: 1 },
+                Location::Line {
+                    line: line_no,
+                    column: 1,
+                },
                 "empty line; JSON Lines holds one JSON object on every line",
             ));
         }
         let instr = parse_record(line, line_no, &self.header)?;
-        self.location = Location::Line { line: line_no, column: 1 };
+        self.location = Location::Line {
+            line: line_no,
+            column: 1,
+        };
         Ok(Some(instr))
     }
 
@@ -250,7 +287,8 @@ mod tests {
     use super::*;
     use crate::io::read_all;
 
-    const HEAD: &str = "{\"format\":\"cwisim-trace\",\"version\":1,\"width\":8,\"lines\":2,\"channels\":1}\n";
+    const HEAD: &str =
+        "{\"format\":\"cwisim-trace\",\"version\":1,\"width\":8,\"lines\":2,\"channels\":1}\n";
 
     fn read(body: &str) -> Result<Vec<Instruction>, TraceError> {
         let src = format!("{HEAD}{body}");
@@ -263,26 +301,65 @@ mod tests {
         let mut buf = Vec::new();
         let h = TraceHeader::new(8, 2, 1).unwrap();
         let mut w = JsonlWriter::new(&mut buf, &h).unwrap();
-        w.write(&Instruction::eval2(0, 4, Intensity::grey(0.25), Intensity::grey(-0.0))).unwrap();
+        w.write(&Instruction::eval2(
+            0,
+            4,
+            Intensity::grey(0.25),
+            Intensity::grey(-0.0),
+        ))
+        .unwrap();
         w.write(&Instruction::refresh()).unwrap();
         let s = String::from_utf8(buf).unwrap();
         assert_eq!(
             s,
             format!("{HEAD}{{\"op\":\"Eval2\",\"x\":0,\"dx\":4,\"I\":[0.25],\"dI\":[-0.0]}}\n{{\"op\":\"Refresh\"}}\n")
         );
-        assert_eq!(read(&s[HEAD.len()..]).unwrap()[0].di().as_slice()[0].to_bits(), (-0.0f64).to_bits());
+        assert_eq!(
+            read(&s[HEAD.len()..]).unwrap()[0].di().as_slice()[0].to_bits(),
+            (-0.0f64).to_bits()
+        );
     }
 
     #[test]
     fn rejects_missing_extra_and_unknown() {
-        assert_eq!(read("{\"op\":\"Eval1\",\"x\":0,\"I\":[1]}\n").unwrap_err().kind, ErrorKind::Syntax);
-        assert_eq!(read("{\"op\":\"Refresh\",\"x\":0}\n").unwrap_err().kind, ErrorKind::Syntax);
-        assert_eq!(read("{\"op\":\"Refresh\",\"y\":0}\n").unwrap_err().kind, ErrorKind::Syntax);
-        assert_eq!(read("{\"op\":\"Blit\"}\n").unwrap_err().kind, ErrorKind::UnknownOpcode);
-        assert_eq!(read("{\"op\":\"Eval1\",\"x\":0,\"dx\":1,\"I\":[1,2]}\n").unwrap_err().kind, ErrorKind::Channels);
-        assert_eq!(read("{\"op\":\"Eval1\",\"x\":0,\"dx\":9,\"I\":[1]}\n").unwrap_err().kind, ErrorKind::Range);
+        assert_eq!(
+            read("{\"op\":\"Eval1\",\"x\":0,\"I\":[1]}\n")
+                .unwrap_err()
+                .kind,
+            ErrorKind::Syntax
+        );
+        assert_eq!(
+            read("{\"op\":\"Refresh\",\"x\":0}\n").unwrap_err().kind,
+            ErrorKind::Syntax
+        );
+        assert_eq!(
+            read("{\"op\":\"Refresh\",\"y\":0}\n").unwrap_err().kind,
+            ErrorKind::Syntax
+        );
+        assert_eq!(
+            read("{\"op\":\"Blit\"}\n").unwrap_err().kind,
+            ErrorKind::UnknownOpcode
+        );
+        assert_eq!(
+            read("{\"op\":\"Eval1\",\"x\":0,\"dx\":1,\"I\":[1,2]}\n")
+                .unwrap_err()
+                .kind,
+            ErrorKind::Channels
+        );
+        assert_eq!(
+            read("{\"op\":\"Eval1\",\"x\":0,\"dx\":9,\"I\":[1]}\n")
+                .unwrap_err()
+                .kind,
+            ErrorKind::Range
+        );
         let e = read("{\"op\":\"Eval1\",\"x\":0,\"dx\":1,\"I\":[1e999]}\n").unwrap_err();
-        assert_eq!(e.location, Location::Line { line: 2, column: 37 });
+        assert_eq!(
+            e.location,
+            Location::Line {
+                line: 2,
+                column: 37
+            }
+        );
         let e = read("{\"op\":\"Eval1\",\"x\":0,\"dx\":1,\n").unwrap_err();
         assert_eq!(e.kind, ErrorKind::Truncated);
     }

@@ -44,7 +44,7 @@ pub mod text;
 
 pub use encoding::{create_trace, Encoding, FileReader};
 pub use error::{ErrorKind, Location, TraceError};
-pub use header::{TraceHeader, FORMAT_VERSION, MAX_CHANNELS, MAX_LINES, MAX_WIDTH};
+pub use header::{HeaderFault, TraceHeader, FORMAT_VERSION, MAX_CHANNELS, MAX_LINES, MAX_WIDTH};
 pub use instruction::{Instruction, Intensity, OperandError};
 pub use io::{TraceRead, TraceWrite};
-pub use opcode::{OperandKind, Opcode};
+pub use opcode::{Opcode, OperandKind};

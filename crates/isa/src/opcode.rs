@@ -148,10 +148,10 @@ impl Opcode {
     /// The known name closest to `name` (case-insensitive match first), for error hints.
     pub fn suggest(name: &str) -> Option<Opcode> {
         let lower = name.to_ascii_lowercase();
-        if let Some(op) = Opcode::ALL
-            .iter()
-            .find(|op| op.name().to_ascii_lowercase() == lower || op.name().replace('_', "").to_ascii_lowercase() == lower)
-        {
+        if let Some(op) = Opcode::ALL.iter().find(|op| {
+            op.name().to_ascii_lowercase() == lower
+                || op.name().replace('_', "").to_ascii_lowercase() == lower
+        }) {
             return Some(*op);
         }
         Opcode::ALL

@@ -13,10 +13,10 @@
 //! round-trip form, so text → value → text is exact.
 
 use crate::error::{operand_error, ErrorKind, Location, TraceError};
-use crate::header::{TraceHeader, FORMAT_VERSION};
+use crate::header::{HeaderFault, TraceHeader, FORMAT_VERSION};
 use crate::instruction::{Instruction, Intensity};
 use crate::io::{LineReader, TraceRead, TraceWrite};
-use crate::opcode::{OperandKind, Opcode};
+use crate::opcode::{Opcode, OperandKind};
 use std::fmt::Write as _;
 use std::io::{self, BufRead, Write};
 
@@ -60,7 +60,9 @@ pub fn format_instruction(instr: &Instruction) -> String {
             OperandKind::Count | OperandKind::Period => {
                 let _ = write!(s, "{}", instr.dx);
             }
-            _ => s.push_str(&format_intensity(&instr.values[kind.value_slot().expect("value")])),
+            _ => s.push_str(&format_intensity(
+                &instr.values[kind.value_slot().expect("value")],
+            )),
         }
     }
     s
@@ -178,6 +180,7 @@ fn parse_header(toks: &[Token<'_>], line: u64) -> Result<TraceHeader, TraceError
         ));
     }
     let mut fields: [Option<u64>; 4] = [None; 4];
+    let mut columns: [u64; 4] = [1; 4];
     const KEYS: [&str; 4] = ["version", "width", "lines", "channels"];
     for t in &toks[1..] {
         let Some((key, value)) = t.text.split_once('=') else {
@@ -191,11 +194,17 @@ fn parse_header(toks: &[Token<'_>], line: u64) -> Result<TraceHeader, TraceError
             return Err(TraceError::new(
                 ErrorKind::Header,
                 at(t.column),
-                format!("unknown header key `{key}`; expected one of version, width, lines, channels"),
+                format!(
+                    "unknown header key `{key}`; expected one of version, width, lines, channels"
+                ),
             ));
         };
         if fields[k].is_some() {
-            return Err(TraceError::new(ErrorKind::Header, at(t.column), format!("header key `{key}` given twice")));
+            return Err(TraceError::new(
+                ErrorKind::Header,
+                at(t.column),
+                format!("header key `{key}` given twice"),
+            ));
         }
         let v: u64 = value.parse().map_err(|_| {
             TraceError::new(
@@ -205,6 +214,7 @@ fn parse_header(toks: &[Token<'_>], line: u64) -> Result<TraceHeader, TraceError
             )
         })?;
         fields[k] = Some(v);
+        columns[k] = t.column;
     }
     for (k, f) in fields.iter().enumerate() {
         if f.is_none() {
@@ -216,15 +226,29 @@ fn parse_header(toks: &[Token<'_>], line: u64) -> Result<TraceHeader, TraceError
         }
     }
     let [version, width, lines, channels] = fields.map(|f| f.expect("checked"));
-    header_from_u64(version, width, lines, channels).map_err(|m| TraceError::new(ErrorKind::Header, at(1), m))
+    header_from_u64(version, width, lines, channels).map_err(|f| {
+        let k = KEYS.iter().position(|k| *k == f.field).unwrap_or(0);
+        TraceError::new(ErrorKind::Header, at(columns[k]), f.message)
+    })
 }
 
 /// Builds and checks a header from wide integers, so that absurd sizes get a message
 /// rather than a wrap-around.
-pub(crate) fn header_from_u64(version: u64, width: u64, lines: u64, channels: u64) -> Result<TraceHeader, String> {
-    let narrow = |name: &str, v: u64, max: u64| {
+pub(crate) fn header_from_u64(
+    version: u64,
+    width: u64,
+    lines: u64,
+    channels: u64,
+) -> Result<TraceHeader, HeaderFault> {
+    let narrow = |field: &'static str, v: u64, max: u64| {
         if v > max {
-            Err(format!("{name} {v} is absurd (the limit is far below {max})"))
+            Err(HeaderFault {
+                field,
+                message: format!(
+                    "{field} {v} is absurd (it does not even fit in {} bits)",
+                    64 - max.leading_zeros()
+                ),
+            })
         } else {
             Ok(v)
         }
@@ -240,7 +264,11 @@ pub(crate) fn header_from_u64(version: u64, width: u64, lines: u64, channels: u6
 }
 
 /// Parses one instruction line (comment already stripped) against a header.
-pub fn parse_instruction(content: &str, line: u64, header: &TraceHeader) -> Result<Option<Instruction>, TraceError> {
+pub fn parse_instruction(
+    content: &str,
+    line: u64,
+    header: &TraceHeader,
+) -> Result<Option<Instruction>, TraceError> {
     let toks = tokens(content);
     if toks.is_empty() {
         return Ok(None);
@@ -260,7 +288,9 @@ pub fn parse_instruction(content: &str, line: u64, header: &TraceHeader) -> Resu
     let kinds = op.operands();
     let given = toks.len() - 1;
     if given != kinds.len() {
-        let column = toks.get(kinds.len() + 1).map_or(content.len() as u64 + 1, |t| t.column);
+        let column = toks
+            .get(kinds.len() + 1)
+            .map_or(content.len() as u64 + 1, |t| t.column);
         return Err(TraceError::new(
             ErrorKind::Syntax,
             at(column),
@@ -281,7 +311,8 @@ pub fn parse_instruction(content: &str, line: u64, header: &TraceHeader) -> Resu
     for (kind, tok) in kinds.iter().zip(&toks[1..]) {
         match kind {
             OperandKind::X | OperandKind::Count | OperandKind::Period => {
-                let v = parse_u32(tok.text, kind.name()).map_err(|m| TraceError::new(ErrorKind::Syntax, at(tok.column), m))?;
+                let v = parse_u32(tok.text, kind.name())
+                    .map_err(|m| TraceError::new(ErrorKind::Syntax, at(tok.column), m))?;
                 if *kind == OperandKind::X {
                     instr.x = v;
                 } else {
@@ -305,7 +336,8 @@ pub fn parse_instruction(content: &str, line: u64, header: &TraceHeader) -> Resu
                 let mut vals = [0.0; crate::header::MAX_CHANNELS];
                 let mut col = tok.column;
                 for (k, p) in parts.iter().enumerate() {
-                    vals[k] = parse_f64(p, kind.name()).map_err(|(kind, m)| TraceError::new(kind, at(col), m))?;
+                    vals[k] = parse_f64(p, kind.name())
+                        .map_err(|(kind, m)| TraceError::new(kind, at(col), m))?;
                     col += p.len() as u64 + 1;
                 }
                 instr.values[kind.value_slot().expect("value")] = Intensity::new(&vals[..channels]);
@@ -320,7 +352,9 @@ pub fn parse_instruction(content: &str, line: u64, header: &TraceHeader) -> Resu
 
 fn parse_u32(text: &str, name: &str) -> Result<u32, String> {
     if !text.bytes().all(|b| b.is_ascii_digit()) {
-        return Err(format!("expected an unsigned integer for `{name}`, found `{text}`"));
+        return Err(format!(
+            "expected an unsigned integer for `{name}`, found `{text}`"
+        ));
     }
     text.parse::<u32>()
         .map_err(|_| format!("`{name}` = {text} does not fit in 32 bits"))
@@ -332,20 +366,32 @@ fn parse_f64(text: &str, name: &str) -> Result<f64, (ErrorKind, String)> {
             .bytes()
             .all(|b| b.is_ascii_digit() || matches!(b, b'.' | b'-' | b'+' | b'e' | b'E'));
     if !looks_numeric {
-        let kind = if text.to_ascii_lowercase().trim_start_matches(['-', '+']).starts_with("inf")
+        let kind = if text
+            .to_ascii_lowercase()
+            .trim_start_matches(['-', '+'])
+            .starts_with("inf")
             || text.eq_ignore_ascii_case("nan")
         {
             ErrorKind::NonFinite
         } else {
             ErrorKind::Syntax
         };
-        return Err((kind, format!("expected a finite number for `{name}`, found `{text}`")));
+        return Err((
+            kind,
+            format!("expected a finite number for `{name}`, found `{text}`"),
+        ));
     }
-    let v: f64 = text
-        .parse()
-        .map_err(|_| (ErrorKind::Syntax, format!("expected a finite number for `{name}`, found `{text}`")))?;
+    let v: f64 = text.parse().map_err(|_| {
+        (
+            ErrorKind::Syntax,
+            format!("expected a finite number for `{name}`, found `{text}`"),
+        )
+    })?;
     if !v.is_finite() {
-        return Err((ErrorKind::NonFinite, format!("`{name}` = {text} overflows f64")));
+        return Err((
+            ErrorKind::NonFinite,
+            format!("`{name}` = {text} overflows f64"),
+        ));
     }
     Ok(v)
 }
@@ -361,7 +407,10 @@ impl<R: BufRead> TraceRead for TextReader<R> {
                 return Ok(None);
             };
             if let Some(instr) = parse_instruction(strip_comment(line), line_no, &self.header)? {
-                self.location = Location::Line { line: line_no, column: 1 };
+                self.location = Location::Line {
+                    line: line_no,
+                    column: 1,
+                };
                 return Ok(Some(instr));
             }
         }
@@ -396,20 +445,33 @@ mod tests {
         assert_eq!(h.width, 8);
         assert_eq!(v.len(), 2);
         assert_eq!(v[0].di().as_slice(), &[-0.25, 0.0, 1e-3]);
-        assert_eq!(format_instruction(&v[0]), "Eval2 0 4 1.0,0.5,0.0 -0.25,0.0,0.001");
+        assert_eq!(
+            format_instruction(&v[0]),
+            "Eval2 0 4 1.0,0.5,0.0 -0.25,0.0,0.001"
+        );
     }
 
     #[test]
     fn errors_are_located() {
-        let e = read("cwisim-trace version=1 width=8 lines=2 channels=1\nEval2 0 4 1.0\n").unwrap_err();
+        let e =
+            read("cwisim-trace version=1 width=8 lines=2 channels=1\nEval2 0 4 1.0\n").unwrap_err();
         assert_eq!(e.kind, ErrorKind::Syntax);
-        assert_eq!(e.location, Location::Line { line: 2, column: 14 });
-        let e = read("cwisim-trace version=1 width=8 lines=2 channels=1\nEval1 -1 4 1.0\n").unwrap_err();
+        assert_eq!(
+            e.location,
+            Location::Line {
+                line: 2,
+                column: 14
+            }
+        );
+        let e = read("cwisim-trace version=1 width=8 lines=2 channels=1\nEval1 -1 4 1.0\n")
+            .unwrap_err();
         assert_eq!(e.location, Location::Line { line: 2, column: 7 });
         assert!(e.message.contains("unsigned integer"), "{}", e.message);
-        let e = read("cwisim-trace version=1 width=8 lines=2 channels=1\nEval1 0 4 NaN\n").unwrap_err();
+        let e =
+            read("cwisim-trace version=1 width=8 lines=2 channels=1\nEval1 0 4 NaN\n").unwrap_err();
         assert_eq!(e.kind, ErrorKind::NonFinite);
-        let e = read("cwisim-trace version=1 width=8 lines=2 channels=1\neval1 0 4 1\n").unwrap_err();
+        let e =
+            read("cwisim-trace version=1 width=8 lines=2 channels=1\neval1 0 4 1\n").unwrap_err();
         assert!(e.message.contains("did you mean `Eval1`"), "{}", e.message);
         let e = read("cwisim-trace version=1 width=99999999999 lines=2 channels=1\n").unwrap_err();
         assert_eq!(e.kind, ErrorKind::Header);

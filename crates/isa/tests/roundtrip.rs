@@ -7,7 +7,9 @@ use proptest::prelude::*;
 fn any_value() -> impl Strategy<Value = f64> {
     prop_oneof![
         // every finite bit pattern: subnormals, -0.0, huge and tiny exponents
-        any::<u64>().prop_map(f64::from_bits).prop_filter("finite", |v| v.is_finite()),
+        any::<u64>()
+            .prop_map(f64::from_bits)
+            .prop_filter("finite", |v| v.is_finite()),
         -4.0f64..4.0,
         Just(0.0),
         Just(-0.0),
@@ -15,38 +17,43 @@ fn any_value() -> impl Strategy<Value = f64> {
 }
 
 fn trace() -> impl Strategy<Value = (TraceHeader, Vec<Instruction>)> {
-    (1u32..300, 1u32..8, prop_oneof![Just(1u8), Just(3u8), 1u8..=4]).prop_flat_map(|(width, lines, channels)| {
-        let header = TraceHeader::new(width, lines, channels).unwrap();
-        let instr = (
-            0..Opcode::COUNT,
-            0..width,
-            0u32..=width,
-            proptest::collection::vec(any_value(), 3 * usize::from(channels)),
-        )
-            .prop_map(move |(k, x, n, vals)| {
-                let op = Opcode::ALL[k];
-                let c = usize::from(channels);
-                let mut i = Instruction {
-                    op,
-                    x: 0,
-                    dx: 0,
-                    values: [Intensity::NONE; 3],
-                };
-                for kind in op.operands() {
-                    match kind {
-                        OperandKind::X => i.x = x,
-                        OperandKind::Count => i.dx = n.min(width - x),
-                        OperandKind::Period => i.dx = n.max(1),
-                        _ => {
-                            let s = kind.value_slot().unwrap();
-                            i.values[s] = Intensity::new(&vals[s * c..s * c + c]);
+    (
+        1u32..300,
+        1u32..8,
+        prop_oneof![Just(1u8), Just(3u8), 1u8..=4],
+    )
+        .prop_flat_map(|(width, lines, channels)| {
+            let header = TraceHeader::new(width, lines, channels).unwrap();
+            let instr = (
+                0..Opcode::COUNT,
+                0..width,
+                0u32..=width,
+                proptest::collection::vec(any_value(), 3 * usize::from(channels)),
+            )
+                .prop_map(move |(k, x, n, vals)| {
+                    let op = Opcode::ALL[k];
+                    let c = usize::from(channels);
+                    let mut i = Instruction {
+                        op,
+                        x: 0,
+                        dx: 0,
+                        values: [Intensity::NONE; 3],
+                    };
+                    for kind in op.operands() {
+                        match kind {
+                            OperandKind::X => i.x = x,
+                            OperandKind::Count => i.dx = n.min(width - x),
+                            OperandKind::Period => i.dx = n.max(1),
+                            _ => {
+                                let s = kind.value_slot().unwrap();
+                                i.values[s] = Intensity::new(&vals[s * c..s * c + c]);
+                            }
                         }
                     }
-                }
-                i
-            });
-        (Just(header), proptest::collection::vec(instr, 0..60))
-    })
+                    i
+                });
+            (Just(header), proptest::collection::vec(instr, 0..60))
+        })
 }
 
 fn encode(enc: Encoding, header: &TraceHeader, instrs: &[Instruction]) -> Vec<u8> {

@@ -36,14 +36,21 @@ fn frame_trace(width: u32, lines: u32) -> Vec<Instruction> {
         for _ in 0..16 {
             let x = rng.below(u64::from(width)) as u32;
             let dx = (1 + rng.below(128) as u32).min(width - x);
-            let (i, di, ddi) = (rng.unit(), (rng.unit() - 0.5) / 64.0, (rng.unit() - 0.5) / 4096.0);
+            let (i, di, ddi) = (
+                rng.unit(),
+                (rng.unit() - 0.5) / 64.0,
+                (rng.unit() - 0.5) / 4096.0,
+            );
             out.push(match rng.below(4) {
                 0 => Instruction::eval1(x, dx, g(i)),
                 1 => Instruction::eval3(x, dx, g(i), g(di), g(ddi)),
                 _ => Instruction::eval2(x, dx, g(i), g(di)),
             });
         }
-        out.push(Instruction::set_i(rng.below(u64::from(width)) as u32, g(0.5)));
+        out.push(Instruction::set_i(
+            rng.below(u64::from(width)) as u32,
+            g(0.5),
+        ));
         out.push(Instruction::refresh());
     }
     out

@@ -86,11 +86,18 @@ pub fn run<T: Sample>(
     timing: Timing,
 ) -> Result<(Image, RunStats), MachineError> {
     let mut eng = engine::<T>(header, machine, timing)?;
-    let mut sink = ImageSink::new(header.width as usize, header.channel_count(), ImageSink::DEFAULT_LIMIT_BYTES);
+    let mut sink = ImageSink::new(
+        header.width as usize,
+        header.channel_count(),
+        ImageSink::DEFAULT_LIMIT_BYTES,
+    );
     for i in instrs {
         debug_assert!(i.check(header).is_ok(), "{i} does not fit the header");
         eng.execute(i, &mut sink);
     }
     let stats = eng.finish(&mut sink);
-    Ok((sink.finish().expect("image within the default limit"), stats))
+    Ok((
+        sink.finish().expect("image within the default limit"),
+        stats,
+    ))
 }

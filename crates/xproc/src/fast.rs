@@ -54,7 +54,11 @@ impl<T: Sample> FastEngine<T> {
             recorder: Recorder::new(&timeline),
             timeline,
             acc: vec![T::ZERO; w * c],
-            regs: [vec![T::ZERO; w * c], vec![T::ZERO; w * c], vec![T::ZERO; w * c]],
+            regs: [
+                vec![T::ZERO; w * c],
+                vec![T::ZERO; w * c],
+                vec![T::ZERO; w * c],
+            ],
             flags: vec![0; w],
             mask_stamp: vec![0; w],
             evals: 0,
@@ -196,7 +200,8 @@ impl<T: Sample> FastEngine<T> {
 
     fn refresh(&mut self, entry: u64, sink: &mut dyn LineSink<T>) {
         let ready = entry + self.timeline.traversal();
-        self.recorder.ready(self.line, ready, self.timeline.deadline(self.line));
+        self.recorder
+            .ready(self.line, ready, self.timeline.deadline(self.line));
         let c = self.channels;
         let (lo, hi) = self.touched.take().unwrap_or((0, 0));
         sink.line(LineOut {

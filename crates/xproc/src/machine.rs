@@ -105,22 +105,29 @@ impl Machine {
                 message: m.to_string(),
             };
             let (key, value) = o.split_once('=').ok_or_else(|| bad("expected KEY=VALUE"))?;
-            let value: serde_json::Value = serde_json::from_str(value)
-                .map_err(|_| bad("the value is not JSON (a number, true/false, null or a quoted string)"))?;
+            let value: serde_json::Value = serde_json::from_str(value).map_err(|_| {
+                bad("the value is not JSON (a number, true/false, null or a quoted string)")
+            })?;
             let mut target = &mut json;
             let mut parts = key.split('.').peekable();
             while let Some(part) = parts.next() {
-                let obj = target.as_object_mut().ok_or_else(|| bad("that key has no sub-keys"))?;
+                let obj = target
+                    .as_object_mut()
+                    .ok_or_else(|| bad("that key has no sub-keys"))?;
                 if parts.peek().is_none() {
                     if key.contains('.') || obj.contains_key(part) {
                         obj.insert(part.to_string(), value.clone());
                     } else {
                         let known: Vec<&String> = obj.keys().collect();
-                        return Err(bad(&format!("unknown machine parameter `{part}`; known: {known:?}")));
+                        return Err(bad(&format!(
+                            "unknown machine parameter `{part}`; known: {known:?}"
+                        )));
                     }
                     break;
                 }
-                target = obj.get_mut(part).ok_or_else(|| bad(&format!("unknown machine parameter `{part}`")))?;
+                target = obj
+                    .get_mut(part)
+                    .ok_or_else(|| bad(&format!("unknown machine parameter `{part}`")))?;
             }
         }
         let m: Machine = serde_json::from_value(json).map_err(|e| MachineError::Parse {
@@ -149,11 +156,17 @@ impl Machine {
             return invalid("hop_cycles", "must be at least 1");
         }
         if self.line_period_cycles == Some(0) {
-            return invalid("line_period_cycles", "must be at least 1 (or null to derive it)");
+            return invalid(
+                "line_period_cycles",
+                "must be at least 1 (or null to derive it)",
+            );
         }
         for (name, &c) in &self.opcode_cycles {
             if Opcode::from_name(name).is_none() {
-                return invalid(&format!("opcode_cycles.{name}"), "is not an opcode name (SetI … Nop)");
+                return invalid(
+                    &format!("opcode_cycles.{name}"),
+                    "is not an opcode name (SetI … Nop)",
+                );
             }
             if c == 0 {
                 return invalid(&format!("opcode_cycles.{name}"), "must be at least 1");
@@ -207,7 +220,8 @@ impl Machine {
 
 fn strip_serde_location(e: &serde_json::Error) -> String {
     let msg = e.to_string();
-    msg.rsplit_once(" at line ").map_or(msg.clone(), |(m, _)| m.to_string())
+    msg.rsplit_once(" at line ")
+        .map_or(msg.clone(), |(m, _)| m.to_string())
 }
 
 /// The model's fixed quantities for one trace, derived from a [`Machine`] and a header.
@@ -280,7 +294,13 @@ mod tests {
         let m = Machine::default();
         let grey = m.timeline(&TraceHeader::new(8, 1, 1).unwrap()).unwrap();
         let rgb = m.timeline(&TraceHeader::new(8, 1, 3).unwrap()).unwrap();
-        let e3 = Instruction::eval3(0, 1, Intensity::grey(0.0), Intensity::grey(0.0), Intensity::grey(0.0));
+        let e3 = Instruction::eval3(
+            0,
+            1,
+            Intensity::grey(0.0),
+            Intensity::grey(0.0),
+            Intensity::grey(0.0),
+        );
         assert_eq!(grey.issue_cycles(&e3), 4);
         assert_eq!(rgb.issue_cycles(&e3), 10);
         assert_eq!(grey.issue_cycles(&Instruction::refresh()), 1);
@@ -289,14 +309,24 @@ mod tests {
     #[test]
     fn overrides_and_validation() {
         let m = Machine::default()
-            .with_overrides(&["clock_hz=2e8".into(), "opcode_cycles.Eval3=3".into(), "line_period_cycles=500".into()])
+            .with_overrides(&[
+                "clock_hz=2e8".into(),
+                "opcode_cycles.Eval3=3".into(),
+                "line_period_cycles=500".into(),
+            ])
             .unwrap();
         assert_eq!(m.clock_hz, 2e8);
         assert_eq!(m.opcode_word_cycles(Opcode::Eval3), 3);
         assert_eq!(m.line_period_cycles, Some(500));
-        assert!(Machine::default().with_overrides(&["clok_hz=1".into()]).is_err());
-        assert!(Machine::default().with_overrides(&["hop_cycles=0".into()]).is_err());
-        assert!(Machine::default().with_overrides(&["opcode_cycles.Blit=2".into()]).is_err());
+        assert!(Machine::default()
+            .with_overrides(&["clok_hz=1".into()])
+            .is_err());
+        assert!(Machine::default()
+            .with_overrides(&["hop_cycles=0".into()])
+            .is_err());
+        assert!(Machine::default()
+            .with_overrides(&["opcode_cycles.Blit=2".into()])
+            .is_err());
         assert!(Machine::from_json("{\"clock_hz\": -1}", "m.json").is_err());
         let e = Machine::from_json("{\"clock\": 1}", "m.json").unwrap_err();
         assert!(e.to_string().starts_with("m.json:1:"), "{e}");

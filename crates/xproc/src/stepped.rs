@@ -127,7 +127,8 @@ impl<T: Sample> SteppedEngine<T> {
         if self.stages[0].is_none() && self.bus.as_ref().is_some_and(|b| b.issued_at <= t) {
             let bus = self.bus.take().expect("checked");
             let cost = bus.issued_at - bus.begin;
-            self.recorder.issue(bus.line, bus.instr.op, bus.begin, t, cost);
+            self.recorder
+                .issue(bus.line, bus.instr.op, bus.begin, t, cost);
             let mut tok = Box::new(Token {
                 v: vector(bus.instr.i()),
                 d: vector(bus.instr.di()),
@@ -157,9 +158,11 @@ impl<T: Sample> SteppedEngine<T> {
 
     fn exit(&mut self, tok: Token<T>, sink: &mut dyn LineSink<T>) {
         self.last_exit = self.t;
-        self.recorder.work(tok.line, tok.updates, tok.dropped, tok.suppressed);
+        self.recorder
+            .work(tok.line, tok.updates, tok.dropped, tok.suppressed);
         if tok.instr.op == Opcode::Refresh {
-            self.recorder.ready(tok.line, self.t, self.timeline.deadline(tok.line));
+            self.recorder
+                .ready(tok.line, self.t, self.timeline.deadline(tok.line));
             sink.line(LineOut {
                 index: tok.line,
                 span: (0, self.stages.len()),
@@ -265,7 +268,10 @@ impl<T: Sample> SteppedEngine<T> {
 impl<T: Sample> Engine<T> for SteppedEngine<T> {
     fn execute(&mut self, instr: &Instruction, sink: &mut dyn LineSink<T>) {
         let (gate, line) = if instr.op == Opcode::Refresh {
-            (self.timeline.refresh_gate(self.refreshes_issued), self.refreshes_issued)
+            (
+                self.timeline.refresh_gate(self.refreshes_issued),
+                self.refreshes_issued,
+            )
         } else {
             (0, self.refreshes_issued)
         };

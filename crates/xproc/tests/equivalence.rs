@@ -25,47 +25,65 @@ fn instruction(width: u32, channels: usize) -> impl Strategy<Value = Instruction
         1 => Just(11usize), // Acc_mode
         1 => Just(13usize), // Nop
     ];
-    (op, 0..width, 0..=width, proptest::collection::vec(value(), 3 * channels)).prop_map(move |(k, x, n, vals)| {
-        let op = Opcode::ALL[k];
-        let mut i = Instruction {
-            op,
-            x: 0,
-            dx: 0,
-            values: [Intensity::NONE; 3],
-        };
-        for kind in op.operands() {
-            match kind {
-                OperandKind::X => i.x = x,
-                OperandKind::Count => i.dx = n.min(width - x),
-                OperandKind::Period => i.dx = n.clamp(1, 5),
-                _ => {
-                    let s = kind.value_slot().unwrap();
-                    i.values[s] = Intensity::new(&vals[s * channels..(s + 1) * channels]);
+    (
+        op,
+        0..width,
+        0..=width,
+        proptest::collection::vec(value(), 3 * channels),
+    )
+        .prop_map(move |(k, x, n, vals)| {
+            let op = Opcode::ALL[k];
+            let mut i = Instruction {
+                op,
+                x: 0,
+                dx: 0,
+                values: [Intensity::NONE; 3],
+            };
+            for kind in op.operands() {
+                match kind {
+                    OperandKind::X => i.x = x,
+                    OperandKind::Count => i.dx = n.min(width - x),
+                    OperandKind::Period => i.dx = n.clamp(1, 5),
+                    _ => {
+                        let s = kind.value_slot().unwrap();
+                        i.values[s] = Intensity::new(&vals[s * channels..(s + 1) * channels]);
+                    }
                 }
             }
-        }
-        i
-    })
+            i
+        })
 }
 
 fn case() -> impl Strategy<Value = (TraceHeader, Machine, Vec<Instruction>)> {
-    (1u32..40, 1u32..5, prop_oneof![Just(1u8), Just(3u8)], 1u32..4, 0u32..3, 1u32..4, 1u64..300)
-        .prop_flat_map(|(width, lines, channels, hop, value_cycles, eval3_cycles, period)| {
-            let header = TraceHeader::new(width, lines, channels).unwrap();
-            let mut m = Machine::default();
-            m.hop_cycles = hop;
-            m.value_cycles = value_cycles;
-            m.opcode_cycles.insert("Eval3".into(), eval3_cycles);
-            // Short line periods: Refresh gates and late lines happen often, and the stepped
-            // engine does not wait ~1e5 cycles per line as with the derived period.
-            m.line_period_cycles = Some(period);
-            m.vblank_lines = 2;
-            (
-                Just(header),
-                Just(m),
-                proptest::collection::vec(instruction(width, usize::from(channels)), 0..80),
-            )
-        })
+    (
+        1u32..40,
+        1u32..5,
+        prop_oneof![Just(1u8), Just(3u8)],
+        1u32..4,
+        0u32..3,
+        1u32..4,
+        1u64..300,
+    )
+        .prop_flat_map(
+            |(width, lines, channels, hop, value_cycles, eval3_cycles, period)| {
+                let header = TraceHeader::new(width, lines, channels).unwrap();
+                // Short line periods: Refresh gates and late lines happen often, and the
+                // stepped engine does not wait ~1e5 cycles per line as with the derived one.
+                let m = Machine {
+                    hop_cycles: hop,
+                    value_cycles,
+                    opcode_cycles: [("Eval3".to_string(), eval3_cycles)].into(),
+                    line_period_cycles: Some(period),
+                    vblank_lines: 2,
+                    ..Machine::default()
+                };
+                (
+                    Just(header),
+                    Just(m),
+                    proptest::collection::vec(instruction(width, usize::from(channels)), 0..80),
+                )
+            },
+        )
 }
 
 proptest! {

@@ -22,13 +22,22 @@ fn run_on(h: TraceHeader, trace: &[In]) -> (Vec<Vec<f64>>, RunStats) {
     assert_eq!(fast, stepped, "fast and stepped scanlines differ");
     assert_eq!(fs, ss, "fast and stepped statistics differ");
     let row = fast.width * fast.channels;
-    let rows = fast.data.chunks(row.max(1)).map(<[f64]>::to_vec).take(fast.lines).collect();
+    let rows = fast
+        .data
+        .chunks(row.max(1))
+        .map(<[f64]>::to_vec)
+        .take(fast.lines)
+        .collect();
     (rows, fs)
 }
 
 #[test]
 fn eval1_accumulates_a_constant_over_the_half_open_range() {
-    let (rows, _) = run8(&[In::eval1(2, 3, g(0.5)), In::eval1(3, 1, g(0.25)), In::refresh()]);
+    let (rows, _) = run8(&[
+        In::eval1(2, 3, g(0.5)),
+        In::eval1(3, 1, g(0.25)),
+        In::refresh(),
+    ]);
     assert_eq!(rows[0], [0.0, 0.0, 0.5, 0.75, 0.5, 0.0, 0.0, 0.0]);
 }
 
@@ -48,17 +57,29 @@ fn eval3_second_order_differencing_order() {
 
 #[test]
 fn set_i_overrides_the_running_value_from_that_processor_on() {
-    let (rows, _) = run8(&[In::set_i(3, g(2.0)), In::eval2(1, 5, g(0.0), g(0.25)), In::refresh()]);
+    let (rows, _) = run8(&[
+        In::set_i(3, g(2.0)),
+        In::eval2(1, 5, g(0.0), g(0.25)),
+        In::refresh(),
+    ]);
     // 0, 0.25, then the preload 2.0 at x=3 and the wave continues from it
     assert_eq!(rows[0], [0.0, 0.0, 0.25, 2.0, 2.25, 2.5, 0.0, 0.0]);
 }
 
 #[test]
 fn set_di_and_set_ddi_override_the_differences() {
-    let (rows, _) = run8(&[In::set_di(2, g(1.0)), In::eval2(0, 4, g(0.0), g(0.5)), In::refresh()]);
+    let (rows, _) = run8(&[
+        In::set_di(2, g(1.0)),
+        In::eval2(0, 4, g(0.0), g(0.5)),
+        In::refresh(),
+    ]);
     // at x=2 dI becomes 1.0 after the value 1.0 was reached with the old dI
     assert_eq!(rows[0][..5], [0.0, 0.5, 1.0, 2.0, 0.0]);
-    let (rows, _) = run8(&[In::set_ddi(1, g(1.0)), In::eval3(0, 4, g(0.0), g(0.0), g(0.0)), In::refresh()]);
+    let (rows, _) = run8(&[
+        In::set_ddi(1, g(1.0)),
+        In::eval3(0, 4, g(0.0), g(0.0), g(0.0)),
+        In::refresh(),
+    ]);
     // ddI = 1 from x=1: values 0, 0, 0, 1
     assert_eq!(rows[0][..5], [0.0, 0.0, 0.0, 1.0, 0.0]);
 }
@@ -90,7 +111,11 @@ fn eval1_does_not_consume_a_di_preload_and_refresh_clears_it() {
 
 #[test]
 fn periodic_sets_reach_every_period_to_the_array_end() {
-    let (rows, s) = run8(&[In::set_pi(1, 3, g(1.0)), In::eval1(0, 8, g(0.0)), In::refresh()]);
+    let (rows, s) = run8(&[
+        In::set_pi(1, 3, g(1.0)),
+        In::eval1(0, 8, g(0.0)),
+        In::refresh(),
+    ]);
     // preloads at 1, 4, 7; each sets the running value, which then stays
     assert_eq!(rows[0], [0.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0]);
     assert_eq!(s.lines[0].processor_updates, 3 + 8);
@@ -101,7 +126,11 @@ fn periodic_sets_reach_every_period_to_the_array_end() {
         In::refresh(),
     ]);
     assert_eq!(rows[0], [0.0, 0.25, 0.5, 0.75, 0.0, 0.25, 0.5, 0.75]);
-    let (rows, _) = run8(&[In::set_pddi(2, 5, g(0.5)), In::eval3(0, 8, g(0.0), g(0.0), g(0.0)), In::refresh()]);
+    let (rows, _) = run8(&[
+        In::set_pddi(2, 5, g(0.5)),
+        In::eval3(0, 8, g(0.0), g(0.0), g(0.0)),
+        In::refresh(),
+    ]);
     // ddI 0.5 from x=2 (x=7 sets it again to 0.5)
     assert_eq!(rows[0], [0.0, 0.0, 0.0, 0.0, 0.5, 1.5, 3.0, 5.0]);
 }
@@ -133,10 +162,19 @@ fn dis_masks_only_the_next_eval_command() {
     assert_eq!(rows[0][..5], [0.75, 0.5, 0.5, 0.75, 0.0]);
     assert_eq!(s.lines[0].suppressed, 2);
     // the mask ends with the next Eval even when that Eval does not reach it
-    let (rows, _) = run8(&[In::dis(5, 1), In::eval1(0, 1, g(1.0)), In::eval1(5, 1, g(1.0)), In::refresh()]);
+    let (rows, _) = run8(&[
+        In::dis(5, 1),
+        In::eval1(0, 1, g(1.0)),
+        In::eval1(5, 1, g(1.0)),
+        In::refresh(),
+    ]);
     assert_eq!(rows[0][5], 1.0);
     // the wave still advances through a masked processor
-    let (rows, _) = run8(&[In::dis(1, 1), In::eval2(0, 3, g(0.0), g(1.0)), In::refresh()]);
+    let (rows, _) = run8(&[
+        In::dis(1, 1),
+        In::eval2(0, 3, g(0.0), g(1.0)),
+        In::refresh(),
+    ]);
     assert_eq!(rows[0][..3], [0.0, 0.0, 2.0]);
 }
 
@@ -158,7 +196,12 @@ fn acc_mode_toggles_accumulation_of_negative_contributions() {
 
 #[test]
 fn acc_mode_persists_across_refresh() {
-    let (rows, _) = run8(&[In::acc_mode(), In::refresh(), In::eval1(0, 1, g(-0.5)), In::refresh()]);
+    let (rows, _) = run8(&[
+        In::acc_mode(),
+        In::refresh(),
+        In::eval1(0, 1, g(-0.5)),
+        In::refresh(),
+    ]);
     assert_eq!(rows[1][0], -0.5);
 }
 
@@ -193,16 +236,29 @@ fn channels_are_independent() {
     let (rows, _) = run_on(
         h,
         &[
-            In::eval2(0, 3, Intensity::new(&[1.0, 0.0, 0.5]), Intensity::new(&[-0.5, 0.25, 0.0])),
+            In::eval2(
+                0,
+                3,
+                Intensity::new(&[1.0, 0.0, 0.5]),
+                Intensity::new(&[-0.5, 0.25, 0.0]),
+            ),
             In::refresh(),
         ],
     );
-    assert_eq!(rows[0], [1.0, 0.0, 0.5, 0.5, 0.25, 0.5, 0.0, 0.5, 0.5, 0.0, 0.0, 0.0]);
+    assert_eq!(
+        rows[0],
+        [1.0, 0.0, 0.5, 0.5, 0.25, 0.5, 0.0, 0.5, 0.5, 0.0, 0.0, 0.0]
+    );
 }
 
 #[test]
 fn instructions_after_the_last_refresh_are_reported_not_output() {
-    let (rows, s) = run8(&[In::eval1(0, 1, g(1.0)), In::refresh(), In::eval1(0, 1, g(1.0)), In::nop()]);
+    let (rows, s) = run8(&[
+        In::eval1(0, 1, g(1.0)),
+        In::refresh(),
+        In::eval1(0, 1, g(1.0)),
+        In::nop(),
+    ]);
     assert_eq!(rows.len(), 1);
     assert_eq!(s.totals.unrefreshed_instructions, 2);
     assert_eq!(s.totals.instructions, 4);

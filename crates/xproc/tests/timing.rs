@@ -20,11 +20,18 @@ fn stats(h: TraceHeader, m: &Machine, trace: &[In]) -> RunStats {
 fn issue_entry_gate_ready_and_slack() {
     // width 8, hop 1, line period 10 cycles; Eval2 costs 1 + 2 values = 3, Eval1 2, Refresh 1
     let h = TraceHeader::new(8, 4, 1).unwrap();
-    let m = Machine::default().with_overrides(&["line_period_cycles=10".into()]).unwrap();
+    let m = Machine::default()
+        .with_overrides(&["line_period_cycles=10".into()])
+        .unwrap();
     let s = stats(
         h,
         &m,
-        &[In::eval2(0, 4, g(0.0), g(0.0)), In::refresh(), In::eval1(0, 8, g(0.0)), In::refresh()],
+        &[
+            In::eval2(0, 4, g(0.0), g(0.0)),
+            In::refresh(),
+            In::eval1(0, 8, g(0.0)),
+            In::refresh(),
+        ],
     );
     let l0 = &s.lines[0];
     // Eval2 issues 0..3 and enters at 3; Refresh issues 3..4, enters at 4, leaves the
@@ -37,7 +44,10 @@ fn issue_entry_gate_ready_and_slack() {
     assert_eq!((l1.first_issue, l1.busy_cycles, l1.stall_cycles), (4, 3, 4));
     assert_eq!((l1.ready, l1.deadline, l1.slack), (19, 20, 1));
     assert_eq!(s.totals.late_lines, 1);
-    assert_eq!((s.totals.worst_slack, s.totals.worst_line), (Some(-2), Some(0)));
+    assert_eq!(
+        (s.totals.worst_slack, s.totals.worst_line),
+        (Some(-2), Some(0))
+    );
     assert_eq!(s.totals.cycles, 19);
     assert_eq!(s.traversal_cycles, 8);
 }
@@ -46,7 +56,9 @@ fn issue_entry_gate_ready_and_slack() {
 fn slow_hops_space_the_tokens() {
     // hop 3: a token holds each processor 3 cycles, so tokens enter at most every 3 cycles
     let h = TraceHeader::new(4, 1, 1).unwrap();
-    let m = Machine::default().with_overrides(&["hop_cycles=3".into()]).unwrap();
+    let m = Machine::default()
+        .with_overrides(&["hop_cycles=3".into()])
+        .unwrap();
     let s = stats(h, &m, &[In::nop(), In::nop(), In::nop(), In::refresh()]);
     // Nops enter at 1, 4, 7; Refresh at 10; ready at 10 + 4*3 = 22
     assert_eq!(s.lines[0].busy_cycles, 4);
@@ -72,9 +84,25 @@ fn vertical_blanking_separates_frames() {
 #[test]
 fn rgb_pays_for_three_channels_and_grey_does_not() {
     let m = Machine::default();
-    let e = |c: usize| In::eval3(0, 1, Intensity::splat(0.0, c), Intensity::splat(0.0, c), Intensity::splat(0.0, c));
-    let grey = stats(TraceHeader::new(4, 1, 1).unwrap(), &m, &[e(1), In::refresh()]);
-    let rgb = stats(TraceHeader::new(4, 1, 3).unwrap(), &m, &[e(3), In::refresh()]);
+    let e = |c: usize| {
+        In::eval3(
+            0,
+            1,
+            Intensity::splat(0.0, c),
+            Intensity::splat(0.0, c),
+            Intensity::splat(0.0, c),
+        )
+    };
+    let grey = stats(
+        TraceHeader::new(4, 1, 1).unwrap(),
+        &m,
+        &[e(1), In::refresh()],
+    );
+    let rgb = stats(
+        TraceHeader::new(4, 1, 3).unwrap(),
+        &m,
+        &[e(3), In::refresh()],
+    );
     assert_eq!(grey.lines[0].busy_cycles, 4 + 1);
     assert_eq!(rgb.lines[0].busy_cycles, 10 + 1);
 }
@@ -82,7 +110,11 @@ fn rgb_pays_for_three_channels_and_grey_does_not() {
 #[test]
 fn default_machine_is_in_time_for_a_light_1024_wide_line() {
     let h = TraceHeader::new(1024, 1024, 1).unwrap();
-    let s = stats(h, &Machine::default(), &[In::eval2(0, 1024, g(0.0), g(0.001)), In::refresh()]);
+    let s = stats(
+        h,
+        &Machine::default(),
+        &[In::eval2(0, 1024, g(0.0), g(0.001)), In::refresh()],
+    );
     // 1559-cycle line period; Eval2 3 + Refresh 1 + 1024 hops = 1028
     assert_eq!(s.line_period, 1559);
     assert_eq!(s.lines[0].ready, 1028);

@@ -1,0 +1,51 @@
+//! `cwisim convert`: re-encode a trace, streaming, one instruction at a time.
+
+use crate::error::CliError;
+use crate::files::{same_file, write_atomic};
+use clap::Args;
+use cwisim_isa::{Encoding, FileReader, TraceRead};
+use std::path::{Path, PathBuf};
+
+/// The arguments of `cwisim convert`.
+#[derive(Args, Clone, Debug, PartialEq, Eq)]
+pub struct ConvertArgs {
+    /// The trace to read: .cwt, .jsonl or .cwb.
+    #[arg(value_name = "IN")]
+    pub input: PathBuf,
+    /// The trace to write: .cwt, .jsonl or .cwb (replaced if it exists).
+    #[arg(value_name = "OUT")]
+    pub output: PathBuf,
+}
+
+/// Runs `cwisim convert`. Returns the number of instructions copied.
+pub fn run(args: &ConvertArgs) -> Result<u64, CliError> {
+    convert(&args.input, &args.output)
+}
+
+/// Copies every instruction of the trace `input` into a new trace `output`, each in the
+/// encoding its extension names. Every instruction is checked on the way; `output` is
+/// written all-or-nothing, so a malformed input leaves no partial file. Comments of a
+/// `.cwt` input are not kept.
+pub fn convert(input: &Path, output: &Path) -> Result<u64, CliError> {
+    Encoding::from_path(input)?;
+    let out_encoding = Encoding::from_path(output)?;
+    if same_file(input, output) {
+        return Err(CliError::Usage(format!(
+            "IN and OUT are the same file ({}); convert into a new file",
+            output.display()
+        )));
+    }
+    let mut reader = FileReader::open(input)?;
+    let header = *reader.header();
+    let mut count = 0;
+    write_atomic(output, |out| {
+        let io_err = |e| CliError::write(output, e);
+        let mut writer = out_encoding.writer(out, &header).map_err(io_err)?;
+        while let Some(instr) = reader.next_instruction()? {
+            writer.write(&instr).map_err(io_err)?;
+            count += 1;
+        }
+        writer.finish().map_err(io_err)
+    })?;
+    Ok(count)
+}

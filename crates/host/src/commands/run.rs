@@ -1,0 +1,245 @@
+//! `cwisim run`: replay a trace, write the image and the statistics.
+
+use super::MachineArgs;
+use crate::demo;
+use crate::error::CliError;
+use crate::files::{same_file, write_atomic};
+use crate::output;
+use crate::progress::Progress;
+use crate::report::{timing_name, unrefreshed_warning, write_summary, StatsReport};
+use clap::{Args, ValueEnum};
+use cwisim_isa::{Encoding, FileReader, TraceRead};
+use cwisim_xproc::{replay, Image, ImageSink, NullSink, RunStats, Timing};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// The timing model, as chosen on the command line.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum TimingArg {
+    /// Closed-form timing; cost proportional to the trace's work (the default).
+    #[default]
+    Fast,
+    /// Every processor advanced every cycle: the slow reference. Same results.
+    Stepped,
+}
+
+impl From<TimingArg> for Timing {
+    fn from(t: TimingArg) -> Timing {
+        match t {
+            TimingArg::Fast => Timing::Fast,
+            TimingArg::Stepped => Timing::Stepped,
+        }
+    }
+}
+
+/// The arguments of `cwisim run`.
+#[derive(Args, Clone, Debug, PartialEq)]
+pub struct RunArgs {
+    /// The trace: .cwt (text), .jsonl (JSON Lines) or .cwb (binary), chosen by extension.
+    /// Without it, the embedded demo trace (a shaded, anti-aliased disc) is replayed.
+    #[arg(value_name = "TRACE")]
+    pub trace: Option<PathBuf>,
+
+    /// Write the image as an 8-bit PNG (1 channel: grey, 3: RGB). Values are clamped to
+    /// [0, 1] and mapped to round(v × 255); NaN becomes 0.
+    #[arg(short = 'o', long = "output", value_name = "OUT.png")]
+    pub output: Option<PathBuf>,
+
+    /// Write the image as a NumPy array: float64, shape (scanlines, width, channels),
+    /// C order, exact values, nothing clamped.
+    #[arg(long, value_name = "OUT.npy")]
+    pub npy: Option<PathBuf>,
+
+    /// The machine model.
+    #[command(flatten)]
+    pub machine: MachineArgs,
+
+    /// Timing model. Both give identical images and cycle counts.
+    #[arg(long, value_enum, default_value_t = TimingArg::Fast)]
+    pub timing: TimingArg,
+
+    /// Print a summary of the statistics to standard output.
+    #[arg(long)]
+    pub stats: bool,
+
+    /// Write the statistics, the trace's dimensions, the machine and the timing model as
+    /// JSON (with one record per scanline).
+    #[arg(long, value_name = "FILE")]
+    pub stats_json: Option<PathBuf>,
+}
+
+/// What a successful replay produced.
+#[derive(Debug)]
+pub struct Replayed {
+    /// The statistics.
+    pub stats: RunStats,
+    /// The image, if one was asked for.
+    pub image: Option<Image>,
+}
+
+/// Runs `cwisim run`: statistics go to `stdout` (with `--stats`), warnings to `stderr`.
+/// `progress` allows the progress bar (it still needs a terminal and a run of over a
+/// second). Nothing is written unless the whole trace replayed without error.
+pub fn run(
+    args: &RunArgs,
+    stdout: &mut dyn Write,
+    stderr: &mut dyn Write,
+    progress: bool,
+) -> Result<(), CliError> {
+    check_paths(args)?;
+    let machine = args.machine.load()?;
+    let timing = Timing::from(args.timing);
+    let (mut reader, size) = open_trace(args.trace.as_deref())?;
+    let header = *reader.header();
+    if args.output.is_some() {
+        output::png_color(header.channel_count())?;
+    }
+    let replayed = {
+        let mut bar = Progress::new(size, progress);
+        let want_image = args.output.is_some() || args.npy.is_some();
+        replay_file(&mut *reader, &machine, timing, want_image, &mut |bytes| {
+            bar.update(bytes)
+        })?
+    };
+    // Check every output can be written before writing any.
+    if let (Some(_), Some(image)) = (&args.output, &replayed.image) {
+        output::check_png(image)?;
+    }
+    if let Some(image) = &replayed.image {
+        if let Some(path) = &args.output {
+            output::write_png(path, image)?;
+        }
+        if let Some(path) = &args.npy {
+            output::write_npy(path, image)?;
+        }
+    }
+    let stats = &replayed.stats;
+    if let Some(path) = &args.stats_json {
+        let json = StatsReport {
+            trace: (&header).into(),
+            machine: &machine,
+            timing: timing_name(timing),
+            stats,
+        }
+        .to_json()
+        .map_err(|e| CliError::write(path, e.into()))?;
+        write_atomic(path, |w| {
+            w.write_all(json.as_bytes())
+                .map_err(|e| CliError::write(path, e))
+        })?;
+    }
+    if let Some(warning) = unrefreshed_warning(stats) {
+        // A lost warning is no reason to fail the run.
+        let _ = writeln!(stderr, "{warning}");
+    }
+    if args.stats {
+        write_summary(stdout, &header, timing, stats).map_err(CliError::Stdout)?;
+        stdout.flush().map_err(CliError::Stdout)?;
+    }
+    Ok(())
+}
+
+/// A reader on the trace file and its size in bytes, or on the embedded demo trace
+/// ([`demo`]) when there is no file.
+pub fn open_trace(path: Option<&Path>) -> Result<(Box<dyn TraceRead>, u64), CliError> {
+    match path {
+        Some(path) => {
+            let reader = FileReader::open(path)?;
+            let size = reader.size();
+            Ok((Box::new(reader), size))
+        }
+        None => {
+            let bytes = demo_trace_bytes();
+            let size = bytes.len() as u64;
+            let reader = Encoding::Binary.reader(std::io::Cursor::new(bytes))?;
+            Ok((reader, size))
+        }
+    }
+}
+
+/// The demo trace encoded as `.cwb`, so that it is read, checked and replayed exactly
+/// like a file.
+fn demo_trace_bytes() -> Vec<u8> {
+    let (header, instrs) = demo::trace();
+    let mut bytes = Vec::new();
+    // Writing into a Vec cannot fail.
+    if let Ok(mut w) = Encoding::Binary.writer(&mut bytes, &header) {
+        for i in &instrs {
+            let _ = w.write(i);
+        }
+        let _ = w.finish();
+    }
+    bytes
+}
+
+/// Replays an open trace on `machine`, collecting the image (up to
+/// [`ImageSink::DEFAULT_LIMIT_BYTES`]) when `want_image`.
+pub fn replay_file(
+    reader: &mut dyn TraceRead,
+    machine: &cwisim_xproc::Machine,
+    timing: Timing,
+    want_image: bool,
+    progress: &mut dyn FnMut(u64),
+) -> Result<Replayed, CliError> {
+    let header = *reader.header();
+    if want_image {
+        let mut sink = ImageSink::new(
+            header.width as usize,
+            header.channel_count(),
+            ImageSink::DEFAULT_LIMIT_BYTES,
+        );
+        let stats = replay::<f64>(reader, machine, timing, &mut sink, progress)?;
+        Ok(Replayed {
+            stats,
+            image: Some(sink.finish()?),
+        })
+    } else {
+        let stats = replay::<f64>(reader, machine, timing, &mut NullSink, progress)?;
+        Ok(Replayed { stats, image: None })
+    }
+}
+
+/// Refuses outputs that would overwrite the trace or each other, and a PNG path that
+/// asks for NumPy.
+fn check_paths(args: &RunArgs) -> Result<(), CliError> {
+    if let Some(png) = &args.output {
+        let ext = png.extension().and_then(|e| e.to_str()).unwrap_or("");
+        if ext.eq_ignore_ascii_case("npy") {
+            return Err(CliError::Usage(format!(
+                "-o writes PNG, but `{}` names a NumPy file; use --npy {}",
+                png.display(),
+                png.display()
+            )));
+        }
+    }
+    let outputs: [(&str, Option<&PathBuf>); 3] = [
+        ("-o", args.output.as_ref()),
+        ("--npy", args.npy.as_ref()),
+        ("--stats-json", args.stats_json.as_ref()),
+    ];
+    let outputs: Vec<(&str, &Path)> = outputs
+        .iter()
+        .filter_map(|(f, p)| p.map(|p| (*f, p.as_path())))
+        .collect();
+    for (i, (flag, path)) in outputs.iter().enumerate() {
+        if args
+            .trace
+            .as_deref()
+            .is_some_and(|trace| same_file(path, trace))
+        {
+            return Err(CliError::Usage(format!(
+                "{flag} {} would overwrite the trace being read",
+                path.display()
+            )));
+        }
+        for (other, other_path) in &outputs[..i] {
+            if same_file(path, other_path) {
+                return Err(CliError::Usage(format!(
+                    "{other} and {flag} both name {}; give each output its own file",
+                    path.display()
+                )));
+            }
+        }
+    }
+    Ok(())
+}

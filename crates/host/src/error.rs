@@ -1,0 +1,114 @@
+//! Every way a `cwisim` command can fail, and the exit code each gives.
+
+use cwisim_isa::TraceError;
+use cwisim_xproc::{ImageLimit, MachineError, ReplayError};
+use std::path::PathBuf;
+
+/// Exit code for bad input or usage: a malformed trace or machine file, bad arguments.
+pub const EXIT_BAD_INPUT: u8 = 2;
+/// Exit code when the input was fine but an output could not be written.
+pub const EXIT_OUTPUT_FAILED: u8 = 1;
+
+/// Why a command failed. Every message is one line and names the file involved.
+#[derive(Debug, thiserror::Error)]
+pub enum CliError {
+    /// The trace cannot be read (its message is located: `file:line:col` or `file: byte N`).
+    #[error(transparent)]
+    Trace(#[from] TraceError),
+    /// The machine description (file or `--set`) is unusable.
+    #[error(transparent)]
+    Machine(#[from] MachineError),
+    /// The output image would be larger than the collector allows.
+    #[error(transparent)]
+    ImageLimit(#[from] ImageLimit),
+    /// Arguments that contradict each other or the trace (same input and output, a
+    /// 4-channel PNG, …).
+    #[error("{0}")]
+    Usage(String),
+    /// An output file could not be written.
+    #[error("{}: cannot write: {source}", path.display())]
+    Write {
+        /// The output file.
+        path: PathBuf,
+        /// What went wrong.
+        source: std::io::Error,
+    },
+    /// Standard output could not be written (a closed pipe, a full disk).
+    #[error("cannot write to standard output: {0}")]
+    Stdout(std::io::Error),
+}
+
+impl From<ReplayError> for CliError {
+    fn from(e: ReplayError) -> Self {
+        match e {
+            ReplayError::Trace(e) => CliError::Trace(e),
+            ReplayError::Machine(e) => CliError::Machine(e),
+        }
+    }
+}
+
+impl CliError {
+    /// The process exit code: [`EXIT_BAD_INPUT`] (2) for bad input or usage,
+    /// [`EXIT_OUTPUT_FAILED`] (1) when writing an output failed.
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            CliError::Trace(_)
+            | CliError::Machine(_)
+            | CliError::ImageLimit(_)
+            | CliError::Usage(_) => EXIT_BAD_INPUT,
+            CliError::Write { .. } | CliError::Stdout(_) => EXIT_OUTPUT_FAILED,
+        }
+    }
+
+    /// A write error on `path`.
+    pub fn write(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        CliError::Write {
+            path: path.into(),
+            source,
+        }
+    }
+
+    /// The message as exactly one line (any line break of an inner message becomes a
+    /// space), for `error: <message>`.
+    pub fn one_line(&self) -> String {
+        let text = self.to_string();
+        let mut out = String::with_capacity(text.len());
+        for (i, part) in text
+            .lines()
+            .map(str::trim)
+            .filter(|l| !l.is_empty())
+            .enumerate()
+        {
+            if i > 0 {
+                out.push(' ');
+            }
+            out.push_str(part);
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use cwisim_isa::{ErrorKind, Location};
+    use std::path::Path;
+
+    #[test]
+    fn messages_are_one_line_and_codes_follow_the_cause() {
+        let e: CliError = TraceError::new(
+            ErrorKind::Syntax,
+            Location::Line { line: 3, column: 7 },
+            "expected x",
+        )
+        .in_file(Path::new("t.cwt"))
+        .into();
+        assert_eq!(e.one_line(), "t.cwt:3:7: expected x");
+        assert_eq!(e.exit_code(), 2);
+        let e = CliError::Usage("first\nsecond\n".into());
+        assert_eq!(e.one_line(), "first second");
+        let e = CliError::write("out.png", std::io::Error::other("disk full"));
+        assert_eq!(e.one_line(), "out.png: cannot write: disk full");
+        assert_eq!(e.exit_code(), 1);
+    }
+}

@@ -1,0 +1,76 @@
+//! Helpers shared by the integration tests: scratch directories and running the real
+//! `cwisim` binary in them.
+
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// The canonical text of the small test trace: an 8-processor grey array, two scanlines.
+pub const SMALL_TRACE: &str = "\
+cwisim-trace version=1 width=8 lines=2 channels=1
+Eval2 2 4 0.5 0.125
+Refresh
+Eval1 0 8 1.0
+Refresh
+";
+
+/// An empty directory for one test, under Cargo's per-target scratch directory.
+pub fn scratch(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join("cwisim-host")
+        .join(name);
+    if dir.exists() {
+        std::fs::remove_dir_all(&dir).expect("clear the scratch dir");
+    }
+    std::fs::create_dir_all(&dir).expect("create the scratch dir");
+    dir
+}
+
+/// Runs `cwisim ARGS` with `dir` as its working directory (so messages name files
+/// relative to it).
+pub fn cwisim(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_cwisim"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("run the cwisim binary")
+}
+
+/// Standard output and standard error as text.
+pub fn text(out: &Output) -> (String, String) {
+    (
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// Runs `cwisim ARGS`, asserting success and an empty standard error.
+pub fn cwisim_ok(dir: &Path, args: &[&str]) -> String {
+    let out = cwisim(dir, args);
+    let (stdout, stderr) = text(&out);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "cwisim {args:?} failed: {stderr}"
+    );
+    assert!(
+        stderr.is_empty(),
+        "cwisim {args:?} wrote to stderr: {stderr}"
+    );
+    stdout
+}
+
+/// Reads a file that must exist.
+pub fn read(path: impl AsRef<Path>) -> Vec<u8> {
+    let path = path.as_ref();
+    std::fs::read(path).unwrap_or_else(|e| panic!("read {}: {e}", path.display()))
+}
+
+/// The shape and values of a `.npy` file.
+pub fn read_npy(path: impl AsRef<Path>) -> (Vec<u64>, Vec<f64>) {
+    let bytes = read(path);
+    let npy = npyz::NpyFile::new(&bytes[..]).expect("a .npy header");
+    let shape = npy.shape().to_vec();
+    (shape, npy.into_vec::<f64>().expect("float64 data"))
+}
