@@ -6,7 +6,8 @@
 use crate::commands::convert::ConvertArgs;
 use crate::commands::machine::MachineCmdArgs;
 use crate::commands::run::RunArgs;
-use crate::commands::{convert, machine, run};
+use crate::commands::scene::{EmitArgs, RenderArgs};
+use crate::commands::{convert, machine, run, scene};
 use crate::error::CliError;
 use clap::{Parser, Subcommand};
 use std::ffi::OsString;
@@ -62,6 +63,29 @@ Example:\n  cwisim run scene.cwt -o scene.png --npy scene.npy --set clock_hz=2e8
         after_help = AFTER_HELP
     )]
     Run(RunArgs),
+
+    /// Render a screen-space scene: Y-processor, trace, X-processor array, image
+    #[command(
+        long_about = "Render a screen-space scene (JSON, \"kind\": \"screen\"; see docs/SCENES.md): the \
+Y-processor splits its polygons into trapezia and emits the scanline instructions (box-filter \
+coverage with van Rij's twelve DO_FILL cases, or point sampling; flat or Gouraud), and the \
+X-processor array executes them. -o writes a PNG ([0, 1] clamped to 8 bits), --npy the exact \
+values (float64, shape (height, width, channels)), --trace the instruction stream (a .cwt \
+trace is annotated with the DO_FILL case of every trapezium row).\n\n\
+Example:\n  cwisim render scene.json -o scene.png --trace scene.cwt --stats",
+        after_help = AFTER_HELP
+    )]
+    Render(RenderArgs),
+
+    /// Scan-convert a screen-space scene into a trace file
+    #[command(
+        long_about = "Scan-convert a screen-space scene into a trace of X-processor instructions, \
+without executing it. The encoding is chosen by OUT's extension: .cwt (text, with a comment \
+naming the DO_FILL case and stretches of every trapezium row), .jsonl or .cwb.\n\n\
+Example:\n  cwisim emit scene.json -o scene.cwt --shading flat --aa box",
+        after_help = AFTER_HELP
+    )]
+    Emit(EmitArgs),
 
     /// Convert a trace between the .cwt, .jsonl and .cwb encodings
     #[command(
@@ -142,6 +166,8 @@ fn dispatch(
     match command {
         Command::Run(args) => run::run(args, stdout, stderr, progress),
         Command::Convert(args) => convert::run(args).map(|_| ()),
+        Command::Render(args) => scene::run_render(args, stdout),
+        Command::Emit(args) => scene::run_emit(args),
         Command::Machine(args) => machine::run(args, stdout, stderr),
     }
 }

@@ -2,6 +2,7 @@
 
 use cwisim_isa::TraceError;
 use cwisim_xproc::{ImageLimit, MachineError, ReplayError};
+use cwisim_ypipe::scene::SceneError;
 use std::path::PathBuf;
 
 /// Exit code for bad input or usage: a malformed trace or machine file, bad arguments.
@@ -18,6 +19,9 @@ pub enum CliError {
     /// The machine description (file or `--set`) is unusable.
     #[error(transparent)]
     Machine(#[from] MachineError),
+    /// The scene file is malformed (its message is located).
+    #[error(transparent)]
+    Scene(#[from] SceneError),
     /// The output image would be larger than the collector allows.
     #[error(transparent)]
     ImageLimit(#[from] ImageLimit),
@@ -54,6 +58,7 @@ impl CliError {
         match self {
             CliError::Trace(_)
             | CliError::Machine(_)
+            | CliError::Scene(_)
             | CliError::ImageLimit(_)
             | CliError::Usage(_) => EXIT_BAD_INPUT,
             CliError::Write { .. } | CliError::Stdout(_) => EXIT_OUTPUT_FAILED,

@@ -33,6 +33,7 @@
 
 pub mod engine;
 pub mod fast;
+pub mod feed;
 pub mod machine;
 pub mod output;
 pub mod sample;
@@ -40,6 +41,7 @@ pub mod stats;
 pub mod stepped;
 
 pub use engine::{engine, replay, run, Engine, ReplayError, Timing};
+pub use feed::EngineWriter;
 pub use machine::{Machine, MachineError, Timeline};
 pub use output::{Image, ImageLimit, ImageSink, LineOut, LineSink, NullSink};
 pub use sample::Sample;

@@ -3,11 +3,64 @@
 pub mod convert;
 pub mod machine;
 pub mod run;
+pub mod scene;
 
 use crate::error::CliError;
+use crate::output;
 use clap::Args;
-use cwisim_xproc::Machine;
+use cwisim_xproc::{Image, Machine};
 use std::path::PathBuf;
+
+/// `-o OUT.png` and `--npy OUT.npy`: where the image goes (`run` and `render`).
+#[derive(Args, Clone, Debug, Default, PartialEq)]
+pub struct ImageArgs {
+    /// Write the image as an 8-bit PNG (1 channel: grey, 3: RGB). Values are clamped to
+    /// [0, 1] and mapped to round(v × 255); NaN becomes 0.
+    #[arg(short = 'o', long = "output", value_name = "OUT.png")]
+    pub output: Option<PathBuf>,
+
+    /// Write the image as a NumPy array: float64, shape (scanlines, width, channels),
+    /// C order, exact values, nothing clamped.
+    #[arg(long, value_name = "OUT.npy")]
+    pub npy: Option<PathBuf>,
+}
+
+impl ImageArgs {
+    /// Whether any image output was asked for.
+    pub fn wanted(&self) -> bool {
+        self.output.is_some() || self.npy.is_some()
+    }
+
+    /// Refuses, before any work, a PNG path that names a NumPy file and a PNG of a
+    /// channel count PNG cannot hold.
+    pub fn check(&self, channels: usize) -> Result<(), CliError> {
+        if let Some(png) = &self.output {
+            let ext = png.extension().and_then(|e| e.to_str()).unwrap_or("");
+            if ext.eq_ignore_ascii_case("npy") {
+                return Err(CliError::Usage(format!(
+                    "-o writes PNG, but `{}` names a NumPy file; use --npy {}",
+                    png.display(),
+                    png.display()
+                )));
+            }
+            output::png_color(channels)?;
+        }
+        Ok(())
+    }
+
+    /// Writes the outputs asked for (PNG checked first, so that either both or neither
+    /// is written when the PNG cannot be).
+    pub fn write(&self, image: &Image) -> Result<(), CliError> {
+        if let Some(path) = &self.output {
+            output::check_png(image)?;
+            output::write_png(path, image)?;
+        }
+        if let Some(path) = &self.npy {
+            output::write_npy(path, image)?;
+        }
+        Ok(())
+    }
+}
 
 /// `--machine FILE` and `--set KEY=VALUE`: which machine model to simulate.
 #[derive(Args, Clone, Debug, Default, PartialEq)]

@@ -1,10 +1,9 @@
 //! `cwisim run`: replay a trace, write the image and the statistics.
 
-use super::MachineArgs;
+use super::{ImageArgs, MachineArgs};
 use crate::demo;
 use crate::error::CliError;
 use crate::files::{same_file, write_atomic};
-use crate::output;
 use crate::progress::Progress;
 use crate::report::{timing_name, unrefreshed_warning, write_summary, StatsReport};
 use clap::{Args, ValueEnum};
@@ -40,15 +39,9 @@ pub struct RunArgs {
     #[arg(value_name = "TRACE")]
     pub trace: Option<PathBuf>,
 
-    /// Write the image as an 8-bit PNG (1 channel: grey, 3: RGB). Values are clamped to
-    /// [0, 1] and mapped to round(v × 255); NaN becomes 0.
-    #[arg(short = 'o', long = "output", value_name = "OUT.png")]
-    pub output: Option<PathBuf>,
-
-    /// Write the image as a NumPy array: float64, shape (scanlines, width, channels),
-    /// C order, exact values, nothing clamped.
-    #[arg(long, value_name = "OUT.npy")]
-    pub npy: Option<PathBuf>,
+    /// Image outputs.
+    #[command(flatten)]
+    pub image: ImageArgs,
 
     /// The machine model.
     #[command(flatten)]
@@ -91,27 +84,16 @@ pub fn run(
     let timing = Timing::from(args.timing);
     let (mut reader, size) = open_trace(args.trace.as_deref())?;
     let header = *reader.header();
-    if args.output.is_some() {
-        output::png_color(header.channel_count())?;
-    }
+    args.image.check(header.channel_count())?;
     let replayed = {
         let mut bar = Progress::new(size, progress);
-        let want_image = args.output.is_some() || args.npy.is_some();
+        let want_image = args.image.wanted();
         replay_file(&mut *reader, &machine, timing, want_image, &mut |bytes| {
             bar.update(bytes)
         })?
     };
-    // Check every output can be written before writing any.
-    if let (Some(_), Some(image)) = (&args.output, &replayed.image) {
-        output::check_png(image)?;
-    }
     if let Some(image) = &replayed.image {
-        if let Some(path) = &args.output {
-            output::write_png(path, image)?;
-        }
-        if let Some(path) = &args.npy {
-            output::write_npy(path, image)?;
-        }
+        args.image.write(image)?;
     }
     let stats = &replayed.stats;
     if let Some(path) = &args.stats_json {
@@ -199,22 +181,11 @@ pub fn replay_file(
     }
 }
 
-/// Refuses outputs that would overwrite the trace or each other, and a PNG path that
-/// asks for NumPy.
+/// Refuses outputs that would overwrite the trace or each other.
 fn check_paths(args: &RunArgs) -> Result<(), CliError> {
-    if let Some(png) = &args.output {
-        let ext = png.extension().and_then(|e| e.to_str()).unwrap_or("");
-        if ext.eq_ignore_ascii_case("npy") {
-            return Err(CliError::Usage(format!(
-                "-o writes PNG, but `{}` names a NumPy file; use --npy {}",
-                png.display(),
-                png.display()
-            )));
-        }
-    }
     let outputs: [(&str, Option<&PathBuf>); 3] = [
-        ("-o", args.output.as_ref()),
-        ("--npy", args.npy.as_ref()),
+        ("-o", args.image.output.as_ref()),
+        ("--npy", args.image.npy.as_ref()),
         ("--stats-json", args.stats_json.as_ref()),
     ];
     let outputs: Vec<(&str, &Path)> = outputs

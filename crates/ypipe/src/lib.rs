@@ -1,0 +1,181 @@
+//! # cwisim-ypipe — the Y-processor
+//!
+//! The host side of the CWI architecture that turns polygons into the scanline commands
+//! of the X-processor array, as van Rij's report (CS-R9427, sections 2–3, appendix A)
+//! describes:
+//!
+//! 1. [`scene`] — screen-space scenes (JSON): polygons with per-vertex intensities.
+//! 2. [`clip`] — polygons are clipped exactly to the image.
+//! 3. [`trapezoid`] — each polygon becomes trapezia with horizontal top and bottom.
+//! 4. [`scan`] — an edge list and an active edge table grouped by Identifier visit the
+//!    trapezia row by row (Algorithms 7–8).
+//! 5. [`dofill`] — each row of a trapezium becomes instructions: box-filter coverage in
+//!    the twelve cases of DO_FILL ([`coverage`]), or point sampling; flat or Gouraud.
+//! 6. [`emit`](fn@emit) — the stream goes to any [`TraceWrite`] (a trace file, the
+//!    array simulator, a counter), one `Refresh` per scanline.
+//!
+//! [`exact`] is the independent exact reference (area and box-filtered intensity of
+//! polygon ∩ pixel) that the emitted streams are checked against.
+//!
+//! Where the project departs from the report, and why: `docs/ERRATA.md`.
+
+#![warn(missing_docs)]
+
+pub mod clip;
+pub mod coverage;
+pub mod dofill;
+pub mod exact;
+pub mod scan;
+pub mod scene;
+pub mod trapezoid;
+
+use crate::dofill::{box_row, sampled_row, Procedure, Shade};
+use crate::scene::ScreenScene;
+use cwisim_isa::{Instruction, TraceHeader, TraceWrite, MAX_CHANNELS};
+use std::io;
+
+/// Flat or Gouraud shading.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Shading {
+    /// One intensity per polygon: the mean of its vertex intensities.
+    Flat,
+    /// Intensities interpolated along the edges and across each scanline.
+    #[default]
+    Gouraud,
+}
+
+/// Anti-aliasing.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Antialias {
+    /// Point sampling at pixel centres.
+    None,
+    /// Box filter: exact covered area per pixel (DO_FILL).
+    #[default]
+    Box,
+}
+
+/// How to scan-convert.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Options {
+    /// Shading.
+    pub shading: Shading,
+    /// Anti-aliasing.
+    pub aa: Antialias,
+}
+
+/// What an emission did.
+#[derive(Clone, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct EmitStats {
+    /// Polygons in the scene.
+    pub polygons: u64,
+    /// Trapezia they became (after clipping).
+    pub trapezia: u64,
+    /// Trapezium rows filled.
+    pub rows_filled: u64,
+    /// Rows of each DO_FILL case, `cases[k]` for case `k + 1` (box filter only).
+    pub cases: [u64; 12],
+    /// Separately calculated pixels.
+    pub single_pixels: u64,
+    /// Middle-part stretches.
+    pub middle_parts: u64,
+    /// Sequence stretches.
+    pub sequences: u64,
+    /// Share-sequence stretches.
+    pub share_sequences: u64,
+    /// Instructions emitted, `Refresh` included.
+    pub instructions: u64,
+}
+
+/// The trace header for a scene: the image width, its height as the lines per frame.
+pub fn header(scene: &ScreenScene) -> TraceHeader {
+    TraceHeader::new(scene.width, scene.height, scene.channels)
+        .expect("a validated scene fits a trace header")
+}
+
+/// The trapezia of a scene's polygons after clipping to the image, numbered 1, 2, … in
+/// polygon order (the report's Identifier).
+pub fn scene_trapezia(scene: &ScreenScene) -> Vec<trapezoid::Trapezium> {
+    let channels = usize::from(scene.channels);
+    let (w, h) = (f64::from(scene.width), f64::from(scene.height));
+    let mut out = Vec::new();
+    for (k, p) in scene.polygons.iter().enumerate() {
+        let clipped = clip::clip_to_rect(p, 0.0, 0.0, w, h);
+        if clipped.vertices.len() < 3 {
+            continue;
+        }
+        let first = out.len() as u32 + 1;
+        out.extend(trapezoid::trapezia(&clipped, k as u32, channels, first));
+    }
+    out
+}
+
+fn flat_intensity(p: &scene::Polygon, channels: usize) -> [f64; MAX_CHANNELS] {
+    let n = p.intensity.len().max(1) as f64;
+    trapezoid::vector(channels, |c| {
+        p.intensity.iter().map(|v| v[c]).sum::<f64>() / n
+    })
+}
+
+/// Scan-converts a scene into `sink`: every scanline's instructions, then its `Refresh`
+/// (one per image row, empty rows included). Text sinks also get a comment per
+/// trapezium row naming its DO_FILL case and stretches.
+pub fn emit(
+    scene: &ScreenScene,
+    options: &Options,
+    sink: &mut dyn TraceWrite,
+) -> io::Result<EmitStats> {
+    let channels = usize::from(scene.channels);
+    let trapezia = scene_trapezia(scene);
+    let shades: Vec<Shade> = scene
+        .polygons
+        .iter()
+        .map(|p| match options.shading {
+            Shading::Flat => Shade::Flat(flat_intensity(p, channels)),
+            Shading::Gouraud => Shade::Gouraud,
+        })
+        .collect();
+    let mut stats = EmitStats {
+        polygons: scene.polygons.len() as u64,
+        trapezia: trapezia.len() as u64,
+        ..EmitStats::default()
+    };
+    let mut result = Ok(());
+    scan::scan(&trapezia, scene.height, channels, |visit| {
+        if result.is_err() {
+            return;
+        }
+        match visit {
+            scan::Visit::Fill(row, t) => {
+                let shade = &shades[t.polygon as usize];
+                let fill = match options.aa {
+                    Antialias::Box => box_row(t, row, scene.width, shade, channels),
+                    Antialias::None => sampled_row(t, row, scene.width, shade, channels),
+                };
+                let Some(fill) = fill else { return };
+                stats.rows_filled += 1;
+                if let Some(case) = fill.case {
+                    stats.cases[usize::from(case.0) - 1] += 1;
+                }
+                result = sink.comment(&fill.note).and_then(|()| {
+                    for (proc_, instr) in &fill.instructions {
+                        match proc_ {
+                            Procedure::Single => stats.single_pixels += 1,
+                            Procedure::MiddlePart => stats.middle_parts += 1,
+                            Procedure::Sequence => stats.sequences += 1,
+                            Procedure::ShareSequence => stats.share_sequences += 1,
+                        }
+                        stats.instructions += 1;
+                        sink.write(instr)?;
+                    }
+                    Ok(())
+                });
+            }
+            scan::Visit::EndOfRow(_) => {
+                stats.instructions += 1;
+                result = sink.write(&Instruction::refresh());
+            }
+        }
+    });
+    result?;
+    Ok(stats)
+}
