@@ -410,3 +410,28 @@ fn random_polygons_reach_all_twelve_cases() {
     }
     assert!(seen.iter().all(|n| *n > 0), "cases reached: {seen:?}");
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(150))]
+
+    /// Slivers thinner than 1e-6 px at any angle, and edges with slopes up to 1e6.
+    #[test]
+    fn slivers_and_steep_edges_match_the_exact_area(
+        a in (0.0f64..24.0, 0.0f64..16.0),
+        b in (0.0f64..24.0, 0.0f64..16.0),
+        thickness in prop_oneof![1e-9f64..1e-6, 1e-6f64..1e-3],
+        steep in any::<bool>(),
+    ) {
+        let (a, mut b) = ([a.0, a.1], [b.0, b.1]);
+        if steep {
+            // |dy/dx| up to 1e6: nearly vertical
+            b[0] = a[0] + (b[1] - a[1]) * 1e-6;
+        }
+        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+        let len = dx.hypot(dy);
+        prop_assume!(len > 1e-3);
+        // the third vertex a hair's breadth off the line a-b
+        let c = [b[0] - dy / len * thickness, b[1] + dx / len * thickness];
+        check_coverage(&scene(24, 16, vec![grey(vec![a, b, c])]))?;
+    }
+}
