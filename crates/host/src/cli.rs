@@ -7,7 +7,7 @@ use crate::commands::convert::ConvertArgs;
 use crate::commands::machine::MachineCmdArgs;
 use crate::commands::run::RunArgs;
 use crate::commands::scene::{EmitArgs, RenderArgs};
-use crate::commands::{convert, machine, run, scene};
+use crate::commands::{convert, diff, dump, history, machine, run, scene, stats, vcd};
 use crate::error::CliError;
 use clap::{Parser, Subcommand};
 use std::ffi::OsString;
@@ -87,6 +87,78 @@ Example:\n  cwisim emit scene.json -o scene.cwt --shading flat --aa box",
     )]
     Emit(EmitArgs),
 
+    /// Per-scanline statistics of a trace or scene: table, plot, CSV, JSON
+    #[command(
+        long_about = "Per-scanline statistics of a trace (.cwt, .jsonl, .cwb, replayed as by `run`), or of \
+a screen scene (.json, rendered first as by `render`: Gouraud, box filter): instructions by \
+opcode, bus (busy) and stall cycles, processor updates, and when each scanline was ready \
+against the display's deadline; negative slack is an overrun, marked LATE. Prints the table \
+(a column per opcode that occurs) and a totals line for the selected scanlines.\n\n\
+--lines keeps some scanlines (N, A-B or A-, counted from 0 over the whole trace). --plot \
+draws a PNG: one bar per scanline, its bus cycles stacked by opcode group (count × the \
+opcode's issue cost) with the stall cycles on top, the line period as a horizontal line, a \
+red marker on every overrun. --csv writes the table with a column for each of the 14 \
+opcodes; --json the selected scanlines' records, their sums, each opcode's issue cost and \
+the run's totals.\n\n\
+Example:\n  cwisim stats traces/overrun.cwt --machine traces/overrun.machine.json --plot overrun.png",
+        after_help = AFTER_HELP
+    )]
+    Stats(stats::StatsArgs),
+
+    /// Every instruction that reached one processor on one scanline, with its registers
+    #[command(
+        long_about = "Pixel history: every instruction whose token reached processor X on scanline Y, \
+in order, with the cycle it arrived and the processor's registers and flags just before and \
+just after it acted (values as at that moment, from the cycle-stepped model).\n\n\
+Example:\n  cwisim history traces/visibility.cwt --x 9 --y 0",
+        after_help = AFTER_HELP
+    )]
+    History(history::HistoryArgs),
+
+    /// A per-cycle waveform (VCD) of one scanline's processors and instruction bus
+    #[command(
+        long_about = "Write a Value Change Dump of one scanline: the chosen processors' registers and \
+flags and the instruction bus (opcode and operands), cycle by cycle, for GTKWave, Surfer or \
+any VCD viewer. The cycle-stepped model is replayed; the dump runs from the cycle the bus \
+starts issuing the scanline's first instruction to the cycle the scanline leaves the array. \
+Time stamps are absolute cycles: one time unit (written 1 ns) is one array clock cycle.\n\n\
+Scope bus: opcode (8-bit code, 0 when idle), x and dx (32-bit, z when idle or not an operand), \
+I, dI, ddI (real, 0 when absent), index (32-bit instruction number), busy (1 while issuing). \
+Scope pN for each processor N of the window: acc, I, dI, ddI (real), has_I, has_dI, has_ddI, \
+locked, masked, neg (1-bit), out (real: what N shifts out when this scanline's Refresh passes, \
+0 before), token (32-bit: the instruction whose token is in N, z when none). With several \
+channels each real is one per channel: I_c0, I_c1, … Tokens of other scanlines passing \
+through are included.\n\n\
+--from X0 --to X1 keep processors X0..=X1 (inclusive) and the file small; a missing --from is \
+0, a missing --to the last processor. Without either, an array of at most 64 processors is \
+dumped whole and a wider one is refused. The file is written only when the replay succeeded, \
+and is the same byte for byte on every run.\n\n\
+Example:\n  cwisim vcd traces/gouraud.cwt --line 1 --from 2 --to 8 -o line1.vcd",
+        after_help = AFTER_HELP
+    )]
+    Vcd(vcd::VcdArgs),
+
+    /// Compare two traces or two outputs; exit 0 when equal, 1 when different
+    #[command(
+        long_about = "Compare two traces (the first differing scanline and instruction, and the count \
+of each opcode on each side) or two outputs (.npy files, or traces replayed: per-scanline \
+max and RMS difference, and --image for an error image). Exit status 0 when equal, 1 when \
+different, 2 on bad input, so it serves in scripts.\n\n\
+Example:\n  cwisim diff a.cwt b.cwb --output\n  cwisim diff a.npy b.npy --image diff.png",
+        after_help = AFTER_HELP
+    )]
+    Diff(diff::DiffArgs),
+
+    /// Disassemble a trace with scanline and cycle annotations
+    #[command(
+        long_about = "Print a trace (any encoding) in the text form, each instruction annotated with \
+its number, its scanline, the cycle the bus started issuing it and the cycle it entered \
+the array. --lines keeps only some scanlines.\n\n\
+Example:\n  cwisim dump trace.cwb --lines 10-12",
+        after_help = AFTER_HELP
+    )]
+    Dump(dump::DumpArgs),
+
     /// Convert a trace between the .cwt, .jsonl and .cwb encodings
     #[command(
         long_about = "Convert a trace between encodings, chosen by each file's extension: .cwt (text), \
@@ -148,7 +220,9 @@ pub fn run_cli_with(
         }
     };
     match dispatch(&cli.command, stdout, stderr, progress) {
-        Ok(()) => 0,
+        Ok(code) => code,
+        // The reader went away (`cwisim dump t.cwb | head`): nothing more to say.
+        Err(CliError::Stdout(e)) if e.kind() == std::io::ErrorKind::BrokenPipe => 0,
         Err(e) => {
             let _ = writeln!(stderr, "error: {}", e.one_line());
             let _ = stderr.flush();
@@ -162,13 +236,19 @@ fn dispatch(
     stdout: &mut dyn Write,
     stderr: &mut dyn Write,
     progress: bool,
-) -> Result<(), CliError> {
+) -> Result<u8, CliError> {
     match command {
-        Command::Run(args) => run::run(args, stdout, stderr, progress),
-        Command::Convert(args) => convert::run(args).map(|_| ()),
-        Command::Render(args) => scene::run_render(args, stdout),
-        Command::Emit(args) => scene::run_emit(args),
-        Command::Machine(args) => machine::run(args, stdout, stderr),
+        Command::Run(args) => run::run(args, stdout, stderr, progress).map(|()| 0),
+        Command::Convert(args) => convert::run(args).map(|_| 0),
+        Command::Machine(args) => machine::run(args, stdout, stderr).map(|()| 0),
+        Command::Render(args) => scene::run_render(args, stdout).map(|()| 0),
+        Command::Emit(args) => scene::run_emit(args).map(|()| 0),
+        Command::Stats(args) => stats::run(args, stdout, stderr).map(|()| 0),
+        Command::History(args) => history::run(args, stdout).map(|()| 0),
+        Command::Vcd(args) => vcd::run(args).map(|()| 0),
+        // equal: 0, different: 1
+        Command::Diff(args) => diff::run(args, stdout).map(|equal| u8::from(!equal)),
+        Command::Dump(args) => dump::run(args, stdout).map(|()| 0),
     }
 }
 

@@ -67,6 +67,38 @@ fn resolve(p: &Path) -> PathBuf {
     }
 }
 
+/// Refuses outputs that would overwrite the input or one another. `input` is what is read
+/// and what to call it in the message (`"trace being read"`, `"scene"`); `outputs` pairs
+/// each option (`-o`, `--npy`, …) with the path it was given, if any.
+pub fn check_outputs(
+    input: Option<(&str, &Path)>,
+    outputs: &[(&str, Option<&Path>)],
+) -> Result<(), CliError> {
+    let given: Vec<(&str, &Path)> = outputs
+        .iter()
+        .filter_map(|(f, p)| p.map(|p| (*f, p)))
+        .collect();
+    for (i, (flag, path)) in given.iter().enumerate() {
+        if let Some((noun, input)) = input {
+            if same_file(path, input) {
+                return Err(CliError::Usage(format!(
+                    "{flag} {} would overwrite the {noun}",
+                    path.display()
+                )));
+            }
+        }
+        for (other, other_path) in &given[..i] {
+            if same_file(path, other_path) {
+                return Err(CliError::Usage(format!(
+                    "{other} and {flag} both name {}; give each output its own file",
+                    path.display()
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -4,7 +4,8 @@
 //! simulated X-processor array (`cwisim-xproc`), and writes what the array shifted out as
 //! a PNG picture or an exact NumPy array, with per-run statistics in text or JSON.
 //!
-//! * [`cli`] — the `cwisim` command line (`run`, `convert`, `machine`) and
+//! * [`cli`] — the `cwisim` command line (`run`, `render`, `emit`, `convert`, `machine`,
+//!   and the study tools `stats`, `history`, `vcd`, `diff`, `dump`) and
 //!   [`cli::run_cli`], which runs it in-process on any output streams.
 //! * [`commands`] — one module per subcommand.
 //! * [`demo`] — the embedded demo trace `cwisim run` replays when given no file.
@@ -12,6 +13,7 @@
 //! * [`report`] — the human statistics summary and the `--stats-json` document.
 //! * [`files`] — writing outputs all-or-nothing, and telling whether two paths are one file.
 //! * [`progress`] — the progress bar `run` shows on a terminal.
+//! * [`range`] — the one range syntax for `--lines` and `--frames`.
 //! * [`error`] — [`CliError`], every way a command can fail, with its exit code.
 //!
 //! ```no_run
@@ -25,11 +27,14 @@
 
 pub mod cli;
 pub mod commands;
+pub mod cost;
 pub mod demo;
 pub mod error;
 pub mod files;
 pub mod output;
+pub mod plot;
 pub mod progress;
+pub mod range;
 pub mod report;
 
 pub use error::CliError;

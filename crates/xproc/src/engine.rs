@@ -3,6 +3,7 @@
 use crate::fast::FastEngine;
 use crate::machine::{Machine, MachineError};
 use crate::output::{Image, ImageSink, LineSink};
+use crate::probe::Probe;
 use crate::sample::Sample;
 use crate::stats::RunStats;
 use crate::stepped::SteppedEngine;
@@ -66,11 +67,28 @@ pub fn replay<T: Sample>(
     while let Some(instr) = reader.next_instruction()? {
         eng.execute(&instr, sink);
         n += 1;
-        if n % 4096 == 0 {
+        if n.is_multiple_of(4096) {
             progress(reader.bytes_read());
         }
     }
     progress(reader.bytes_read());
+    Ok(eng.finish(sink))
+}
+
+/// Replays a trace on the cycle-stepped engine, reporting to `probe` as it steps
+/// (`cwisim history`, `cwisim vcd`).
+pub fn replay_probed<T: Sample>(
+    reader: &mut dyn TraceRead,
+    machine: &Machine,
+    probe: &mut dyn Probe,
+    sink: &mut dyn LineSink<T>,
+) -> Result<RunStats, ReplayError> {
+    let header = *reader.header();
+    let timeline = machine.timeline(&header)?;
+    let mut eng = Box::new(SteppedEngine::<T>::with_probe(&header, timeline, probe));
+    while let Some(instr) = reader.next_instruction()? {
+        eng.execute(&instr, sink);
+    }
     Ok(eng.finish(sink))
 }
 

@@ -36,13 +36,15 @@ pub mod fast;
 pub mod feed;
 pub mod machine;
 pub mod output;
+pub mod probe;
 pub mod sample;
 pub mod stats;
 pub mod stepped;
 
-pub use engine::{engine, replay, run, Engine, ReplayError, Timing};
+pub use engine::{engine, replay, replay_probed, run, Engine, ReplayError, Timing};
 pub use feed::EngineWriter;
 pub use machine::{Machine, MachineError, Timeline};
 pub use output::{Image, ImageLimit, ImageSink, LineOut, LineSink, NullSink};
+pub use probe::{NoProbe, Probe, ProcessorState};
 pub use sample::Sample;
 pub use stats::{LineStats, OpcodeCounts, RunStats, Totals};

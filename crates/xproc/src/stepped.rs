@@ -10,6 +10,7 @@
 use crate::engine::Engine;
 use crate::machine::Timeline;
 use crate::output::{LineOut, LineSink};
+use crate::probe::{NoProbe, Probe, ProcessorState};
 use crate::sample::{vector, Sample};
 use crate::stats::{Recorder, RunStats};
 use cwisim_isa::{Instruction, Opcode, TraceHeader, MAX_CHANNELS};
@@ -35,6 +36,8 @@ struct Processor<T> {
 /// An instruction travelling along the chain.
 struct Token<T> {
     instr: Instruction,
+    /// Its number in the trace.
+    index: u64,
     /// The scanline it belongs to.
     line: u64,
     /// Running value, first and second difference.
@@ -53,6 +56,7 @@ struct Token<T> {
 /// The instruction on the bus.
 struct Bus {
     instr: Instruction,
+    index: u64,
     line: u64,
     begin: u64,
     /// The cycle its issue is complete.
@@ -60,7 +64,7 @@ struct Bus {
 }
 
 /// The cycle-stepped engine (see the module documentation).
-pub struct SteppedEngine<T: Sample> {
+pub struct SteppedEngine<'p, T: Sample> {
     channels: usize,
     timeline: Timeline,
     recorder: Recorder,
@@ -77,11 +81,22 @@ pub struct SteppedEngine<T: Sample> {
     /// Scanlines that have left the array.
     lines_out: u64,
     last_exit: u64,
+    /// Instructions issued so far.
+    issued: u64,
+    probe: &'p mut dyn Probe,
 }
 
-impl<T: Sample> SteppedEngine<T> {
+impl<T: Sample> SteppedEngine<'static, T> {
     /// An array for `header`'s width and channels, timed by `timeline`.
     pub fn new(header: &TraceHeader, timeline: Timeline) -> Self {
+        // NoProbe has no state; leaking one zero-sized value costs nothing.
+        SteppedEngine::with_probe(header, timeline, Box::leak(Box::new(NoProbe)))
+    }
+}
+
+impl<'p, T: Sample> SteppedEngine<'p, T> {
+    /// An array that reports to `probe` as it steps.
+    pub fn with_probe(header: &TraceHeader, timeline: Timeline, probe: &'p mut dyn Probe) -> Self {
         let w = header.width as usize;
         let blank = Processor {
             acc: [T::ZERO; MAX_CHANNELS],
@@ -103,6 +118,8 @@ impl<T: Sample> SteppedEngine<T> {
             refreshes_issued: 0,
             lines_out: 0,
             last_exit: 0,
+            issued: 0,
+            probe,
         }
     }
 
@@ -126,6 +143,7 @@ impl<T: Sample> SteppedEngine<T> {
         }
         if self.stages[0].is_none() && self.bus.as_ref().is_some_and(|b| b.issued_at <= t) {
             let bus = self.bus.take().expect("checked");
+            self.probe.enter(t, bus.index);
             let cost = bus.issued_at - bus.begin;
             self.recorder
                 .issue(bus.line, bus.instr.op, bus.begin, t, cost);
@@ -139,6 +157,7 @@ impl<T: Sample> SteppedEngine<T> {
                     Vec::new()
                 },
                 instr: bus.instr,
+                index: bus.index,
                 line: bus.line,
                 leave_at: t + self.timeline.hop,
                 updates: 0,
@@ -161,6 +180,7 @@ impl<T: Sample> SteppedEngine<T> {
         self.recorder
             .work(tok.line, tok.updates, tok.dropped, tok.suppressed);
         if tok.instr.op == Opcode::Refresh {
+            self.probe.line_ready(self.t, tok.line);
             self.recorder
                 .ready(tok.line, self.t, self.timeline.deadline(tok.line));
             sink.line(LineOut {
@@ -172,8 +192,40 @@ impl<T: Sample> SteppedEngine<T> {
         }
     }
 
-    /// What the token does in processor `p`.
+    /// What the token does in processor `p`, reported to the probe if it watches `p`.
     fn apply(&mut self, p: usize, tok: &mut Token<T>) {
+        if !self.probe.watches(p) {
+            self.act(p, tok);
+            return;
+        }
+        let before = self.state(p);
+        let updates = tok.updates;
+        self.act(p, tok);
+        let after = self.state(p);
+        let addressed =
+            tok.updates > updates || matches!(tok.instr.op, Opcode::AccMode | Opcode::Refresh);
+        self.probe.visit(
+            self.t, p, tok.index, tok.line, &tok.instr, addressed, &before, &after,
+        );
+    }
+
+    /// Processor `p`'s registers as `f64`.
+    fn state(&self, p: usize) -> ProcessorState {
+        let pr = &self.procs[p];
+        let c = self.channels;
+        let v = |x: &Vector<T>| x[..c].iter().map(|s| s.to_f64()).collect::<Vec<f64>>();
+        ProcessorState {
+            acc: v(&pr.acc),
+            reg: [v(&pr.reg[0]), v(&pr.reg[1]), v(&pr.reg[2])],
+            has: pr.has,
+            locked: pr.locked,
+            masked: pr.masked,
+            negative_enabled: pr.negative_enabled,
+        }
+    }
+
+    /// The token's effect in processor `p`.
+    fn act(&mut self, p: usize, tok: &mut Token<T>) {
         let c = self.channels;
         let i = &tok.instr;
         let (x, dx) = (i.x as usize, i.dx as usize);
@@ -189,7 +241,7 @@ impl<T: Sample> SteppedEngine<T> {
                 }
             }
             Opcode::SetPI | Opcode::SetPdI | Opcode::SetPddI => {
-                if p >= x && (p - x) % dx == 0 {
+                if p >= x && (p - x).is_multiple_of(dx) {
                     let slot = i.op as usize - Opcode::SetPI as usize;
                     pr.reg[slot] = vector(&i.values[slot]);
                     pr.has[slot] = true;
@@ -265,7 +317,7 @@ impl<T: Sample> SteppedEngine<T> {
     }
 }
 
-impl<T: Sample> Engine<T> for SteppedEngine<T> {
+impl<T: Sample> Engine<T> for SteppedEngine<'_, T> {
     fn execute(&mut self, instr: &Instruction, sink: &mut dyn LineSink<T>) {
         let (gate, line) = if instr.op == Opcode::Refresh {
             (
@@ -281,8 +333,10 @@ impl<T: Sample> Engine<T> for SteppedEngine<T> {
             }
             if self.bus.is_none() && self.t >= gate {
                 let cost = self.timeline.issue_cycles(instr);
+                self.probe.issue(self.t, self.issued, line, instr);
                 self.bus = Some(Bus {
                     instr: *instr,
+                    index: self.issued,
                     line,
                     begin: self.t,
                     issued_at: self.t + cost,
@@ -290,6 +344,7 @@ impl<T: Sample> Engine<T> for SteppedEngine<T> {
                 if instr.op == Opcode::Refresh {
                     self.refreshes_issued += 1;
                 }
+                self.issued += 1;
                 return;
             }
             self.next_cycle();

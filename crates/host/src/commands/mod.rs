@@ -1,9 +1,15 @@
 //! The subcommands of `cwisim`, one module each, and the machine options they share.
 
 pub mod convert;
+pub mod diff;
+pub mod dump;
+pub mod history;
 pub mod machine;
 pub mod run;
 pub mod scene;
+pub mod stats;
+pub mod until;
+pub mod vcd;
 
 use crate::error::CliError;
 use crate::output;

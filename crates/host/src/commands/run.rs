@@ -1,9 +1,10 @@
 //! `cwisim run`: replay a trace, write the image and the statistics.
 
 use super::{ImageArgs, MachineArgs};
+use crate::cost::{display_name, CostArgs, CostMap, CostReader};
 use crate::demo;
 use crate::error::CliError;
-use crate::files::{same_file, write_atomic};
+use crate::files::{check_outputs, write_atomic};
 use crate::progress::Progress;
 use crate::report::{timing_name, unrefreshed_warning, write_summary, StatsReport};
 use clap::{Args, ValueEnum};
@@ -42,6 +43,10 @@ pub struct RunArgs {
     /// Image outputs.
     #[command(flatten)]
     pub image: ImageArgs,
+
+    /// Cost outputs: instructions per pixel.
+    #[command(flatten)]
+    pub cost: CostArgs,
 
     /// The machine model.
     #[command(flatten)]
@@ -85,15 +90,35 @@ pub fn run(
     let (mut reader, size) = open_trace(args.trace.as_deref())?;
     let header = *reader.header();
     args.image.check(header.channel_count())?;
+    args.cost.check()?;
+    let mut cost = args
+        .cost
+        .wanted()
+        .then(|| CostMap::new(header.width as usize));
     let replayed = {
         let mut bar = Progress::new(size, progress);
         let want_image = args.image.wanted();
-        replay_file(&mut *reader, &machine, timing, want_image, &mut |bytes| {
+        let mut costed;
+        let reader: &mut dyn TraceRead = match &mut cost {
+            Some(map) => {
+                costed = CostReader::new(&mut *reader, map);
+                &mut costed
+            }
+            None => &mut *reader,
+        };
+        replay_file(reader, &machine, timing, want_image, &mut |bytes| {
             bar.update(bytes)
         })?
     };
     if let Some(image) = &replayed.image {
         args.image.write(image)?;
+    }
+    if let Some(cost) = &cost {
+        let name = match &args.trace {
+            Some(path) => display_name(path),
+            None => "demo trace".to_string(),
+        };
+        args.cost.write(cost, &name)?;
     }
     let stats = &replayed.stats;
     if let Some(path) = &args.stats_json {
@@ -183,34 +208,15 @@ pub fn replay_file(
 
 /// Refuses outputs that would overwrite the trace or each other.
 fn check_paths(args: &RunArgs) -> Result<(), CliError> {
-    let outputs: [(&str, Option<&PathBuf>); 3] = [
-        ("-o", args.image.output.as_ref()),
-        ("--npy", args.image.npy.as_ref()),
-        ("--stats-json", args.stats_json.as_ref()),
-    ];
-    let outputs: Vec<(&str, &Path)> = outputs
-        .iter()
-        .filter_map(|(f, p)| p.map(|p| (*f, p.as_path())))
-        .collect();
-    for (i, (flag, path)) in outputs.iter().enumerate() {
-        if args
-            .trace
-            .as_deref()
-            .is_some_and(|trace| same_file(path, trace))
-        {
-            return Err(CliError::Usage(format!(
-                "{flag} {} would overwrite the trace being read",
-                path.display()
-            )));
-        }
-        for (other, other_path) in &outputs[..i] {
-            if same_file(path, other_path) {
-                return Err(CliError::Usage(format!(
-                    "{other} and {flag} both name {}; give each output its own file",
-                    path.display()
-                )));
-            }
-        }
-    }
-    Ok(())
+    let [cost_image, cost_npy] = args.cost.outputs();
+    check_outputs(
+        args.trace.as_deref().map(|t| ("trace being read", t)),
+        &[
+            ("-o", args.image.output.as_deref()),
+            ("--npy", args.image.npy.as_deref()),
+            ("--stats-json", args.stats_json.as_deref()),
+            (cost_image.0, cost_image.1.map(PathBuf::as_path)),
+            (cost_npy.0, cost_npy.1.map(PathBuf::as_path)),
+        ],
+    )
 }

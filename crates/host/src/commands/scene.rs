@@ -3,12 +3,13 @@
 
 use super::{ImageArgs, MachineArgs};
 use crate::commands::run::TimingArg;
+use crate::cost::{display_name, CostArgs, CostMap, Tee};
 use crate::error::CliError;
-use crate::files::{same_file, write_atomic};
+use crate::files::{check_outputs, same_file, write_atomic};
 use crate::report::{timing_name, write_summary, StatsReport};
 use clap::{Args, ValueEnum};
 use cwisim_isa::{Encoding, TraceWrite};
-use cwisim_xproc::{EngineWriter, ImageSink, Timing};
+use cwisim_xproc::{EngineWriter, ImageSink, LineSink, Machine, RunStats, Timing};
 use cwisim_ypipe::scene::{load_scene, Scene, ScreenScene};
 use cwisim_ypipe::{emit, header, Antialias, EmitStats, Options, Shading};
 use std::io::Write;
@@ -46,7 +47,8 @@ pub struct ScanArgs {
 }
 
 impl ScanArgs {
-    fn options(&self) -> Options {
+    /// The Y-processor's options (the default: Gouraud shading, box filter).
+    pub fn options(&self) -> Options {
         Options {
             shading: match self.shading {
                 ShadingArg::Flat => Shading::Flat,
@@ -83,6 +85,9 @@ pub struct RenderArgs {
     /// Image outputs.
     #[command(flatten)]
     pub image: ImageArgs,
+    /// Cost outputs: instructions per pixel.
+    #[command(flatten)]
+    pub cost: CostArgs,
     /// Also write the emitted trace (.cwt annotated text, .jsonl or .cwb).
     #[arg(long, value_name = "OUT")]
     pub trace: Option<PathBuf>,
@@ -103,9 +108,45 @@ pub struct RenderArgs {
     pub stats_json: Option<PathBuf>,
 }
 
-fn screen(path: &Path) -> Result<ScreenScene, CliError> {
+/// Loads a screen-space scene file (errors are located).
+pub fn load_screen(path: &Path) -> Result<ScreenScene, CliError> {
     let Scene::Screen(s) = load_scene(path)?;
     Ok(s)
+}
+
+/// Scan-converts `scene` straight into the array on `machine`, handing its scanlines to
+/// `sink`, and every instruction also to `also` (after the array took it) when given.
+/// Returns the scan conversion's and the array's statistics.
+pub fn render_scene(
+    scene: &ScreenScene,
+    options: &Options,
+    machine: &Machine,
+    timing: Timing,
+    sink: &mut dyn LineSink<f64>,
+    also: Option<&mut dyn TraceWrite>,
+) -> Result<(EmitStats, RunStats), CliError> {
+    let h = header(scene);
+    let mut array = EngineWriter::<f64>::new(&h, machine, timing, sink)?;
+    let emitted: EmitStats = match also {
+        None => emit(scene, options, &mut array),
+        Some(second) => emit(
+            scene,
+            options,
+            &mut Tee {
+                first: &mut array,
+                second,
+            },
+        ),
+    }
+    .map_err(|e| {
+        CliError::Usage(format!(
+            "the Y-processor emitted an invalid instruction: {e}"
+        ))
+    })?;
+    array
+        .finish()
+        .map_err(|e| CliError::Usage(format!("the array failed: {e}")))?;
+    Ok((emitted, array.into_stats().expect("finished")))
 }
 
 /// The whole trace in one encoding, in memory (written only once complete).
@@ -129,7 +170,7 @@ pub fn run_emit(args: &EmitArgs) -> Result<(), CliError> {
             "the output would overwrite the scene".into(),
         ));
     }
-    let scene = screen(&args.scene)?;
+    let scene = load_screen(&args.scene)?;
     let bytes = encode(&scene, &args.scan.options(), &args.output)?;
     write_atomic(&args.output, |w| {
         w.write_all(&bytes)
@@ -139,23 +180,20 @@ pub fn run_emit(args: &EmitArgs) -> Result<(), CliError> {
 
 /// Runs `cwisim render`.
 pub fn run_render(args: &RenderArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
-    for out in [
-        &args.image.output,
-        &args.image.npy,
-        &args.trace,
-        &args.stats_json,
-    ]
-    .into_iter()
-    .flatten()
-    {
-        if same_file(&args.scene, out) {
-            return Err(CliError::Usage(format!(
-                "{} would overwrite the scene",
-                out.display()
-            )));
-        }
-    }
-    let scene = screen(&args.scene)?;
+    let [cost_image, cost_npy] = args.cost.outputs();
+    check_outputs(
+        Some(("scene", args.scene.as_path())),
+        &[
+            ("-o", args.image.output.as_deref()),
+            ("--npy", args.image.npy.as_deref()),
+            ("--trace", args.trace.as_deref()),
+            ("--stats-json", args.stats_json.as_deref()),
+            (cost_image.0, cost_image.1.map(PathBuf::as_path)),
+            (cost_npy.0, cost_npy.1.map(PathBuf::as_path)),
+        ],
+    )?;
+    args.cost.check()?;
+    let scene = load_screen(&args.scene)?;
     let options = args.scan.options();
     let machine = args.machine.load()?;
     let timing = Timing::from(args.timing);
@@ -170,20 +208,20 @@ pub fn run_render(args: &RenderArgs, stdout: &mut dyn Write) -> Result<(), CliEr
         h.channel_count(),
         ImageSink::DEFAULT_LIMIT_BYTES,
     );
-    let (emitted, stats) = {
-        let mut array = EngineWriter::<f64>::new(&h, &machine, timing, &mut sink)?;
-        let emitted: EmitStats = emit(&scene, &options, &mut array).map_err(|e| {
-            CliError::Usage(format!(
-                "the Y-processor emitted an invalid instruction: {e}"
-            ))
-        })?;
-        array
-            .finish()
-            .map_err(|e| CliError::Usage(format!("the array failed: {e}")))?;
-        (emitted, array.into_stats().expect("finished"))
-    };
+    let mut cost = args.cost.wanted().then(|| CostMap::new(h.width as usize));
+    let (emitted, stats) = render_scene(
+        &scene,
+        &options,
+        &machine,
+        timing,
+        &mut sink,
+        cost.as_mut().map(|c| c as &mut dyn TraceWrite),
+    )?;
     let image = sink.finish()?;
     args.image.write(&image)?;
+    if let Some(cost) = &cost {
+        args.cost.write(cost, &display_name(&args.scene))?;
+    }
     if let (Some(path), Some(bytes)) = (&args.trace, &trace_bytes) {
         write_atomic(path, |w| {
             w.write_all(bytes).map_err(|e| CliError::write(path, e))

@@ -74,3 +74,25 @@ pub fn read_npy(path: impl AsRef<Path>) -> (Vec<u64>, Vec<f64>) {
     let shape = npy.shape().to_vec();
     (shape, npy.into_vec::<f64>().expect("float64 data"))
 }
+
+/// The repository root.
+pub fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// A checked-in example trace, by file name, as a command-line argument.
+pub fn trace(name: &str) -> String {
+    repo()
+        .join("traces")
+        .join(name)
+        .to_string_lossy()
+        .into_owned()
+}
+
+/// The scene of the report's figure 25, as a command-line argument.
+pub fn fig25() -> String {
+    repo()
+        .join("crates/ypipe/tests/fixtures/fig25.json")
+        .to_string_lossy()
+        .into_owned()
+}

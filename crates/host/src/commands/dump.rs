@@ -1,0 +1,98 @@
+//! `cwisim dump`: a trace in the text form, every instruction annotated with its number,
+//! its scanline and the cycles the bus started issuing it and handed it to the array.
+//!
+//! The output is itself a valid `.cwt` trace (annotations are comments), so
+//! `cwisim dump t.cwb > t.cwt` disassembles.
+
+use super::until::UntilLine;
+use super::MachineArgs;
+use crate::error::CliError;
+use crate::range::{parse_range, Range};
+use clap::Args;
+use cwisim_isa::text::{format_header, format_instruction};
+use cwisim_isa::{FileReader, Instruction, TraceRead};
+use cwisim_xproc::{replay_probed, NullSink, Probe};
+use std::collections::VecDeque;
+use std::io::Write;
+use std::path::PathBuf;
+
+/// The arguments of `cwisim dump`.
+#[derive(Args, Clone, Debug, PartialEq)]
+pub struct DumpArgs {
+    /// The trace: .cwt, .jsonl or .cwb.
+    #[arg(value_name = "TRACE")]
+    pub trace: PathBuf,
+    /// Only these scanlines: N, A-B (both included) or A- (to the end).
+    #[arg(long, value_name = "RANGE", value_parser = parse_range)]
+    pub lines: Option<Range>,
+    /// The machine model (for the cycles).
+    #[command(flatten)]
+    pub machine: MachineArgs,
+}
+
+/// Prints each instruction when its token enters the array (the bus hands instructions
+/// over in order, so a queue pairs issue and entry).
+struct Printer<'o> {
+    out: &'o mut dyn Write,
+    lines: Range,
+    pending: VecDeque<(u64, u64, u64, Instruction)>, // (index, line, begin, instruction)
+    current_line: Option<u64>,
+    error: Option<std::io::Error>,
+}
+
+impl Probe for Printer<'_> {
+    fn issue(&mut self, cycle: u64, index: u64, line: u64, instr: &Instruction) {
+        self.pending.push_back((index, line, cycle, *instr));
+    }
+
+    fn enter(&mut self, cycle: u64, index: u64) {
+        let Some((i, line, begin, instr)) = self.pending.pop_front() else {
+            return;
+        };
+        debug_assert_eq!(i, index, "tokens enter in issue order");
+        if self.error.is_some() || !self.lines.contains(line) {
+            return;
+        }
+        let mut write = || -> std::io::Result<()> {
+            if self.current_line != Some(line) {
+                writeln!(self.out, "# --- scanline {line}")?;
+                self.current_line = Some(line);
+            }
+            writeln!(
+                self.out,
+                "{:<48} # #{index} line {line} issue {begin} enter {cycle}",
+                format_instruction(&instr)
+            )
+        };
+        if let Err(e) = write() {
+            self.error = Some(e);
+        }
+    }
+}
+
+/// Runs `cwisim dump`.
+pub fn run(args: &DumpArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
+    let machine = args.machine.load()?;
+    let mut file = FileReader::open(&args.trace)?;
+    let header = *file.header();
+    let lines = args.lines.unwrap_or(Range::ALL);
+    writeln!(stdout, "{}", format_header(&header)).map_err(CliError::Stdout)?;
+    writeln!(
+        stdout,
+        "# cycles of the bus: `issue` = it starts issuing, `enter` = the token enters processor 0"
+    )
+    .map_err(CliError::Stdout)?;
+    let mut printer = Printer {
+        out: stdout,
+        lines,
+        pending: VecDeque::new(),
+        current_line: None,
+        error: None,
+    };
+    let mut reader = UntilLine::new(&mut file, lines.last);
+    replay_probed::<f64>(&mut reader, &machine, &mut printer, &mut NullSink)?;
+    match printer.error {
+        Some(e) => Err(CliError::Stdout(e)),
+        None => Ok(()),
+    }
+}
