@@ -1,6 +1,7 @@
 //! The one range syntax for scanlines and frames, shared by every command that takes one
 //! (`--lines`, `--frames`): `N` (just N), `A-B` (A to B, both included), `A-` (A to the
-//! end). Numbers count from 0.
+//! end). Numbers count from 0; scanlines over the whole trace, frames by the trace
+//! header's lines per frame.
 
 use crate::error::CliError;
 use std::fmt;
@@ -25,6 +26,25 @@ impl Range {
     /// Whether `n` is in the range.
     pub fn contains(&self, n: u64) -> bool {
         n >= self.first && self.last.is_none_or(|l| n <= l)
+    }
+
+    /// The scanlines of these frames, for a trace of `lines_per_frame` scanlines per frame.
+    pub fn frames_to_lines(&self, lines_per_frame: u64) -> Range {
+        Range {
+            first: self.first.saturating_mul(lines_per_frame),
+            last: self
+                .last
+                .map(|l| l.saturating_add(1).saturating_mul(lines_per_frame) - 1),
+        }
+    }
+
+    /// The scanlines `--lines` or `--frames` select (clap keeps them exclusive).
+    pub fn selection(
+        lines: Option<Range>,
+        frames: Option<Range>,
+        lines_per_frame: u64,
+    ) -> Option<Range> {
+        frames.map(|f| f.frames_to_lines(lines_per_frame)).or(lines)
     }
 
     /// Whether every number after `n` is past the range.
@@ -125,5 +145,20 @@ mod tests {
         }
         assert_eq!("3-9".parse::<Range>().unwrap().to_string(), "3-9");
         assert_eq!("5-".parse::<Range>().unwrap().to_string(), "5-");
+        // frames 1-2 of 4-line frames are scanlines 4-11; frame 3- is 12-
+        let f: Range = "1-2".parse().unwrap();
+        assert_eq!(f.frames_to_lines(4).to_string(), "4-11");
+        assert_eq!(
+            "3-".parse::<Range>()
+                .unwrap()
+                .frames_to_lines(4)
+                .to_string(),
+            "12-"
+        );
+        assert_eq!(Range::selection(Some(f), None, 4), Some(f));
+        assert_eq!(
+            Range::selection(None, Some(f), 4).unwrap().to_string(),
+            "4-11"
+        );
     }
 }

@@ -279,6 +279,10 @@ fn lines_selects_exactly_the_range() {
     );
     let run = json(dir.join("run.json"));
     let all = run["stats"]["lines"].as_array().expect("lines");
+    // overrun.cwt has 4 scanlines per frame: --frames 0 is scanlines 0-3
+    let by_frame = cwisim_ok(&dir, &overrun_args(&["--frames", "0"], &t, &m));
+    let by_lines = cwisim_ok(&dir, &overrun_args(&["--lines", "0-3"], &t, &m));
+    assert_eq!(by_frame, by_lines);
     for (range, want) in [("1-2", 1..3), ("3", 3..4), ("2-", 2..4), ("0-9", 0..4)] {
         let out = cwisim_ok(
             &dir,

@@ -57,6 +57,36 @@ fn dump_annotates_every_instruction_and_reads_back_as_the_same_trace() {
     ));
     assert!(part.contains("# --- scanline 2") && part.contains("# --- scanline 3"));
     assert!(!part.contains("line 1 issue"), "{part}");
+    // --frames: overrun.cwt has 4 scanlines per frame, so frame 0 is scanlines 0-3 and
+    // frame 1 does not exist
+    let frame0 = text(&cwisim(
+        &dir,
+        &["dump", overrun.to_str().unwrap(), "--frames", "0"],
+    ));
+    assert_eq!(
+        frame0,
+        text(&cwisim(
+            &dir,
+            &["dump", overrun.to_str().unwrap(), "--lines", "0-3"]
+        ))
+    );
+    let none = text(&cwisim(
+        &dir,
+        &["dump", overrun.to_str().unwrap(), "--frames", "1-"],
+    ));
+    assert!(!none.contains("# ---"), "{none}");
+    let both = cwisim(
+        &dir,
+        &[
+            "dump",
+            overrun.to_str().unwrap(),
+            "--frames",
+            "0",
+            "--lines",
+            "1",
+        ],
+    );
+    assert_eq!(both.status.code(), Some(2));
     let bad = cwisim(&dir, &["dump", overrun.to_str().unwrap(), "--lines", "3-1"]);
     assert_eq!(bad.status.code(), Some(2));
 }

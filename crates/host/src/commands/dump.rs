@@ -25,6 +25,10 @@ pub struct DumpArgs {
     /// Only these scanlines: N, A-B (both included) or A- (to the end).
     #[arg(long, value_name = "RANGE", value_parser = parse_range)]
     pub lines: Option<Range>,
+    /// Only the scanlines of these frames: N, A-B or A- (frames of the trace header's
+    /// lines per frame).
+    #[arg(long, value_name = "RANGE", value_parser = parse_range, conflicts_with = "lines")]
+    pub frames: Option<Range>,
     /// The machine model (for the cycles).
     #[command(flatten)]
     pub machine: MachineArgs,
@@ -75,7 +79,8 @@ pub fn run(args: &DumpArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
     let machine = args.machine.load()?;
     let mut file = FileReader::open(&args.trace)?;
     let header = *file.header();
-    let lines = args.lines.unwrap_or(Range::ALL);
+    let lines =
+        Range::selection(args.lines, args.frames, u64::from(header.lines)).unwrap_or(Range::ALL);
     writeln!(stdout, "{}", format_header(&header)).map_err(CliError::Stdout)?;
     writeln!(
         stdout,

@@ -32,6 +32,10 @@ pub struct StatsArgs {
     /// Only these scanlines (counted over the whole trace, from 0): N, A-B or A-.
     #[arg(long, value_name = "RANGE", value_parser = parse_range)]
     pub lines: Option<Range>,
+    /// Only the scanlines of these frames: N, A-B or A- (frames of the trace header's
+    /// lines per frame).
+    #[arg(long, value_name = "RANGE", value_parser = parse_range, conflicts_with = "lines")]
+    pub frames: Option<Range>,
 
     /// Draw the bus cycles per scanline (a PNG): one bar per scanline stacked by opcode
     /// group and stall cycles, the line period as a horizontal line, a red marker on
@@ -190,21 +194,26 @@ pub fn run(
         }
     };
     let timeline = machine.timeline(&header)?;
-    let range = args.lines.unwrap_or(Range::ALL);
+    let chosen = Range::selection(args.lines, args.frames, u64::from(header.lines));
+    let range = chosen.unwrap_or(Range::ALL);
     let lines: Vec<LineStats> = stats
         .lines
         .iter()
         .filter(|l| range.contains(l.line))
         .cloned()
         .collect();
-    if lines.is_empty() && args.lines.is_some() {
+    if lines.is_empty() && chosen.is_some() {
         let have = match stats.lines.len() {
             0 => "the run output no scanline".to_string(),
             1 => "the run output 1 scanline (0)".to_string(),
             n => format!("the run output {n} scanlines (0-{})", n - 1),
         };
         return Err(CliError::Usage(format!(
-            "--lines {range} selects no scanline: {have}"
+            "{} selects no scanline: {have}",
+            match args.frames {
+                Some(f) => format!("--frames {f}"),
+                None => format!("--lines {range}"),
+            }
         )));
     }
     let name = display_name(&args.input);
@@ -238,7 +247,7 @@ pub fn run(
             line_period: stats.line_period,
             traversal_cycles: stats.traversal_cycles,
             issue_cycles: OpcodeCounts(cost),
-            range: args.lines.map(|r| r.to_string()),
+            range: chosen.map(|r| r.to_string()),
             selected: selected.clone(),
             totals: &stats.totals,
             lines: &lines,
