@@ -3,7 +3,6 @@
 //! end). Numbers count from 0; scanlines over the whole trace, frames by the trace
 //! header's lines per frame.
 
-use crate::error::CliError;
 use std::fmt;
 use std::str::FromStr;
 
@@ -45,11 +44,6 @@ impl Range {
         lines_per_frame: u64,
     ) -> Option<Range> {
         frames.map(|f| f.frames_to_lines(lines_per_frame)).or(lines)
-    }
-
-    /// Whether every number after `n` is past the range.
-    pub fn ends_before(&self, n: u64) -> bool {
-        self.last.is_some_and(|l| n > l)
     }
 }
 
@@ -103,12 +97,6 @@ pub fn parse_range(s: &str) -> Result<Range, String> {
     s.parse()
 }
 
-impl From<String> for CliError {
-    fn from(message: String) -> Self {
-        CliError::Usage(message)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -138,7 +126,6 @@ mod tests {
         );
         let r: Range = "3-9".parse().unwrap();
         assert!(r.contains(3) && r.contains(9) && !r.contains(10) && !r.contains(2));
-        assert!(r.ends_before(10) && !r.ends_before(9));
         assert!(Range::ALL.contains(u64::MAX));
         for s in ["", "-3", "a-b", "9-3", "1-2-3", " 4"] {
             assert!(s.parse::<Range>().is_err(), "{s:?}");

@@ -35,11 +35,6 @@ impl<'a, T: Sample> EngineWriter<'a, T> {
     }
 
     /// The statistics, after [`TraceWrite::finish`].
-    pub fn stats(&self) -> Option<&RunStats> {
-        self.stats.as_ref()
-    }
-
-    /// The statistics, after [`TraceWrite::finish`].
     pub fn into_stats(self) -> Option<RunStats> {
         self.stats
     }

@@ -307,26 +307,34 @@ pub fn csv(lines: &[LineStats]) -> String {
     let mut out = csv_header();
     out.push('\n');
     for l in lines {
-        let mut row: Vec<String> = vec![
-            l.line.to_string(),
-            l.frame.to_string(),
-            l.row.to_string(),
-            l.instructions.to_string(),
-        ];
-        row.extend(l.opcodes.0.iter().map(u64::to_string));
-        row.extend([
-            l.busy_cycles.to_string(),
-            l.stall_cycles.to_string(),
-            l.processor_updates.to_string(),
-            l.ready.to_string(),
-            l.deadline.to_string(),
-            l.slack.to_string(),
-            u8::from(l.slack < 0).to_string(),
-        ]);
+        let mut row = columns(l, Opcode::ALL);
+        row.push(u8::from(l.slack < 0).to_string());
         out.push_str(&row.join(","));
         out.push('\n');
     }
     out
+}
+
+/// One scanline's values in the column order of the table and the CSV (before the CSV's
+/// `late`): line, frame, row, instructions, `ops`' counts, busy, stall, updates, ready,
+/// deadline, slack.
+fn columns(l: &LineStats, ops: &[Opcode]) -> Vec<String> {
+    let mut r = vec![
+        l.line.to_string(),
+        l.frame.to_string(),
+        l.row.to_string(),
+        l.instructions.to_string(),
+    ];
+    r.extend(ops.iter().map(|op| l.opcodes.get(*op).to_string()));
+    r.extend([
+        l.busy_cycles.to_string(),
+        l.stall_cycles.to_string(),
+        l.processor_updates.to_string(),
+        l.ready.to_string(),
+        l.deadline.to_string(),
+        l.slack.to_string(),
+    ]);
+    r
 }
 
 /// The printed table: a comment line naming the input and the machine's line period, a
@@ -352,22 +360,7 @@ pub fn table(
     let mut rows: Vec<Vec<String>> = Vec::with_capacity(lines.len() + 2);
     rows.push(head);
     for l in lines {
-        let mut r = vec![
-            l.line.to_string(),
-            l.frame.to_string(),
-            l.row.to_string(),
-            l.instructions.to_string(),
-        ];
-        r.extend(ops.iter().map(|op| l.opcodes.get(*op).to_string()));
-        r.extend([
-            l.busy_cycles.to_string(),
-            l.stall_cycles.to_string(),
-            l.processor_updates.to_string(),
-            l.ready.to_string(),
-            l.deadline.to_string(),
-            l.slack.to_string(),
-        ]);
-        rows.push(r);
+        rows.push(columns(l, &ops));
     }
     let mut total = vec![
         "total".to_string(),
