@@ -7,7 +7,7 @@ use crate::commands::convert::ConvertArgs;
 use crate::commands::machine::MachineCmdArgs;
 use crate::commands::run::RunArgs;
 use crate::commands::scene::{EmitArgs, RenderArgs};
-use crate::commands::{convert, diff, dump, history, machine, run, scene, stats, vcd};
+use crate::commands::{convert, diff, dump, history, machine, run, scene, scenes, stats, vcd};
 use crate::error::CliError;
 use clap::{Parser, Subcommand};
 use std::ffi::OsString;
@@ -64,33 +64,59 @@ Example:\n  cwisim run scene.cwt -o scene.png --npy scene.npy --set clock_hz=2e8
     )]
     Run(RunArgs),
 
-    /// Render a screen-space scene: Y-processor, trace, X-processor array, image
+    /// Render a scene end to end: host, Y-processor, X-processor array, image and summary
     #[command(
-        long_about = "Render a screen-space scene (JSON, \"kind\": \"screen\"; see docs/SCENES.md): the \
-Y-processor splits its polygons into trapezia and emits the scanline instructions (box-filter \
-coverage with van Rij's twelve DO_FILL cases, or point sampling; flat or Gouraud), and the \
-X-processor array executes them. -o writes a PNG ([0, 1] clamped to 8 bits), --npy the exact \
-values (float64, shape (height, width, channels)), --trace the instruction stream (a .cwt \
-trace is annotated with the DO_FILL case of every trapezium row).\n\n\
-Example:\n  cwisim render scene.json -o scene.png --trace scene.cwt --stats",
+        long_about = "Render a scene end to end and print a summary. SCENE is a JSON file (\"kind\": \"world\": \
+meshes, camera, lights and materials in 3D; or \"kind\": \"screen\": polygons in pixels; see \
+docs/SCENES.md) or the name of an embedded scene (`cwisim scenes` lists them); without SCENE \
+the embedded pot is drawn.\n\n\
+A world scene is projected, lit by the report's formula (per vertex for Gouraud shading, \
+per face for flat) with back faces culled, and its hidden surfaces removed: \
+--visibility exact cuts every triangle down to its visible fragments in object space (then \
+every pixel holds the exact box-filtered coverage); --visibility eval0 sends whole \
+triangles front to back and lets the array's Eval0 claim the pixels a nearer triangle fully \
+covers (the hardware's way; edge pixels are approximate, see docs/VISIBILITY.md). The \
+Y-processor splits the polygons into trapezia and emits the scanline instructions \
+(box-filter coverage with van Rij's twelve DO_FILL cases, or point sampling; flat or \
+Gouraud), and the X-processor array executes them on the machine model.\n\n\
+The summary gives the polygons and trapezia, the instructions by opcode, the cycles per \
+frame, the worst scanline against the display's line period, and the wall time of every \
+stage. -o writes a PNG ([0, 1] clamped to 8 bits; the default, SCENE-NAME.png, when no other \
+output is asked for), --npy the exact values (float64, shape (height, width, channels)), \
+--trace the instruction stream (a .cwt trace is annotated with the DO_FILL case of every \
+trapezium row). A progress bar shows on a terminal when a render takes over a second.\n\n\
+Examples:\n  cwisim render\n  cwisim render still-life --size 960x640 -o still-life.png\n  \
+cwisim render pot --visibility eval0 --shading flat --stats\n  cwisim render scene.json \
+--trace scene.cwt --npy scene.npy",
         after_help = AFTER_HELP
     )]
     Render(RenderArgs),
 
-    /// Scan-convert a screen-space scene into a trace file
+    /// Scan-convert a scene into a trace file
     #[command(
-        long_about = "Scan-convert a screen-space scene into a trace of X-processor instructions, \
-without executing it. The encoding is chosen by OUT's extension: .cwt (text, with a comment \
-naming the DO_FILL case and stretches of every trapezium row), .jsonl or .cwb.\n\n\
-Example:\n  cwisim emit scene.json -o scene.cwt --shading flat --aa box",
+        long_about = "Scan-convert a scene (a file or an embedded name; world scenes are projected, lit \
+and their hidden surfaces removed first, as by `render`) into a trace of X-processor \
+instructions, without executing it. The encoding is chosen by OUT's extension: .cwt (text, \
+with a comment naming the DO_FILL case and stretches of every trapezium row), .jsonl or \
+.cwb.\n\n\
+Example:\n  cwisim emit fig25 -o fig25.cwt --shading flat --aa box",
         after_help = AFTER_HELP
     )]
     Emit(EmitArgs),
 
+    /// List the embedded scenes, or print one as JSON
+    #[command(
+        long_about = "List the scenes built into cwisim, with what each shows; with NAME, print that \
+scene's JSON file, to copy and edit.\n\n\
+Example:\n  cwisim scenes\n  cwisim scenes pot > my-pot.json",
+        after_help = AFTER_HELP
+    )]
+    Scenes(scenes::ScenesArgs),
+
     /// Per-scanline statistics of a trace or scene: table, plot, CSV, JSON
     #[command(
         long_about = "Per-scanline statistics of a trace (.cwt, .jsonl, .cwb, replayed as by `run`), or of \
-a screen scene (.json, rendered first as by `render`: Gouraud, box filter): instructions by \
+a scene file (.json, rendered first as by `render`: Gouraud, box filter, exact visibility): instructions by \
 opcode, bus (busy) and stall cycles, processor updates, and when each scanline was ready \
 against the display's deadline; negative slack is an overrun, marked LATE. Prints the table \
 (a column per opcode that occurs) and a totals line for the selected scanlines.\n\n\
@@ -241,7 +267,8 @@ fn dispatch(
         Command::Run(args) => run::run(args, stdout, stderr, progress).map(|()| 0),
         Command::Convert(args) => convert::run(args).map(|_| 0),
         Command::Machine(args) => machine::run(args, stdout, stderr).map(|()| 0),
-        Command::Render(args) => scene::run_render(args, stdout).map(|()| 0),
+        Command::Render(args) => scene::run_render(args, stdout, progress).map(|()| 0),
+        Command::Scenes(args) => scenes::run(args, stdout).map(|()| 0),
         Command::Emit(args) => scene::run_emit(args).map(|()| 0),
         Command::Stats(args) => stats::run(args, stdout, stderr).map(|()| 0),
         Command::History(args) => history::run(args, stdout).map(|()| 0),

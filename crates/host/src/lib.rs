@@ -1,18 +1,22 @@
 //! # cwisim-host — the `cwisim` command-line tool
 //!
-//! The host side of the simulator: it reads trace files (`cwisim-isa`), replays them on the
-//! simulated X-processor array (`cwisim-xproc`), and writes what the array shifted out as
-//! a PNG picture or an exact NumPy array, with per-run statistics in text or JSON.
+//! The host side of the simulator: it renders scenes (`cwisim-world`, `cwisim-ypipe`),
+//! reads trace files (`cwisim-isa`), replays them on the simulated X-processor array
+//! (`cwisim-xproc`), and writes what the array shifted out as a PNG picture or an exact
+//! NumPy array, with per-run statistics in text or JSON.
 //!
-//! * [`cli`] — the `cwisim` command line (`run`, `render`, `emit`, `convert`, `machine`,
-//!   and the study tools `stats`, `history`, `vcd`, `diff`, `dump`) and
+//! * [`cli`] — the `cwisim` command line (`run`, `render`, `emit`, `scenes`, `convert`,
+//!   `machine`, and the study tools `stats`, `history`, `vcd`, `diff`, `dump`) and
 //!   [`cli::run_cli`], which runs it in-process on any output streams.
+//! * [`prepare`] — from a SCENE argument (a file or an embedded name) to the polygons the
+//!   Y-processor takes, through `cwisim-world` for 3D scenes.
+//! * [`summary`] — what `cwisim render` prints: every stage's figures and wall time.
 //! * [`commands`] — one module per subcommand.
 //! * [`demo`] — the embedded demo trace `cwisim run` replays when given no file.
 //! * [`output`] — NumPy `.npy` and PNG encoding of an [`Image`](cwisim_xproc::Image).
 //! * [`report`] — the human statistics summary and the `--stats-json` document.
 //! * [`files`] — writing outputs all-or-nothing, and telling whether two paths are one file.
-//! * [`progress`] — the progress bar `run` shows on a terminal.
+//! * [`progress`] — the progress bars `run` and `render` show on a terminal.
 //! * [`range`] — the one range syntax for `--lines` and `--frames`.
 //! * [`error`] — [`CliError`], every way a command can fail, with its exit code.
 //!
@@ -33,8 +37,10 @@ pub mod error;
 pub mod files;
 pub mod output;
 pub mod plot;
+pub mod prepare;
 pub mod progress;
 pub mod range;
 pub mod report;
+pub mod summary;
 
 pub use error::CliError;

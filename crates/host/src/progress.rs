@@ -1,4 +1,5 @@
-//! The progress bar of `cwisim run`: bytes of the trace read so far, on standard error.
+//! The progress bars of `cwisim run` (bytes of the trace read so far) and `cwisim render`
+//! (scanlines done), on standard error.
 //!
 //! It stays hidden for the first second (short runs never flash a bar) and whenever
 //! standard error is not a terminal (pipes, files, tests), so it never pollutes captured
@@ -11,7 +12,7 @@ use std::time::{Duration, Instant};
 /// How long a run goes before its bar appears.
 pub const SHOW_AFTER: Duration = Duration::from_secs(1);
 
-/// A progress bar over the bytes of one trace file.
+/// A progress bar over the bytes of one trace file, or the scanlines of one render.
 pub struct Progress {
     bar: ProgressBar,
     start: Instant,
@@ -24,11 +25,26 @@ impl Progress {
     /// A bar over `total_bytes` (0 if unknown), drawn only if `enabled` and standard error
     /// is a terminal, and not before [`SHOW_AFTER`].
     pub fn new(total_bytes: u64, enabled: bool) -> Self {
-        let len = (total_bytes > 0).then_some(total_bytes);
-        let bar = ProgressBar::with_draw_target(len, ProgressDrawTarget::hidden());
-        if let Ok(style) = ProgressStyle::with_template(
+        Self::with_template(
+            total_bytes,
+            enabled,
             "{spinner} replaying [{wide_bar}] {bytes}/{total_bytes} ({eta} left)",
-        ) {
+        )
+    }
+
+    /// A bar over the `total` scanlines of a render (`cwisim render`), with the same rules.
+    pub fn scanlines(total: u64, enabled: bool) -> Self {
+        Self::with_template(
+            total,
+            enabled,
+            "{spinner} rendering [{wide_bar}] {pos}/{len} scanlines ({eta} left)",
+        )
+    }
+
+    fn with_template(total: u64, enabled: bool, template: &str) -> Self {
+        let len = (total > 0).then_some(total);
+        let bar = ProgressBar::with_draw_target(len, ProgressDrawTarget::hidden());
+        if let Ok(style) = ProgressStyle::with_template(template) {
             bar.set_style(style.progress_chars("=> "));
         }
         Progress {
@@ -39,9 +55,9 @@ impl Progress {
         }
     }
 
-    /// `bytes` of the trace have been read.
-    pub fn update(&mut self, bytes: u64) {
-        self.bar.set_position(bytes);
+    /// `done` bytes (or scanlines) so far.
+    pub fn update(&mut self, done: u64) {
+        self.bar.set_position(done);
         if self.enabled && !self.shown && self.start.elapsed() >= SHOW_AFTER {
             self.shown = true;
             self.bar.set_draw_target(ProgressDrawTarget::stderr());

@@ -128,13 +128,26 @@ fn annotated_text_names_the_cases() {
 #[test]
 fn bad_scenes_exit_2_with_a_located_message() {
     let dir = scratch("bad_scenes_exit_2");
-    let cases: [(&str, &str, &str); 6] = [
+    let cases: [(&str, &str, &str); 9] = [
         (
             "two.json",
             r#"{"kind":"screen","width":8,"height":4,"channels":1,"polygons":[{"vertices":[[0,0],[4,0]],"intensity":[[1],[1]]}]}"#,
             "at least 3",
         ),
-        ("kind.json", r#"{"kind":"world"}"#, "expected \"screen\""),
+        ("kind.json", r#"{"kind":"solid"}"#, "expected \"screen\" or \"world\""),
+        ("world.json", r#"{"kind":"world"}"#, "missing field `width`"),
+        (
+            "inside.json",
+            r#"{"kind":"world","width":8,"height":4,"channels":1,"camera":{"eye":[0,0,0],"target":[0,0,-1],"fov_y":60},"ambient":1,
+"meshes":[{"material":{"k_a":1,"k_d":0,"k_s":0,"n":1},"vertices":[[-1,-1,-1],[1,-1,-1],[0,1,1]],"faces":[[0,1,2]]}]}"#,
+            "inside.json:2:11: meshes[0]: vertex 2 of mesh \"mesh 0\" at [0, 1, 1] is behind the camera",
+        ),
+        (
+            "degenerate.json",
+            r#"{"kind":"world","width":8,"height":4,"channels":1,"camera":{"eye":[0,0,5],"target":[0,0,0],"fov_y":60},"ambient":1,
+"meshes":[{"material":{"k_a":1,"k_d":0,"k_s":0,"n":1},"vertices":[[0,0,0],[1,1,0],[2,2,0]],"faces":[[0,1,2]]}]}"#,
+            "meshes[0].faces[0]: degenerate face",
+        ),
         (
             "nan.json",
             r#"{"kind":"screen","width":8,"height":4,"channels":1,"polygons":[{"vertices":[[0,0],[4,0],[1e999,3]],"intensity":[[1],[1],[1]]}]}"#,

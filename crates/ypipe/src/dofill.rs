@@ -14,9 +14,15 @@
 //! `S` the coverage increment (`1/|1/slope|`: docs/ERRATA.md). With flat shading (`di = 0`)
 //! the same stretches need one order less: `Eval1` for the middle part and `Eval2` for
 //! sequences.
+//!
+//! With [`Claim::Eval0`] the stretches whose pixels are all fully covered (a middle part
+//! or a separately calculated pixel of coverage exactly 1) are claimed with `Eval0`
+//! instead, and so is the whole span of a point-sampled row: one `Eval0` when the row is
+//! flat, else a staircase of `Eval0`s ([`claim_chunk`], docs/ERRATA.md, D9).
 
 use crate::coverage::{Case, Slice};
 use crate::trapezoid::{vector, Trapezium, Vector};
+use crate::Claim;
 use cwisim_isa::{Instruction, Intensity};
 use std::fmt::Write as _;
 
@@ -40,6 +46,8 @@ pub enum Procedure {
     Sequence,
     /// Inside both edges' spans.
     ShareSequence,
+    /// Fully covered pixels claimed with `Eval0` ([`Claim::Eval0`]).
+    Claim,
 }
 
 impl Procedure {
@@ -49,6 +57,7 @@ impl Procedure {
             Procedure::MiddlePart => "middle",
             Procedure::Sequence => "sequence",
             Procedure::ShareSequence => "share-sequence",
+            Procedure::Claim => "claim",
         }
     }
 }
@@ -112,6 +121,68 @@ impl RowShade {
     }
 }
 
+/// The number of pixels per `Eval0` when a run whose Gouraud intensity changes by `di`
+/// (per channel) per pixel is claimed as a staircase: the largest `k ≥ 1` with
+/// `max_c |di[c]| · (k − 1) / 2 ≤ tolerance`, at most `n`. Each `Eval0` holds the value
+/// at the middle of its `k` pixels, so no pixel centre is further than `(k − 1) / 2`
+/// pixels from it. A run with `di = 0` (or a tolerance no run length reaches) is one
+/// `Eval0`; a negative or NaN tolerance admits only `k = 1`.
+pub fn claim_chunk(di: &[f64], tolerance: f64, n: u32) -> u32 {
+    let n = n.max(1);
+    let m = di.iter().fold(0.0f64, |m, d| m.max(d.abs()));
+    if m == 0.0 {
+        return n;
+    }
+    if tolerance.is_nan() || tolerance < 0.0 {
+        return 1;
+    }
+    let fits = |k: u32| m * f64::from(k - 1) / 2.0 <= tolerance;
+    if n == 1 || fits(n) {
+        return n; // a huge tolerance, or a gentle gradient: the whole run
+    }
+    // 2·tolerance/m, which may overflow (the cast saturates), capped at the run; then
+    // correct the rounding of the division against the defining inequality
+    let q = (2.0 * tolerance / m).floor() as u32;
+    let mut k = q.min(n - 1) + 1;
+    while k > 1 && !fits(k) {
+        k -= 1;
+    }
+    while k < n && fits(k + 1) {
+        k += 1;
+    }
+    k
+}
+
+/// The `Eval0`s that claim pixels `first ..= last` of a row: one when the row is flat,
+/// else a staircase of [`claim_chunk`] pixels each, holding the Gouraud value at the
+/// chunk's centre (the mean of its first and last pixel-centre values).
+fn claim_run(rs: &RowShade, first: i64, last: i64, tolerance: f64) -> Vec<Instruction> {
+    let ch = rs.channels;
+    let n = (last - first + 1) as u32;
+    if rs.flat() {
+        return vec![Instruction::eval0(
+            first as u32,
+            n,
+            intensity(&rs.at(first), ch),
+        )];
+    }
+    let k = i64::from(claim_chunk(&rs.di[..ch], tolerance, n));
+    let mut out = Vec::new();
+    let mut a = first;
+    while a <= last {
+        let b = (a + k - 1).min(last);
+        let (va, vb) = (rs.at(a), rs.at(b));
+        let centre = vector(ch, |c| 0.5 * (va[c] + vb[c]));
+        out.push(Instruction::eval0(
+            a as u32,
+            (b - a + 1) as u32,
+            intensity(&centre, ch),
+        ));
+        a = b + 1;
+    }
+    out
+}
+
 fn intensity(v: &Vector, channels: usize) -> Intensity {
     Intensity::new(&v[..channels])
 }
@@ -120,13 +191,15 @@ fn map(v: &Vector, channels: usize, f: impl Fn(f64, usize) -> f64) -> Intensity 
     intensity(&vector(channels, |c| f(v[c], c)), channels)
 }
 
-/// Box-filtered fill of `t` in pixel row `row` of an image `width` wide.
+/// Box-filtered fill of `t` in pixel row `row` of an image `width` wide. With
+/// [`Claim::Eval0`], the stretches of coverage exactly 1 are claimed with `Eval0`.
 pub fn box_row(
     t: &Trapezium,
     row: u32,
     width: u32,
     shade: &Shade,
     channels: usize,
+    claim: Claim,
 ) -> Option<RowFill> {
     let s = Slice::of(t, row)?;
     let h = s.height();
@@ -176,6 +249,13 @@ pub fn box_row(
         if proc_ == Procedure::Single && ac == 0.0 {
             continue; // the edge only touches this pixel's border
         }
+        if let Claim::Eval0 { tolerance } = claim {
+            let full = matches!(proc_, Procedure::Single | Procedure::MiddlePart) && ac == 1.0;
+            if full {
+                push_claim(&mut fill, &rs, first, last, tolerance);
+                continue;
+            }
+        }
         let n = (last - first + 1) as u32;
         let x = first as u32;
         let fpi = rs.at(first);
@@ -219,15 +299,30 @@ pub fn box_row(
     Some(fill)
 }
 
+/// Claims pixels `first ..= last` into `fill`, with its note (` claim 3..=9 (2 Eval0)`).
+fn push_claim(fill: &mut RowFill, rs: &RowShade, first: i64, last: i64, tolerance: f64) {
+    let run = claim_run(rs, first, last, tolerance);
+    if first == last {
+        let _ = write!(fill.note, " claim {first}");
+    } else {
+        let _ = write!(fill.note, " claim {first}..={last}");
+    }
+    let _ = write!(fill.note, " ({} Eval0)", run.len());
+    fill.instructions
+        .extend(run.into_iter().map(|i| (Procedure::Claim, i)));
+}
+
 /// Point-sampled fill (no anti-aliasing) of `t` in pixel row `row`: the pixels whose
 /// centre lies in the trapezium (half-open: `[x_left, x_right)` at `y = row + 0.5`, and
 /// `y_top <= y < y_bot`), one `Eval1` (flat) or `Eval2` (Gouraud) — sections 3.1 and 3.2.
+/// With [`Claim::Eval0`] the polygon owns the whole span, which is claimed with `Eval0`.
 pub fn sampled_row(
     t: &Trapezium,
     row: u32,
     width: u32,
     shade: &Shade,
     channels: usize,
+    claim: Claim,
 ) -> Option<RowFill> {
     let y = f64::from(row) + 0.5;
     if !(t.y_top <= y && y < t.y_bot) {
@@ -240,6 +335,18 @@ pub fn sampled_row(
         return None;
     }
     let rs = RowShade::new(t, shade, y, channels);
+    if let Claim::Eval0 { tolerance } = claim {
+        let mut fill = RowFill {
+            case: None,
+            instructions: Vec::new(),
+            note: format!(
+                "row {row} trapezium {} (polygon {}): point-sampled",
+                t.id, t.polygon
+            ),
+        };
+        push_claim(&mut fill, &rs, first, end - 1, tolerance);
+        return Some(fill);
+    }
     let (x, n) = (first as u32, (end - first) as u32);
     let fpi = rs.at(first);
     let instr = if rs.flat() {
@@ -257,4 +364,160 @@ pub fn sampled_row(
             end - 1
         ),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use cwisim_isa::{Opcode, MAX_CHANNELS};
+
+    fn shade(x_left: f64, i_left: &[f64], di: &[f64]) -> RowShade {
+        let mut rs = RowShade {
+            x_left,
+            i_left: [0.0; MAX_CHANNELS],
+            di: [0.0; MAX_CHANNELS],
+            channels: i_left.len(),
+        };
+        rs.i_left[..i_left.len()].copy_from_slice(i_left);
+        rs.di[..di.len()].copy_from_slice(di);
+        rs
+    }
+
+    /// The definition, by search: the largest `k` in `1..=n` with `m·(k−1)/2 ≤ tolerance`.
+    fn chunk_by_search(di: &[f64], tolerance: f64, n: u32) -> u32 {
+        let m = di.iter().fold(0.0f64, |m, d| m.max(d.abs()));
+        (1..=n)
+            .rev()
+            .find(|&k| k == 1 || m * f64::from(k - 1) / 2.0 <= tolerance)
+            .unwrap()
+    }
+
+    #[test]
+    fn claim_chunk_is_the_largest_k_within_the_tolerance() {
+        // m·(k−1)/2 ≤ 1/512 with m = 1/256: k − 1 ≤ 1
+        assert_eq!(claim_chunk(&[1.0 / 256.0], 1.0 / 512.0, 100), 2);
+        assert_eq!(claim_chunk(&[-1.0 / 256.0], 1.0 / 512.0, 100), 2);
+        // the largest |di| of the channels decides: 0.004·(k−1)/2 ≤ 0.01 gives k = 6
+        assert_eq!(claim_chunk(&[0.001, -0.004, 0.0], 0.01, 100), 6);
+        assert_eq!(claim_chunk(&[0.001, -0.004, 0.0], 0.01, 4), 4); // capped at the run
+        assert_eq!(claim_chunk(&[0.01], 1.0 / 512.0, 100), 1);
+        // tolerance 0: one pixel per Eval0, unless the run is flat
+        assert_eq!(claim_chunk(&[1e-300], 0.0, 100), 1);
+        assert_eq!(claim_chunk(&[0.0, 0.0], 0.0, 100), 100);
+        // huge tolerances and tiny gradients overflow 2·tolerance/|di|: the whole run
+        assert_eq!(claim_chunk(&[1e-300], 1e9, 4096), 4096);
+        assert_eq!(claim_chunk(&[1e-300], f64::MAX, 4096), 4096);
+        assert_eq!(claim_chunk(&[0.5], f64::INFINITY, 7), 7);
+        assert_eq!(claim_chunk(&[0.5], 1e9, 7), 7);
+        // nonsense tolerances admit only k = 1
+        assert_eq!(claim_chunk(&[0.5], f64::NAN, 7), 1);
+        assert_eq!(claim_chunk(&[0.5], -1.0, 7), 1);
+        assert_eq!(claim_chunk(&[0.5], 0.25, 1), 1);
+        // against the definition, over a spread of gradients, tolerances and runs
+        let mut seed = 0x9E37_79B9_7F4A_7C15u64;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..20_000 {
+            let di = [(next() - 0.5) * 10f64.powf(-6.0 * next()), next() * 1e-3];
+            let tolerance =
+                [0.0, 1.0 / 512.0, next() * 0.05, 1.0 / 4096.0][(next() * 4.0) as usize];
+            let n = 1 + (next() * 300.0) as u32;
+            assert_eq!(
+                claim_chunk(&di, tolerance, n),
+                chunk_by_search(&di, tolerance, n),
+                "di {di:?}, tolerance {tolerance}, n {n}"
+            );
+        }
+    }
+
+    /// The staircase, pixel by pixel: which Eval0 holds each pixel of `first..=last`.
+    fn staircase(run: &[Instruction], first: i64, last: i64) -> Vec<Vec<f64>> {
+        let mut values = Vec::new();
+        let mut next = first;
+        for i in run {
+            assert_eq!(i.op, Opcode::Eval0);
+            assert_eq!(i64::from(i.x), next, "the Eval0s tile the run in order");
+            assert!(i.dx >= 1);
+            for _ in 0..i.dx {
+                values.push(i.i().as_slice().to_vec());
+            }
+            next += i64::from(i.dx);
+        }
+        assert_eq!(next, last + 1, "the Eval0s cover the whole run");
+        values
+    }
+
+    #[test]
+    fn the_staircase_stays_within_the_tolerance_at_every_pixel_centre() {
+        let rows = [
+            shade(2.3, &[0.25], &[0.011]),
+            shade(-7.9, &[0.9, 0.1, 0.5], &[-0.0037, 0.0052, 0.0]),
+            shade(100.0, &[0.5], &[1.0 / 4096.0]),
+            shade(0.5, &[1.0, 0.0], &[-0.2, 0.2]),
+        ];
+        for rs in &rows {
+            for tolerance in [0.0, 1.0 / 4096.0, 1.0 / 512.0, 0.01, 0.1, 1e9] {
+                for (first, last) in [(3, 3), (3, 4), (0, 63), (17, 211)] {
+                    let run = claim_run(rs, first, last, tolerance);
+                    let values = staircase(&run, first, last);
+                    let n = (last - first + 1) as u32;
+                    let k = claim_chunk(&rs.di[..rs.channels], tolerance, n);
+                    assert_eq!(run.len() as u32, n.div_ceil(k), "Eval0s of {k} pixels");
+                    for (j, v) in values.iter().enumerate() {
+                        let want = rs.at(first + j as i64);
+                        for c in 0..rs.channels {
+                            let err = (v[c] - want[c]).abs();
+                            assert!(
+                                err <= tolerance + 1e-12,
+                                "pixel {}: {} vs Gouraud {} (tolerance {tolerance})",
+                                first + j as i64,
+                                v[c],
+                                want[c]
+                            );
+                        }
+                    }
+                    if tolerance == 0.0 {
+                        assert_eq!(run.len() as u32, n, "one Eval0 per pixel");
+                        for (j, v) in values.iter().enumerate() {
+                            assert_eq!(v[..], rs.at(first + j as i64)[..rs.channels]);
+                        }
+                    }
+                    if tolerance == 1e9 {
+                        assert_eq!(run.len(), 1, "a huge tolerance claims the run at once");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn each_step_holds_the_value_at_its_centre() {
+        // di = 0.01, tolerance 0.02: k = 5, so the steps hold the values at 2, 7, 12
+        let rs = shade(0.5, &[0.0], &[0.01]);
+        let run = claim_run(&rs, 0, 13, 0.02);
+        let got: Vec<(u32, u32, f64)> = run
+            .iter()
+            .map(|i| (i.x, i.dx, i.i().as_slice()[0]))
+            .collect();
+        let want = [(0, 5, 0.02), (5, 5, 0.07), (10, 4, 0.115)];
+        assert_eq!(got.len(), want.len());
+        for (g, w) in got.iter().zip(&want) {
+            assert_eq!((g.0, g.1), (w.0, w.1));
+            assert!((g.2 - w.2).abs() < 1e-15, "{g:?} vs {w:?}");
+        }
+    }
+
+    #[test]
+    fn a_flat_run_is_one_eval0() {
+        let rs = shade(0.0, &[0.3, 0.6], &[0.0, 0.0]);
+        let run = claim_run(&rs, 5, 40, 0.0);
+        assert_eq!(
+            run,
+            [Instruction::eval0(5, 36, Intensity::new(&[0.3, 0.6]))]
+        );
+    }
 }

@@ -10,7 +10,8 @@
 //! 4. [`scan`] — an edge list and an active edge table grouped by Identifier visit the
 //!    trapezia row by row (Algorithms 7–8).
 //! 5. [`dofill`] — each row of a trapezium becomes instructions: box-filter coverage in
-//!    the twelve cases of DO_FILL ([`coverage`]), or point sampling; flat or Gouraud.
+//!    the twelve cases of DO_FILL ([`coverage`]), or point sampling; flat or Gouraud;
+//!    optionally claiming fully covered pixels with `Eval0` ([`Claim`]).
 //! 6. [`emit`](fn@emit) — the stream goes to any [`TraceWrite`] (a trace file, the
 //!    array simulator, a counter), one `Refresh` per scanline.
 //!
@@ -54,13 +55,33 @@ pub enum Antialias {
     Box,
 }
 
+/// What a polygon does to the pixels it fully covers.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum Claim {
+    /// Accumulate, like every other pixel (the default).
+    #[default]
+    Accumulate,
+    /// Claim them with Eval0 so that later (farther) polygons no longer accumulate there.
+    /// With Gouraud shading the claimed run is a staircase of Eval0s, each holding the
+    /// intensity at its centre, as long as the staircase stays within `tolerance` of the
+    /// Gouraud value at every pixel centre.
+    Eval0 {
+        /// The largest difference allowed, per channel, between a claimed pixel's value
+        /// and the Gouraud intensity at its centre (0: one `Eval0` per pixel).
+        tolerance: f64,
+    },
+}
+
 /// How to scan-convert.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Options {
     /// Shading.
     pub shading: Shading,
     /// Anti-aliasing.
     pub aa: Antialias,
+    /// What a polygon does to the pixels it fully covers: with box filtering the runs of
+    /// coverage exactly 1, with point sampling its whole span (`docs/ERRATA.md`, D9).
+    pub claim: Claim,
 }
 
 /// What an emission did.
@@ -82,6 +103,8 @@ pub struct EmitStats {
     pub sequences: u64,
     /// Share-sequence stretches.
     pub share_sequences: u64,
+    /// `Eval0` instructions claiming fully covered pixels ([`Claim::Eval0`]).
+    pub claims: u64,
     /// Instructions emitted, `Refresh` included.
     pub instructions: u64,
 }
@@ -148,8 +171,10 @@ pub fn emit(
             scan::Visit::Fill(row, t) => {
                 let shade = &shades[t.polygon as usize];
                 let fill = match options.aa {
-                    Antialias::Box => box_row(t, row, scene.width, shade, channels),
-                    Antialias::None => sampled_row(t, row, scene.width, shade, channels),
+                    Antialias::Box => box_row(t, row, scene.width, shade, channels, options.claim),
+                    Antialias::None => {
+                        sampled_row(t, row, scene.width, shade, channels, options.claim)
+                    }
                 };
                 let Some(fill) = fill else { return };
                 stats.rows_filled += 1;
@@ -163,6 +188,7 @@ pub fn emit(
                             Procedure::MiddlePart => stats.middle_parts += 1,
                             Procedure::Sequence => stats.sequences += 1,
                             Procedure::ShareSequence => stats.share_sequences += 1,
+                            Procedure::Claim => stats.claims += 1,
                         }
                         stats.instructions += 1;
                         sink.write(instr)?;

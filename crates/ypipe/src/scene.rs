@@ -23,8 +23,9 @@
 //! (`polygons[3].intensity[1]`) where it applies, what was expected and what was found.
 //! [`ScreenScene::to_json`] writes a scene back, deterministically and losslessly.
 //!
-//! A new kind (the 3D `"world"` scenes) is a new [`Scene`] variant, a new arm in
-//! [`parse_scene`]'s dispatch on `kind`, and a new entry of [`SCENE_KINDS`].
+//! Other kinds live in the crates that draw them (the 3D `"world"` scenes: `cwisim-world`);
+//! their readers build on [`read_kind`], [`locate_error`] and [`json_error`], so that every
+//! kind's errors look alike.
 //!
 //! ```
 //! use cwisim_ypipe::scene::{parse_scene, Scene};
@@ -34,8 +35,8 @@
 //! assert_eq!((s.width, s.height, s.polygons.len()), (4, 3, 1));
 //! assert_eq!(parse_scene(&s.to_json()).unwrap(), Scene::Screen(s));
 //!
-//! let err = parse_scene(r#"{"kind": "world"}"#).unwrap_err();
-//! assert_eq!(err.to_string(), r#"1:10: kind: unknown scene kind "world"; expected "screen""#);
+//! let err = parse_scene(r#"{"kind": "solid"}"#).unwrap_err();
+//! assert_eq!(err.to_string(), r#"1:10: kind: unknown scene kind "solid"; expected "screen""#);
 //! ```
 
 use serde::{Deserialize, Serialize};
@@ -154,6 +155,9 @@ pub enum SceneErrorKind {
     NonFinite,
     /// A polygon whose edges cross, touch or overlap.
     SelfIntersection,
+    /// A world scene whose geometry cannot be drawn: a degenerate face, a non-convex
+    /// face, an empty mesh, or a camera inside or behind an object.
+    Geometry,
 }
 
 /// A scene that cannot be used: where, what kind of fault, and what was expected.
@@ -255,52 +259,12 @@ impl SceneError {
 ///
 /// [`validate`]: ScreenScene::validate
 pub fn parse_scene(text: &str) -> Result<Scene, SceneError> {
-    // First pass: the shape (an object with a known kind; polygons that are objects).
+    let kind = read_kind(text, SCENE_KINDS)?;
+    let locate = |e: SceneError| locate_error(text, e);
     let value: serde_json::Value =
         serde_json::from_str(text).map_err(|e| SceneError::from_json(json_kind(&e), &e))?;
-    let locate = |e: SceneError| {
-        let offset = e
-            .field
-            .as_deref()
-            .map_or(Some(first_token(text)), |f| locate(text, f));
-        match offset {
-            Some(o) => e.at_offset(text, o),
-            None => e,
-        }
-    };
-    let serde_json::Value::Object(root) = &value else {
-        return Err(locate(SceneError::at_field(
-            SceneErrorKind::Schema,
-            "",
-            format!(
-                "expected a scene object {{\"kind\": …}}, found {}",
-                describe(&value)
-            ),
-        )));
-    };
-    let kinds = SCENE_KINDS
-        .iter()
-        .map(|k| format!("\"{k}\""))
-        .collect::<Vec<_>>()
-        .join(" or ");
-    let kind = match root.get("kind") {
-        None => {
-            return Err(locate(SceneError::at_field(
-                SceneErrorKind::Schema,
-                "",
-                format!("missing field `kind`; expected {kinds}"),
-            )))
-        }
-        Some(serde_json::Value::String(k)) => k.as_str(),
-        Some(other) => {
-            return Err(locate(SceneError::at_field(
-                SceneErrorKind::Schema,
-                "kind",
-                format!("expected a string ({kinds}), found {}", describe(other)),
-            )))
-        }
-    };
-    match kind {
+    let root = value.as_object().expect("read_kind checked the object");
+    match kind.as_str() {
         "screen" => {
             if let Some(serde_json::Value::Array(polys)) = root.get("polygons") {
                 for (k, p) in polys.iter().enumerate() {
@@ -340,15 +304,78 @@ pub fn parse_scene(text: &str) -> Result<Scene, SceneError> {
             scene.validate().map_err(locate)?;
             Ok(Scene::Screen(scene))
         }
-        other => Err(locate(SceneError::at_field(
+        other => unreachable!("read_kind accepts only SCENE_KINDS, not {other}"),
+    }
+}
+
+/// Reads the `kind` of a scene file's text and checks it is one of `known`: the first
+/// step of every reader of scene files (this crate's screen scenes, and the readers of
+/// other kinds that build on it). Errors are located in `text`.
+pub fn read_kind(text: &str, known: &[&str]) -> Result<String, SceneError> {
+    let value: serde_json::Value =
+        serde_json::from_str(text).map_err(|e| SceneError::from_json(json_kind(&e), &e))?;
+    let locate = |e: SceneError| locate_error(text, e);
+    let serde_json::Value::Object(root) = &value else {
+        return Err(locate(SceneError::at_field(
+            SceneErrorKind::Schema,
+            "",
+            format!(
+                "expected a scene object {{\"kind\": …}}, found {}",
+                describe(&value)
+            ),
+        )));
+    };
+    let kinds = known
+        .iter()
+        .map(|k| format!("\"{k}\""))
+        .collect::<Vec<_>>()
+        .join(" or ");
+    match root.get("kind") {
+        None => Err(locate(SceneError::at_field(
+            SceneErrorKind::Schema,
+            "",
+            format!("missing field `kind`; expected {kinds}"),
+        ))),
+        Some(serde_json::Value::String(k)) if known.contains(&k.as_str()) => Ok(k.clone()),
+        Some(serde_json::Value::String(k)) => Err(locate(SceneError::at_field(
             SceneErrorKind::Kind,
             "kind",
             format!(
                 "unknown scene kind {}; expected {kinds}",
-                serde_json::Value::from(other)
+                serde_json::Value::from(k.as_str())
             ),
         ))),
+        Some(other) => Err(locate(SceneError::at_field(
+            SceneErrorKind::Schema,
+            "kind",
+            format!("expected a string ({kinds}), found {}", describe(other)),
+        ))),
     }
+}
+
+/// Gives `e` the line and column, in `text`, of the value its JSON path names (of the
+/// scene's first token when it names none). A path that is not in `text` leaves `e`
+/// unlocated.
+pub fn locate_error(text: &str, e: SceneError) -> SceneError {
+    let offset = e
+        .field
+        .as_deref()
+        .map_or(Some(first_token(text)), |f| locate(text, f));
+    match offset {
+        Some(o) => e.at_offset(text, o),
+        None => e,
+    }
+}
+
+/// A `serde_json` error while reading a scene, located (line and column) and typed
+/// ([`SceneErrorKind::Syntax`], or [`SceneErrorKind::Schema`] for a wrong type or key).
+pub fn json_error(e: &serde_json::Error) -> SceneError {
+    SceneError::from_json(json_kind(e), e)
+}
+
+/// What a JSON value is, for messages: "a number", "an array", …
+pub fn describe_json(v: &serde_json::Value) -> &'static str {
+    describe(v)
 }
 
 /// Reads and validates a scene file; every error names the file.

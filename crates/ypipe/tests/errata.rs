@@ -126,6 +126,7 @@ fn e4_pixel_centres_are_at_half_integers() {
         &Options {
             shading: Shading::Flat,
             aa: Antialias::None,
+            ..Default::default()
         },
     );
     assert_eq!(img, [0.0, 0.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0]);

@@ -1,12 +1,12 @@
 //! The emitted instruction stream of every named fixture, as reviewed snapshots: one
 //! trapezium row per DO_FILL case (tests/fixtures/caseNN.json) and the three triangles
-//! of the report's figure 25.
+//! of the report's figure 25 (also with `Eval0` claims).
 
 mod common;
 
 use common::{fixture, render, text};
 use cwisim_ypipe::exact::scene_coverage;
-use cwisim_ypipe::{Antialias, Options, Shading};
+use cwisim_ypipe::{Antialias, Claim, Options, Shading};
 
 #[test]
 fn each_of_the_twelve_cases_has_its_fixture_and_stream() {
@@ -56,6 +56,64 @@ fn shading_and_antialiasing_modes_of_case_10() {
         (Shading::Flat, Antialias::Box, "case10_flat_box"),
         (Shading::Gouraud, Antialias::None, "case10_gouraud_none"),
     ] {
-        insta::assert_snapshot!(name, text(&scene, &Options { shading, aa }));
+        insta::assert_snapshot!(
+            name,
+            text(
+                &scene,
+                &Options {
+                    shading,
+                    aa,
+                    ..Default::default()
+                }
+            )
+        );
     }
+}
+
+/// Figure 25, Gouraud and box filter, each triangle claiming its fully covered pixels
+/// with a staircase of `Eval0`s within 1/512 of the Gouraud value. Reviewed: the claims
+/// are the middle parts of full rows and the pixels right of the vertical edge x = 2,
+/// never a partially covered pixel (checked below against the exact coverage).
+#[test]
+fn figure_25_with_eval0_claims() {
+    let scene = fixture("fig25.json");
+    let options = Options {
+        claim: Claim::Eval0 {
+            tolerance: 1.0 / 512.0,
+        },
+        ..Options::default()
+    };
+    let trace = text(&scene, &options);
+    insta::assert_snapshot!("fig25_claim", trace);
+    let (w, h) = (scene.width as usize, scene.height as usize);
+    let mut claimed = vec![0u32; w * h];
+    let mut row = 0;
+    for line in trace.lines() {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("Refresh") => row += 1,
+            Some("Eval0") => {
+                let x: usize = words.next().unwrap().parse().unwrap();
+                let dx: usize = words.next().unwrap().parse().unwrap();
+                for p in x..x + dx {
+                    claimed[row * w + p] += 1;
+                }
+            }
+            _ => {}
+        }
+    }
+    assert_eq!(row, h);
+    let cover: Vec<Vec<f64>> = scene
+        .polygons
+        .iter()
+        .map(|p| cwisim_ypipe::exact::coverage(p, scene.width, scene.height))
+        .collect();
+    let mut n = 0;
+    for k in 0..w * h {
+        let full = cover.iter().filter(|c| c[k] >= 1.0 - 1e-12).count() as u32;
+        // the triangles do not overlap: a pixel is claimed once if one covers it fully
+        assert_eq!(claimed[k], full, "pixel ({}, {})", k % w, k / w);
+        n += claimed[k];
+    }
+    assert!(n > 10, "{n} pixels claimed");
 }

@@ -7,6 +7,7 @@ pub mod history;
 pub mod machine;
 pub mod run;
 pub mod scene;
+pub mod scenes;
 pub mod stats;
 pub mod until;
 pub mod vcd;

@@ -1,88 +1,49 @@
-//! `cwisim emit` and `cwisim render`: a screen-space scene through the Y-processor
-//! (`cwisim-ypipe`), into a trace file or straight into the array simulator.
+//! `cwisim render` and `cwisim emit`: a scene (screen or world, a file or an embedded
+//! name) through the host side and the Y-processor (`cwisim-world`, `cwisim-ypipe`), into
+//! the array simulator or a trace file.
 
 use super::{ImageArgs, MachineArgs};
 use crate::commands::run::TimingArg;
-use crate::cost::{display_name, CostArgs, CostMap, Tee};
+use crate::cost::{display_name, CostArgs, CostMap};
 use crate::error::CliError;
 use crate::files::{check_outputs, same_file, write_atomic};
+use crate::prepare::{prepare, DrawArgs, PreparedScene};
+use crate::progress::Progress;
 use crate::report::{timing_name, write_summary, StatsReport};
-use clap::{Args, ValueEnum};
-use cwisim_isa::{Encoding, TraceWrite};
+use crate::summary::{write_render_summary, StageTimes};
+use clap::Args;
+use cwisim_isa::{Encoding, Instruction, Opcode, TraceWrite};
 use cwisim_xproc::{EngineWriter, ImageSink, LineSink, Machine, RunStats, Timing};
-use cwisim_ypipe::scene::{load_scene, Scene, ScreenScene};
-use cwisim_ypipe::{emit, header, Antialias, EmitStats, Options, Shading};
-use std::io::Write;
+use cwisim_ypipe::scene::ScreenScene;
+use cwisim_ypipe::{emit, header, EmitStats, Options};
+use std::io::{self, Write};
 use std::path::{Path, PathBuf};
-
-/// `--shading`.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
-pub enum ShadingArg {
-    /// One intensity per polygon (the mean of its vertices'): Eval1 spans.
-    Flat,
-    /// Interpolated along the edges and across each scanline: Eval2 spans.
-    #[default]
-    Gouraud,
-}
-
-/// `--aa`.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
-pub enum AaArg {
-    /// Point sampling at pixel centres.
-    None,
-    /// Box filter: the exact covered area of every pixel (DO_FILL's twelve cases).
-    #[default]
-    Box,
-}
-
-/// The scan-conversion options shared by `emit` and `render`.
-#[derive(Args, Clone, Debug, Default, PartialEq)]
-pub struct ScanArgs {
-    /// Shading.
-    #[arg(long, value_enum, default_value_t = ShadingArg::Gouraud)]
-    pub shading: ShadingArg,
-    /// Anti-aliasing.
-    #[arg(long, value_enum, default_value_t = AaArg::Box)]
-    pub aa: AaArg,
-}
-
-impl ScanArgs {
-    /// The Y-processor's options (the default: Gouraud shading, box filter).
-    pub fn options(&self) -> Options {
-        Options {
-            shading: match self.shading {
-                ShadingArg::Flat => Shading::Flat,
-                ShadingArg::Gouraud => Shading::Gouraud,
-            },
-            aa: match self.aa {
-                AaArg::None => Antialias::None,
-                AaArg::Box => Antialias::Box,
-            },
-        }
-    }
-}
+use std::time::{Duration, Instant};
 
 /// The arguments of `cwisim emit`.
 #[derive(Args, Clone, Debug, PartialEq)]
 pub struct EmitArgs {
-    /// The screen-space scene (JSON, "kind": "screen").
-    #[arg(value_name = "SCENE.json")]
+    /// The scene: a JSON file ("kind": "screen" or "world") or an embedded scene's name
+    /// (`cwisim scenes` lists them).
+    #[arg(value_name = "SCENE")]
     pub scene: PathBuf,
     /// The trace to write: .cwt (annotated text), .jsonl or .cwb, by extension.
     #[arg(short = 'o', long = "output", value_name = "OUT")]
     pub output: PathBuf,
-    /// Scan conversion.
+    /// How to draw it.
     #[command(flatten)]
-    pub scan: ScanArgs,
+    pub draw: DrawArgs,
 }
 
 /// The arguments of `cwisim render`.
 #[derive(Args, Clone, Debug, PartialEq)]
 pub struct RenderArgs {
-    /// The screen-space scene (JSON, "kind": "screen").
-    #[arg(value_name = "SCENE.json")]
-    pub scene: PathBuf,
-    /// Image outputs.
+    /// The scene: a JSON file ("kind": "screen" or "world") or an embedded scene's name
+    /// (`cwisim scenes` lists them). Default: the embedded pot.
+    #[arg(value_name = "SCENE")]
+    pub scene: Option<PathBuf>,
+    /// Image outputs. Without -o, --npy, --trace, --cost-image or --cost-npy, the PNG goes
+    /// to SCENE-NAME.png in the working directory.
     #[command(flatten)]
     pub image: ImageArgs,
     /// Cost outputs: instructions per pixel.
@@ -91,62 +52,135 @@ pub struct RenderArgs {
     /// Also write the emitted trace (.cwt annotated text, .jsonl or .cwb).
     #[arg(long, value_name = "OUT")]
     pub trace: Option<PathBuf>,
-    /// Scan conversion.
+    /// How to draw it.
     #[command(flatten)]
-    pub scan: ScanArgs,
+    pub draw: DrawArgs,
     /// The machine model.
     #[command(flatten)]
     pub machine: MachineArgs,
     /// Timing model. Both give identical images and cycle counts.
     #[arg(long, value_enum, default_value_t = TimingArg::Fast)]
     pub timing: TimingArg,
-    /// Print a summary of the statistics to standard output.
+    /// Also print the array's full statistics summary.
     #[arg(long)]
     pub stats: bool,
-    /// Write the scan-conversion and array statistics as JSON.
+    /// Write the scene's, the scan conversion's and the array's statistics as JSON.
     #[arg(long, value_name = "FILE")]
     pub stats_json: Option<PathBuf>,
+    /// Print nothing (errors still go to standard error).
+    #[arg(short, long)]
+    pub quiet: bool,
 }
 
-/// Loads a screen-space scene file (errors are located).
-pub fn load_screen(path: &Path) -> Result<ScreenScene, CliError> {
-    let Scene::Screen(s) = load_scene(path)?;
-    Ok(s)
+/// The array as a [`TraceWrite`] fed one scanline at a time: instructions are buffered
+/// until their `Refresh` and then handed to the array, so that the array's share of the
+/// wall time is measured per scanline rather than per instruction. Every instruction also
+/// goes to `also` (a cost map, say) as it comes.
+struct ScanlineFeed<'a, 's> {
+    array: EngineWriter<'s, f64>,
+    also: Option<&'a mut dyn TraceWrite>,
+    buffer: Vec<Instruction>,
+    array_time: Duration,
+    progress: Option<&'a mut Progress>,
+    lines: u64,
+}
+
+impl ScanlineFeed<'_, '_> {
+    fn flush(&mut self) -> io::Result<()> {
+        let start = Instant::now();
+        for instr in self.buffer.drain(..) {
+            self.array.write(&instr)?;
+        }
+        self.array_time += start.elapsed();
+        Ok(())
+    }
+}
+
+impl TraceWrite for ScanlineFeed<'_, '_> {
+    fn write(&mut self, instr: &Instruction) -> io::Result<()> {
+        if let Some(also) = self.also.as_deref_mut() {
+            also.write(instr)?;
+        }
+        self.buffer.push(*instr);
+        if instr.op == Opcode::Refresh {
+            self.flush()?;
+            self.lines += 1;
+            if let Some(p) = self.progress.as_deref_mut() {
+                p.update(self.lines);
+            }
+        }
+        Ok(())
+    }
+
+    fn comment(&mut self, text: &str) -> io::Result<()> {
+        match self.also.as_deref_mut() {
+            Some(also) => also.comment(text),
+            None => Ok(()),
+        }
+    }
+
+    fn finish(&mut self) -> io::Result<()> {
+        self.flush()?;
+        let start = Instant::now();
+        self.array.finish()?;
+        self.array_time += start.elapsed();
+        if let Some(also) = self.also.as_deref_mut() {
+            also.finish()?;
+        }
+        Ok(())
+    }
+}
+
+/// What rendering a screen scene gives besides the scanlines.
+pub struct Rendered {
+    /// The scan conversion's statistics.
+    pub emitted: EmitStats,
+    /// The array's statistics.
+    pub stats: RunStats,
+    /// Wall time in the Y-processor (scan conversion).
+    pub ypipe_time: Duration,
+    /// Wall time in the array simulator.
+    pub array_time: Duration,
 }
 
 /// Scan-converts `scene` straight into the array on `machine`, handing its scanlines to
-/// `sink`, and every instruction also to `also` (after the array took it) when given.
-/// Returns the scan conversion's and the array's statistics.
-pub fn render_scene(
+/// `sink`, and every instruction also to `also` when given.
+pub fn render_scene<'a>(
     scene: &ScreenScene,
     options: &Options,
     machine: &Machine,
     timing: Timing,
     sink: &mut dyn LineSink<f64>,
-    also: Option<&mut dyn TraceWrite>,
-) -> Result<(EmitStats, RunStats), CliError> {
+    also: Option<&'a mut dyn TraceWrite>,
+    progress: Option<&'a mut Progress>,
+) -> Result<Rendered, CliError> {
     let h = header(scene);
-    let mut array = EngineWriter::<f64>::new(&h, machine, timing, sink)?;
-    let emitted: EmitStats = match also {
-        None => emit(scene, options, &mut array),
-        Some(second) => emit(
-            scene,
-            options,
-            &mut Tee {
-                first: &mut array,
-                second,
-            },
-        ),
-    }
-    .map_err(|e| {
+    let array = EngineWriter::<f64>::new(&h, machine, timing, sink)?;
+    let mut feed = ScanlineFeed {
+        array,
+        also,
+        buffer: Vec::new(),
+        array_time: Duration::ZERO,
+        progress,
+        lines: 0,
+    };
+    let start = Instant::now();
+    let emitted = emit(scene, options, &mut feed).map_err(|e| {
         CliError::Usage(format!(
             "the Y-processor emitted an invalid instruction: {e}"
         ))
     })?;
-    array
-        .finish()
+    feed.finish()
         .map_err(|e| CliError::Usage(format!("the array failed: {e}")))?;
-    Ok((emitted, array.into_stats().expect("finished")))
+    let total = start.elapsed();
+    let array_time = feed.array_time;
+    let stats = feed.array.into_stats().expect("finished");
+    Ok(Rendered {
+        emitted,
+        stats,
+        ypipe_time: total.saturating_sub(array_time),
+        array_time,
+    })
 }
 
 /// The whole trace in one encoding, in memory (written only once complete).
@@ -170,19 +204,37 @@ pub fn run_emit(args: &EmitArgs) -> Result<(), CliError> {
             "the output would overwrite the scene".into(),
         ));
     }
-    let scene = load_screen(&args.scene)?;
-    let bytes = encode(&scene, &args.scan.options(), &args.output)?;
+    let prepared = prepare(Some(&args.scene), &args.draw)?;
+    let bytes = encode(&prepared.screen, &prepared.options, &args.output)?;
     write_atomic(&args.output, |w| {
         w.write_all(&bytes)
             .map_err(|e| CliError::write(&args.output, e))
     })
 }
 
+/// The PNG path `render` writes when given no output at all.
+fn default_png(args: &RenderArgs, prepared: &PreparedScene) -> Option<PathBuf> {
+    let any = args.image.wanted()
+        || args.trace.is_some()
+        || args.cost.wanted()
+        || args.stats_json.is_some();
+    (!any).then(|| PathBuf::from(format!("{}.png", prepared.source.name())))
+}
+
 /// Runs `cwisim render`.
-pub fn run_render(args: &RenderArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
+pub fn run_render(
+    args: &RenderArgs,
+    stdout: &mut dyn Write,
+    progress: bool,
+) -> Result<(), CliError> {
     let [cost_image, cost_npy] = args.cost.outputs();
+    let scene_file = args
+        .scene
+        .as_deref()
+        .filter(|p| p.exists())
+        .map(|p| ("scene", p));
     check_outputs(
-        Some(("scene", args.scene.as_path())),
+        scene_file,
         &[
             ("-o", args.image.output.as_deref()),
             ("--npy", args.image.npy.as_deref()),
@@ -193,14 +245,18 @@ pub fn run_render(args: &RenderArgs, stdout: &mut dyn Write) -> Result<(), CliEr
         ],
     )?;
     args.cost.check()?;
-    let scene = load_screen(&args.scene)?;
-    let options = args.scan.options();
+    let prepared = prepare(args.scene.as_deref(), &args.draw)?;
+    let mut image_args = args.image.clone();
+    if let Some(png) = default_png(args, &prepared) {
+        image_args.output = Some(png);
+    }
+    let scene = &prepared.screen;
     let machine = args.machine.load()?;
     let timing = Timing::from(args.timing);
-    let h = header(&scene);
-    args.image.check(h.channel_count())?;
+    let h = header(scene);
+    image_args.check(h.channel_count())?;
     let trace_bytes = match &args.trace {
-        Some(path) => Some(encode(&scene, &options, path)?),
+        Some(path) => Some(encode(scene, &prepared.options, path)?),
         None => None,
     };
     let mut sink = ImageSink::new(
@@ -209,18 +265,26 @@ pub fn run_render(args: &RenderArgs, stdout: &mut dyn Write) -> Result<(), CliEr
         ImageSink::DEFAULT_LIMIT_BYTES,
     );
     let mut cost = args.cost.wanted().then(|| CostMap::new(h.width as usize));
-    let (emitted, stats) = render_scene(
-        &scene,
-        &options,
+    let mut progress = Progress::scanlines(u64::from(h.lines), progress && !args.quiet);
+    let rendered = render_scene(
+        scene,
+        &prepared.options,
         &machine,
         timing,
         &mut sink,
         cost.as_mut().map(|c| c as &mut dyn TraceWrite),
+        Some(&mut progress),
     )?;
+    drop(progress);
+    let start = Instant::now();
     let image = sink.finish()?;
-    args.image.write(&image)?;
+    image_args.write(&image)?;
     if let Some(cost) = &cost {
-        args.cost.write(cost, &display_name(&args.scene))?;
+        let name = match prepared.source.path() {
+            Some(p) => display_name(p),
+            None => prepared.source.name(),
+        };
+        args.cost.write(cost, &name)?;
     }
     if let (Some(path), Some(bytes)) = (&args.trace, &trace_bytes) {
         write_atomic(path, |w| {
@@ -232,12 +296,13 @@ pub fn run_render(args: &RenderArgs, stdout: &mut dyn Write) -> Result<(), CliEr
             trace: (&h).into(),
             machine: &machine,
             timing: timing_name(timing),
-            stats: &stats,
+            stats: &rendered.stats,
         };
         let mut json =
             serde_json::to_value(&report).map_err(|e| CliError::write(path, e.into()))?;
         json["emit"] =
-            serde_json::to_value(&emitted).map_err(|e| CliError::write(path, e.into()))?;
+            serde_json::to_value(&rendered.emitted).map_err(|e| CliError::write(path, e.into()))?;
+        json["scene"] = crate::summary::scene_json(&prepared);
         let text = serde_json::to_string_pretty(&json)
             .map_err(|e| CliError::write(path, e.into()))?
             + "\n";
@@ -246,36 +311,41 @@ pub fn run_render(args: &RenderArgs, stdout: &mut dyn Write) -> Result<(), CliEr
                 .map_err(|e| CliError::write(path, e))
         })?;
     }
-    if args.stats {
-        write_emit_summary(stdout, &emitted).map_err(CliError::Stdout)?;
-        write_summary(stdout, &h, timing, &stats).map_err(CliError::Stdout)?;
+    let output_time = start.elapsed();
+    if !args.quiet {
+        let times = StageTimes {
+            load: prepared.times.load,
+            transform: prepared.times.transform,
+            visibility: prepared.times.visibility,
+            ypipe: rendered.ypipe_time,
+            array: rendered.array_time,
+            output: output_time,
+        };
+        let written: Vec<&Path> = [
+            image_args.output.as_deref(),
+            image_args.npy.as_deref(),
+            args.trace.as_deref(),
+            args.stats_json.as_deref(),
+            cost_image.1.map(PathBuf::as_path),
+            cost_npy.1.map(PathBuf::as_path),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        write_render_summary(
+            stdout,
+            &prepared,
+            &rendered.emitted,
+            &rendered.stats,
+            &times,
+            &written,
+        )
+        .map_err(CliError::Stdout)?;
+        if args.stats {
+            writeln!(stdout).map_err(CliError::Stdout)?;
+            write_summary(stdout, &h, timing, &rendered.stats).map_err(CliError::Stdout)?;
+        }
         stdout.flush().map_err(CliError::Stdout)?;
     }
     Ok(())
-}
-
-fn write_emit_summary(out: &mut dyn Write, e: &EmitStats) -> std::io::Result<()> {
-    writeln!(out, "{:<26}{}", "polygons", e.polygons)?;
-    writeln!(out, "{:<26}{}", "trapezia", e.trapezia)?;
-    writeln!(out, "{:<26}{}", "trapezium rows", e.rows_filled)?;
-    let cases: Vec<String> = e
-        .cases
-        .iter()
-        .enumerate()
-        .filter(|(_, n)| **n > 0)
-        .map(|(k, n)| format!("{}:{n}", k + 1))
-        .collect();
-    if !cases.is_empty() {
-        writeln!(
-            out,
-            "{:<26}{}",
-            "DO_FILL cases (case:rows)",
-            cases.join(" ")
-        )?;
-    }
-    writeln!(
-        out,
-        "{:<26}{} pixels, {} middle parts, {} sequences, {} share-sequences",
-        "procedures", e.single_pixels, e.middle_parts, e.sequences, e.share_sequences
-    )
 }

@@ -1,17 +1,18 @@
 //! `cwisim stats`: the per-scanline table, a plot, CSV and JSON.
 //!
-//! The input is a trace (replayed as by `cwisim run`) or a screen scene (rendered as by
+//! The input is a trace (replayed as by `cwisim run`) or a scene file (rendered as by
 //! `cwisim render` with its default options: Gouraud shading, box filter). Every number
 //! is a field of the run's [`LineStats`]; the plot adds the bus cycles per opcode, the
 //! opcode counts × each opcode's issue cost on the machine.
 
 use super::MachineArgs;
 use crate::commands::run::{open_trace, replay_file, TimingArg};
-use crate::commands::scene::{load_screen, render_scene, ScanArgs};
+use crate::commands::scene::render_scene;
 use crate::cost::{check_extension, display_name};
 use crate::error::CliError;
 use crate::files::{self, write_atomic};
 use crate::plot::{issue_costs, render_stats_plot, StatsPlot};
+use crate::prepare::{prepare, DrawArgs};
 use crate::range::{parse_range, Range};
 use crate::report::{timing_name, unrefreshed_warning, TraceShape};
 use clap::Args;
@@ -187,10 +188,17 @@ pub fn run(
             (header, replayed.stats)
         }
         Input::Scene => {
-            let scene = load_screen(&args.input)?;
-            let options = ScanArgs::default().options();
-            let (_, stats) = render_scene(&scene, &options, &machine, timing, &mut NullSink, None)?;
-            (cwisim_ypipe::header(&scene), stats)
+            let prepared = prepare(Some(&args.input), &DrawArgs::default())?;
+            let rendered = render_scene(
+                &prepared.screen,
+                &prepared.options,
+                &machine,
+                timing,
+                &mut NullSink,
+                None,
+                None,
+            )?;
+            (cwisim_ypipe::header(&prepared.screen), rendered.stats)
         }
     };
     let timeline = machine.timeline(&header)?;

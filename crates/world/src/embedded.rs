@@ -1,0 +1,60 @@
+//! The scenes built into `cwisim` (`cwisim scenes` lists them). Their files are in
+//! `crates/world/scenes/`: copy one to start a scene of your own.
+
+/// A scene built into the binary.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Embedded {
+    /// The name to give `cwisim render`.
+    pub name: &'static str,
+    /// One line about it.
+    pub about: &'static str,
+    /// The scene file.
+    pub text: &'static str,
+}
+
+/// Every embedded scene; the first is the default of `cwisim render`.
+pub const EMBEDDED: &[Embedded] = &[
+    Embedded {
+        name: "pot",
+        about: "world, grey: a lit pot, a surface of revolution of trapezia and triangles (the report's figures 24 and 28), open at the top so its inside shows behind the rim",
+        text: include_str!("../scenes/pot.json"),
+    },
+    Embedded {
+        name: "fig25",
+        about: "screen, grey: the three triangles P, Q, R of the report's figure 25 (the Identifier example)",
+        text: include_str!("../scenes/fig25.json"),
+    },
+    Embedded {
+        name: "cases12",
+        about: "screen, grey: one trapezium row per DO_FILL case 1–12, four to a row (at its own size; --size rescales and so changes the cases)",
+        text: include_str!("../scenes/cases12.json"),
+    },
+    Embedded {
+        name: "still-life",
+        about: "world, RGB: a red vase, a green box and a blue cone on a table, occluding each other",
+        text: include_str!("../scenes/still-life.json"),
+    },
+];
+
+/// The embedded scene called `name`.
+pub fn embedded(name: &str) -> Option<&'static Embedded> {
+    EMBEDDED.iter().find(|e| e.name == name)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_embedded_scene_reads_and_projects() {
+        for e in EMBEDDED {
+            let scene =
+                crate::parse_any(e.text, None).unwrap_or_else(|err| panic!("{}: {err}", e.name));
+            if let crate::AnyScene::World(w) = scene {
+                let (tris, _) =
+                    crate::project::project(&w, cwisim_ypipe::Shading::Gouraud).unwrap();
+                assert!(!tris.is_empty(), "{}", e.name);
+            }
+        }
+    }
+}

@@ -1,0 +1,100 @@
+//! Screen triangles: what projection and lighting hand to visibility.
+
+use cwisim_ypipe::trapezoid::Vector;
+
+/// A triangle in screen space after projection and lighting.
+///
+/// Screen coordinates are pixels, x to the right, y downward (the Y-processor's
+/// convention). `inv_depth` is `1 / depth` at each vertex, depth being the distance in
+/// front of the camera along its view direction: for a planar triangle under perspective
+/// projection, `1 / depth` is an **affine** function of the screen position, so comparing
+/// two triangles' `1 / depth` at a screen point is an exact depth test, and the set of
+/// points where one is nearer than the other is a half-plane.
+///
+/// `intensity` is the per-vertex intensity vector (its first `channels` entries used).
+/// Across the triangle the intensity is the affine interpolation of the three vertex
+/// values in screen space (Gouraud as the X-processors do it): [`ScreenTriangle::intensity_at`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ScreenTriangle {
+    /// The vertices `[x, y]` in pixels.
+    pub points: [[f64; 2]; 3],
+    /// `1 / depth` at each vertex (> 0: in front of the camera).
+    pub inv_depth: [f64; 3],
+    /// The intensity vector at each vertex.
+    pub intensity: [Vector; 3],
+    /// Which mesh of the scene it comes from.
+    pub mesh: u32,
+    /// Which face of that mesh.
+    pub face: u32,
+}
+
+impl ScreenTriangle {
+    /// Twice the signed area (positive: counter-clockwise with y downward, i.e. clockwise
+    /// as seen on the screen).
+    pub fn doubled_area(&self) -> f64 {
+        let [a, b, c] = self.points;
+        (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1])
+    }
+
+    /// The barycentric coordinates of screen point `p` (they sum to 1; all ≥ 0 inside).
+    /// `None` for a degenerate (zero-area) triangle.
+    pub fn barycentric(&self, p: [f64; 2]) -> Option<[f64; 3]> {
+        let d = self.doubled_area();
+        if d == 0.0 || !d.is_finite() {
+            return None;
+        }
+        let [a, b, c] = self.points;
+        let w_b = ((p[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (p[1] - a[1])) / d;
+        let w_c = ((b[0] - a[0]) * (p[1] - a[1]) - (p[0] - a[0]) * (b[1] - a[1])) / d;
+        Some([1.0 - w_b - w_c, w_b, w_c])
+    }
+
+    /// `1 / depth` at screen point `p` (affine; extrapolated outside the triangle).
+    pub fn inv_depth_at(&self, p: [f64; 2]) -> Option<f64> {
+        let w = self.barycentric(p)?;
+        Some(w[0] * self.inv_depth[0] + w[1] * self.inv_depth[1] + w[2] * self.inv_depth[2])
+    }
+
+    /// The intensity at screen point `p` (affine; extrapolated outside the triangle).
+    pub fn intensity_at(&self, p: [f64; 2], channels: usize) -> Option<Vector> {
+        let w = self.barycentric(p)?;
+        Some(cwisim_ypipe::trapezoid::vector(channels, |c| {
+            w[0] * self.intensity[0][c] + w[1] * self.intensity[1][c] + w[2] * self.intensity[2][c]
+        }))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tri() -> ScreenTriangle {
+        let mut i = [[0.0; 4]; 3];
+        i[0][0] = 1.0;
+        i[1][0] = 3.0;
+        i[2][0] = 5.0;
+        ScreenTriangle {
+            points: [[0.0, 0.0], [4.0, 0.0], [0.0, 4.0]],
+            inv_depth: [1.0, 0.5, 0.25],
+            intensity: i,
+            mesh: 0,
+            face: 0,
+        }
+    }
+
+    #[test]
+    fn affine_functions_reproduce_vertices_and_interpolate() {
+        let t = tri();
+        for k in 0..3 {
+            assert_eq!(t.inv_depth_at(t.points[k]), Some(t.inv_depth[k]));
+            assert_eq!(
+                t.intensity_at(t.points[k], 1).unwrap()[0],
+                t.intensity[k][0]
+            );
+        }
+        // midpoint of the hypotenuse
+        assert_eq!(t.inv_depth_at([2.0, 2.0]), Some(0.375));
+        assert_eq!(t.intensity_at([2.0, 2.0], 1).unwrap()[0], 4.0);
+        assert!(t.doubled_area() > 0.0);
+    }
+}

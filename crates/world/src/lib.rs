@@ -1,0 +1,198 @@
+//! # cwisim-world — 3D scenes for the Y-processor
+//!
+//! The host side that the CWI architecture assumes: the Y-processors receive objects
+//! whose hidden surfaces are already dealt with. This crate turns a 3D world scene into
+//! the screen-space polygons `cwisim-ypipe` scan-converts:
+//!
+//! 1. [`scene`] — world scene files (`"kind": "world"`): camera, lights, materials with
+//!    the report's `k_a`, `k_d`, `k_s`, `n`, meshes; [`mesh`] builds the meshes (inline,
+//!    [`obj`] files, surfaces of revolution) with normals per face corner.
+//! 2. [`project`] — transform and lighting: [`camera`] projection, back-face culling,
+//!    the report's formula ([`lighting`]) per vertex (Gouraud) or per face (flat):
+//!    [`face::ScreenTriangle`]s.
+//! 3. [`visibility`] — visible surfaces, two ways ([`Visibility`]): exact object-space
+//!    fragments (polygon booleans with `i_overlay`), or the triangles in front-to-back
+//!    order so that the array's `Eval0` claims hide farther ones.
+//! 4. [`to_screen`] — the result as a `cwisim_ypipe::scene::ScreenScene`.
+//!
+//! [`parse_any`] / [`load_any`] read any scene file (screen or world); [`embedded`] holds
+//! the scenes built into the binary.
+
+#![warn(missing_docs)]
+
+pub mod camera;
+pub mod embedded;
+pub mod face;
+pub mod lighting;
+pub mod mesh;
+pub mod obj;
+pub mod project;
+pub mod scene;
+pub mod visibility;
+
+use cwisim_ypipe::scene::{
+    parse_scene, read_kind, Polygon, Scene, SceneError, SceneErrorKind, ScreenScene,
+};
+use cwisim_ypipe::Shading;
+use std::path::Path;
+
+pub use project::ProjectStats;
+pub use scene::WorldScene;
+pub use visibility::VisibilityStats;
+
+/// The scene kinds `cwisim` reads.
+pub const KINDS: &[&str] = &["screen", "world"];
+
+/// A scene of any kind.
+#[derive(Clone, Debug, PartialEq)]
+pub enum AnyScene {
+    /// Polygons in screen space.
+    Screen(ScreenScene),
+    /// A 3D world.
+    World(WorldScene),
+}
+
+impl AnyScene {
+    /// `"screen"` or `"world"`.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            AnyScene::Screen(_) => "screen",
+            AnyScene::World(_) => "world",
+        }
+    }
+
+    /// The image size.
+    pub fn size(&self) -> (u32, u32) {
+        match self {
+            AnyScene::Screen(s) => (s.width, s.height),
+            AnyScene::World(w) => (w.width(), w.height()),
+        }
+    }
+
+    /// The same scene drawn at another size: a world scene's camera keeps its vertical
+    /// field of view; a screen scene's polygons are scaled (x by `width / old width`, y by
+    /// `height / old height`).
+    pub fn with_size(self, width: u32, height: u32) -> Result<AnyScene, SceneError> {
+        match self {
+            AnyScene::World(w) => Ok(AnyScene::World(w.with_size(width, height)?)),
+            AnyScene::Screen(mut s) => {
+                let (fx, fy) = (
+                    f64::from(width) / f64::from(s.width),
+                    f64::from(height) / f64::from(s.height),
+                );
+                for p in &mut s.polygons {
+                    for v in &mut p.vertices {
+                        *v = [v[0] * fx, v[1] * fy];
+                    }
+                }
+                s.width = width;
+                s.height = height;
+                s.validate()?;
+                Ok(AnyScene::Screen(s))
+            }
+        }
+    }
+}
+
+/// Reads a scene of any kind from JSON text. OBJ files named by a world scene are read
+/// relative to `base`.
+pub fn parse_any(text: &str, base: Option<&Path>) -> Result<AnyScene, SceneError> {
+    match read_kind(text, KINDS)?.as_str() {
+        "screen" => {
+            let Scene::Screen(s) = parse_scene(text)?;
+            Ok(AnyScene::Screen(s))
+        }
+        _ => Ok(AnyScene::World(scene::parse_world(text, base)?)),
+    }
+}
+
+/// Reads a scene file of any kind; errors name the file.
+pub fn load_any(path: &Path) -> Result<AnyScene, SceneError> {
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        SceneError::at_field(
+            SceneErrorKind::Io,
+            "",
+            format!("cannot read the scene: {e}"),
+        )
+        .in_file(path)
+    })?;
+    parse_any(&text, path.parent()).map_err(|e| match e.path {
+        Some(_) => e, // an OBJ file's error names that file
+        None => e.in_file(path),
+    })
+}
+
+/// How hidden surfaces are removed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Visibility {
+    /// In object space: each triangle minus what hides it, exactly
+    /// ([`visibility::exact_fragments`]).
+    #[default]
+    Exact,
+    /// By the array: whole triangles front to back, each claiming its fully covered
+    /// pixels with `Eval0` (set the Y-processor's `Claim::Eval0`).
+    Eval0,
+}
+
+/// A world scene made ready for the Y-processor.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Prepared {
+    /// The screen-space polygons, in the order to send them.
+    pub screen: ScreenScene,
+    /// What projection did.
+    pub project: ProjectStats,
+    /// What visibility did (exact only).
+    pub visibility: Option<VisibilityStats>,
+}
+
+/// The polygons to send for lit screen triangles, in order: exact visible fragments,
+/// or the whole triangles front to back ([`Visibility`]).
+pub fn resolve(
+    tris: &[face::ScreenTriangle],
+    channels: usize,
+    visibility: Visibility,
+) -> (Vec<Polygon>, Option<VisibilityStats>) {
+    match visibility {
+        Visibility::Exact => {
+            let (fragments, stats) = visibility::exact_fragments(tris, channels);
+            (
+                fragments.into_iter().map(|f| f.polygon).collect(),
+                Some(stats),
+            )
+        }
+        Visibility::Eval0 => (
+            visibility::front_to_back(tris)
+                .into_iter()
+                .map(|k| {
+                    let t = &tris[k];
+                    Polygon::new(
+                        t.points.to_vec(),
+                        t.intensity.iter().map(|i| i[..channels].to_vec()).collect(),
+                    )
+                })
+                .collect(),
+            None,
+        ),
+    }
+}
+
+/// Projects, lights and resolves the visibility of a world scene ([`project::project`],
+/// then [`resolve`]).
+pub fn to_screen(
+    scene: &WorldScene,
+    shading: Shading,
+    visibility: Visibility,
+) -> Result<Prepared, SceneError> {
+    let (tris, project) = project::project(scene, shading)?;
+    let (polygons, visibility) = resolve(&tris, scene.channels(), visibility);
+    Ok(Prepared {
+        screen: ScreenScene {
+            width: scene.width(),
+            height: scene.height(),
+            channels: scene.channels() as u8,
+            polygons,
+        },
+        project,
+        visibility,
+    })
+}

@@ -1,0 +1,544 @@
+//! Meshes: built from a scene's description (inline, OBJ, or a surface of revolution),
+//! placed in the world, checked, and given a normal at every face corner.
+//!
+//! Faces are convex polygons, counter-clockwise seen from the front. Polygons with more
+//! than three corners are drawn as a fan of triangles from their first corner
+//! ([`Face::triangles`]); a face whose fan would fold over (non-convex as seen from its
+//! first corner) is refused rather than drawn wrong. Planarity is not checked: a
+//! non-planar face is drawn as its fan.
+//!
+//! Normals: given ones (inline `normals`, OBJ `vn`) are used as they are (transformed);
+//! otherwise the normal at a corner is the area-weighted mean of the normals of the
+//! faces around that vertex that differ from this face's by less than the mesh's
+//! `crease_angle`, so smooth surfaces shade smoothly and creases stay sharp.
+
+use crate::obj;
+use crate::scene::{MeshSpec, Revolution, Scale, Transform};
+use cwisim_ypipe::scene::{SceneError, SceneErrorKind};
+use glam::{DMat3, DMat4, DQuat, DVec3, EulerRot};
+use std::path::Path;
+
+/// One face: its corners (indices into [`Mesh::positions`]) and a unit normal per corner.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Face {
+    /// Vertex indices, counter-clockwise seen from the front.
+    pub corners: Vec<u32>,
+    /// The shading normal at each corner (unit length).
+    pub normals: Vec<DVec3>,
+}
+
+impl Face {
+    /// The fan triangles `(0, k, k+1)` as corner positions within the face.
+    pub fn triangles(&self) -> impl Iterator<Item = [usize; 3]> + '_ {
+        (1..self.corners.len() - 1).map(|k| [0, k, k + 1])
+    }
+}
+
+/// A mesh in world space.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Mesh {
+    /// Its name (the scene's, or `mesh K`).
+    pub name: String,
+    /// Vertex positions.
+    pub positions: Vec<DVec3>,
+    /// Faces.
+    pub faces: Vec<Face>,
+}
+
+impl Mesh {
+    /// Triangles after fanning every face.
+    pub fn triangle_count(&self) -> usize {
+        self.faces.iter().map(|f| f.corners.len() - 2).sum()
+    }
+
+    /// The geometric (Newell) normal of face `f`, not normalized: its length is twice the
+    /// face's area.
+    pub fn face_normal(&self, f: usize) -> DVec3 {
+        newell(&self.faces[f].corners, &self.positions)
+    }
+}
+
+/// Why a mesh could not be built.
+#[derive(Debug)]
+pub enum BuildError {
+    /// A fault at a JSON path of the scene (to be located in the scene's text).
+    Scene(SceneError),
+    /// A fault in another file (already located there).
+    File(SceneError),
+}
+
+fn geometry(field: String, message: String) -> BuildError {
+    BuildError::Scene(SceneError::at_field(
+        SceneErrorKind::Geometry,
+        field,
+        message,
+    ))
+}
+
+fn newell(corners: &[u32], p: &[DVec3]) -> DVec3 {
+    let mut n = DVec3::ZERO;
+    let o = p[corners[0] as usize];
+    for k in 1..corners.len() - 1 {
+        let (a, b) = (p[corners[k] as usize] - o, p[corners[k + 1] as usize] - o);
+        n += a.cross(b);
+    }
+    n
+}
+
+/// The raw geometry of a source, before placement: positions, faces, optional normals
+/// per corner, and how to name a face in messages.
+#[derive(Debug)]
+pub(crate) struct Raw {
+    pub positions: Vec<DVec3>,
+    pub faces: Vec<Vec<u32>>,
+    pub normals: Option<Vec<Vec<DVec3>>>,
+}
+
+/// Builds mesh `k` of a scene.
+pub fn build(spec: &MeshSpec, k: usize, base: Option<&Path>) -> Result<Mesh, BuildError> {
+    let name = spec.name.clone().unwrap_or_else(|| format!("mesh {k}"));
+    let (raw, face_field): (Raw, Box<dyn Fn(usize) -> String>) = if let Some(r) = &spec.revolution {
+        (
+            revolution(r, k)?,
+            Box::new(move |f| format!("meshes[{k}].revolution (face {f})")),
+        )
+    } else if let Some(file) = &spec.obj {
+        let path = match base {
+            Some(b) => b.join(file),
+            None => Path::new(file).to_path_buf(),
+        };
+        let raw = obj::read(&path).map_err(BuildError::File)?;
+        let shown = file.clone();
+        (
+            raw,
+            Box::new(move |f| format!("meshes[{k}].obj (face {f} of {shown})")),
+        )
+    } else {
+        (
+            inline(spec, k)?,
+            Box::new(move |f| format!("meshes[{k}].faces[{f}]")),
+        )
+    };
+    if raw.faces.is_empty() {
+        return Err(geometry(
+            format!("meshes[{k}]"),
+            format!("mesh {name:?} has no faces"),
+        ));
+    }
+    let matrix = placement(&spec.transform);
+    let normal_matrix = DMat3::from_mat4(matrix).inverse().transpose();
+    let positions: Vec<DVec3> = raw
+        .positions
+        .iter()
+        .map(|p| matrix.transform_point3(*p))
+        .collect();
+    for (i, p) in positions.iter().enumerate() {
+        if !p.is_finite() || p.abs().max_element() > crate::scene::MAX_WORLD_COORDINATE {
+            return Err(BuildError::Scene(SceneError::at_field(
+                SceneErrorKind::Limit,
+                format!("meshes[{k}]"),
+                format!(
+                    "vertex {i} of mesh {name:?} lands at {p} after its transform, beyond ±1e9"
+                ),
+            )));
+        }
+    }
+    // checks: corners, degenerate and non-convex faces
+    let mut areas = Vec::with_capacity(raw.faces.len());
+    for (f, corners) in raw.faces.iter().enumerate() {
+        if corners.len() < 3 {
+            return Err(geometry(
+                face_field(f),
+                format!("a face needs at least 3 corners, found {}", corners.len()),
+            ));
+        }
+        let n = newell(corners, &positions);
+        let scale = corners
+            .iter()
+            .map(|&c| (positions[c as usize] - positions[corners[0] as usize]).length_squared())
+            .fold(0.0, f64::max);
+        if n.length() <= 1e-12 * scale || scale == 0.0 {
+            return Err(geometry(
+                face_field(f),
+                "degenerate face: its corners are collinear or coincide (zero area)".into(),
+            ));
+        }
+        if corners.len() > 3 {
+            let o = positions[corners[0] as usize];
+            for c in 1..corners.len() - 1 {
+                let t = (positions[corners[c] as usize] - o)
+                    .cross(positions[corners[c + 1] as usize] - o);
+                if t.dot(n) < -1e-12 * scale {
+                    return Err(geometry(
+                        face_field(f),
+                        format!(
+                            "non-convex face ({} corners): the fan of triangles from its first corner would fold over; split it into triangles or convex faces",
+                            corners.len()
+                        ),
+                    ));
+                }
+            }
+        }
+        areas.push(n);
+    }
+    let faces = match raw.normals {
+        Some(given) => raw
+            .faces
+            .into_iter()
+            .zip(given)
+            .map(|(corners, ns)| Face {
+                corners,
+                normals: ns
+                    .into_iter()
+                    .map(|n| (normal_matrix * n).normalize_or_zero())
+                    .collect(),
+            })
+            .collect(),
+        None => smooth_normals(raw.faces, &areas, positions.len(), spec.crease_angle),
+    };
+    for (f, face) in faces.iter().enumerate() {
+        if face
+            .normals
+            .iter()
+            .any(|n| *n == DVec3::ZERO || !n.is_finite())
+        {
+            return Err(geometry(
+                face_field(f),
+                "a given normal is zero or not finite".into(),
+            ));
+        }
+    }
+    Ok(Mesh {
+        name,
+        positions,
+        faces,
+    })
+}
+
+/// Scale, then rotate (x, then y, then z), then translate.
+fn placement(t: &Transform) -> DMat4 {
+    let scale = match t.scale {
+        None => DVec3::ONE,
+        Some(Scale::Uniform(s)) => DVec3::splat(s),
+        Some(Scale::Axes(s)) => DVec3::from_array(s),
+    };
+    let r = t.rotate.unwrap_or([0.0; 3]).map(f64::to_radians);
+    // extrinsic x, then y, then z: R = Rz · Ry · Rx
+    let rotation = DQuat::from_euler(EulerRot::ZYX, r[2], r[1], r[0]);
+    let translation = DVec3::from_array(t.translate.unwrap_or([0.0; 3]));
+    DMat4::from_scale_rotation_translation(scale, rotation, translation)
+}
+
+/// Normals per corner from the faces around each vertex within the crease angle.
+fn smooth_normals(
+    faces: Vec<Vec<u32>>,
+    newell: &[DVec3],
+    vertices: usize,
+    crease_degrees: f64,
+) -> Vec<Face> {
+    let mut around: Vec<Vec<u32>> = vec![Vec::new(); vertices];
+    for (f, corners) in faces.iter().enumerate() {
+        for &c in corners {
+            if around[c as usize].last() != Some(&(f as u32)) {
+                around[c as usize].push(f as u32);
+            }
+        }
+    }
+    let cos_crease = crease_degrees.to_radians().cos();
+    let unit: Vec<DVec3> = newell.iter().map(|n| n.normalize()).collect();
+    faces
+        .into_iter()
+        .enumerate()
+        .map(|(f, corners)| {
+            let normals = corners
+                .iter()
+                .map(|&c| {
+                    let mut sum = DVec3::ZERO;
+                    for &g in &around[c as usize] {
+                        let g = g as usize;
+                        if g == f || unit[g].dot(unit[f]) > cos_crease {
+                            sum += newell[g];
+                        }
+                    }
+                    sum.normalize_or(unit[f])
+                })
+                .collect();
+            Face { corners, normals }
+        })
+        .collect()
+}
+
+fn inline(spec: &MeshSpec, k: usize) -> Result<Raw, BuildError> {
+    let vertices = spec.vertices.as_deref().unwrap_or_default();
+    let faces = spec.faces.as_deref().unwrap_or_default();
+    if vertices.is_empty() {
+        return Err(BuildError::Scene(SceneError::at_field(
+            SceneErrorKind::Shape,
+            format!("meshes[{k}].vertices"),
+            "an inline mesh needs at least 3 vertices, found none",
+        )));
+    }
+    for (i, v) in vertices.iter().enumerate() {
+        crate::scene::check_point(&format!("meshes[{k}].vertices[{i}]"), *v)
+            .map_err(BuildError::Scene)?;
+    }
+    let mut out_faces = Vec::with_capacity(faces.len());
+    for (f, face) in faces.iter().enumerate() {
+        let mut corners = Vec::with_capacity(face.len());
+        for (c, &i) in face.iter().enumerate() {
+            if i >= vertices.len() as u64 {
+                return Err(BuildError::Scene(SceneError::at_field(
+                    SceneErrorKind::Shape,
+                    format!("meshes[{k}].faces[{f}][{c}]"),
+                    format!(
+                        "vertex index {i} is out of range: the mesh has {} vertices (indices from 0)",
+                        vertices.len()
+                    ),
+                )));
+            }
+            corners.push(i as u32);
+        }
+        out_faces.push(corners);
+    }
+    let normals = match &spec.normals {
+        None => None,
+        Some(ns) => {
+            if ns.len() != vertices.len() {
+                return Err(BuildError::Scene(SceneError::at_field(
+                    SceneErrorKind::Shape,
+                    format!("meshes[{k}].normals"),
+                    format!(
+                        "expected one normal per vertex ({}), found {}",
+                        vertices.len(),
+                        ns.len()
+                    ),
+                )));
+            }
+            for (i, n) in ns.iter().enumerate() {
+                crate::scene::check_point(&format!("meshes[{k}].normals[{i}]"), *n)
+                    .map_err(BuildError::Scene)?;
+            }
+            Some(
+                out_faces
+                    .iter()
+                    .map(|corners| {
+                        corners
+                            .iter()
+                            .map(|&c| DVec3::from_array(ns[c as usize]))
+                            .collect()
+                    })
+                    .collect(),
+            )
+        }
+    };
+    Ok(Raw {
+        positions: vertices.iter().map(|v| DVec3::from_array(*v)).collect(),
+        faces: out_faces,
+        normals,
+    })
+}
+
+/// The most segments around the axis.
+pub const MAX_SEGMENTS: u32 = 1024;
+
+/// A surface of revolution about the y axis: a ring of `segments` vertices per profile
+/// point off the axis, one vertex per point on it; trapezia between two rings, triangles
+/// between a ring and the axis. The front is on the right of the profile traversed in
+/// order, in the (radius → right, height → up) plane: a profile that starts on the axis
+/// at the bottom and climbs outward faces outward.
+pub(crate) fn revolution(r: &Revolution, k: usize) -> Result<Raw, BuildError> {
+    let field = |s: &str| format!("meshes[{k}].revolution.{s}");
+    if !(3..=MAX_SEGMENTS).contains(&r.segments) {
+        return Err(BuildError::Scene(SceneError::at_field(
+            SceneErrorKind::Limit,
+            field("segments"),
+            format!("expected 3..={MAX_SEGMENTS} segments, found {}", r.segments),
+        )));
+    }
+    if r.profile.len() < 2 {
+        return Err(BuildError::Scene(SceneError::at_field(
+            SceneErrorKind::Shape,
+            field("profile"),
+            format!(
+                "a profile needs at least 2 points, found {}",
+                r.profile.len()
+            ),
+        )));
+    }
+    for (i, p) in r.profile.iter().enumerate() {
+        let f = field(&format!("profile[{i}]"));
+        crate::scene::check_point(&f, [p[0], p[1], 0.0]).map_err(BuildError::Scene)?;
+        if p[0] < 0.0 {
+            return Err(BuildError::Scene(SceneError::at_field(
+                SceneErrorKind::Shape,
+                f,
+                format!("a radius must be ≥ 0, found {}", p[0]),
+            )));
+        }
+        if i > 0 && r.profile[i - 1] == *p {
+            return Err(geometry(
+                f,
+                format!("profile points {} and {i} coincide", i - 1),
+            ));
+        }
+        if i > 0 && p[0] == 0.0 && r.profile[i - 1][0] == 0.0 {
+            return Err(geometry(
+                f,
+                format!(
+                    "profile points {} and {i} both lie on the axis: that segment has no surface",
+                    i - 1
+                ),
+            ));
+        }
+    }
+    let s = r.segments as usize;
+    let mut positions = Vec::new();
+    // first vertex index of each profile point's ring (a ring of 1 on the axis)
+    let mut rings = Vec::with_capacity(r.profile.len());
+    for p in &r.profile {
+        rings.push(positions.len() as u32);
+        if p[0] == 0.0 {
+            positions.push(DVec3::new(0.0, p[1], 0.0));
+        } else {
+            for j in 0..s {
+                let a = std::f64::consts::TAU * j as f64 / s as f64;
+                positions.push(DVec3::new(p[0] * a.cos(), p[1], -p[0] * a.sin()));
+            }
+        }
+    }
+    let at = |i: usize, j: usize| -> u32 {
+        if r.profile[i][0] == 0.0 {
+            rings[i]
+        } else {
+            rings[i] + (j % s) as u32
+        }
+    };
+    let mut faces = Vec::new();
+    for i in 0..r.profile.len() - 1 {
+        let (p, q) = (r.profile[i], r.profile[i + 1]);
+        for j in 0..s {
+            let mut face: Vec<u32> = vec![at(i, j), at(i, j + 1), at(i + 1, j + 1), at(i + 1, j)];
+            face.dedup();
+            if face.first() == face.last() {
+                face.pop();
+            }
+            // orient: the outward normal of the profile segment, turned to this segment
+            let a = std::f64::consts::TAU * (j as f64 + 0.5) / s as f64;
+            let (dr, dh) = (q[0] - p[0], q[1] - p[1]);
+            let expected = DVec3::new(dh * a.cos(), -dr, -dh * a.sin());
+            if newell(&face, &positions).dot(expected) < 0.0 {
+                face.reverse();
+            }
+            faces.push(face);
+        }
+    }
+    Ok(Raw {
+        positions,
+        faces,
+        normals: None,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Material, PerChannel};
+
+    fn spec() -> MeshSpec {
+        MeshSpec {
+            name: None,
+            material: Material {
+                k_a: PerChannel::All(0.1),
+                k_d: PerChannel::All(0.5),
+                k_s: PerChannel::All(0.0),
+                n: 1.0,
+            },
+            two_sided: false,
+            crease_angle: 50.0,
+            transform: Transform::default(),
+            vertices: None,
+            faces: None,
+            normals: None,
+            obj: None,
+            revolution: None,
+        }
+    }
+
+    #[test]
+    fn a_revolved_cylinder_faces_outward_and_is_smooth_around_sharp_at_the_base() {
+        let mut m = spec();
+        m.revolution = Some(Revolution {
+            profile: vec![[0.0, 0.0], [1.0, 0.0], [1.0, 2.0]],
+            segments: 16,
+        });
+        let mesh = build(&m, 0, None).unwrap();
+        assert_eq!(mesh.faces.len(), 32);
+        // base triangles face down, side trapezia face outward
+        for (f, face) in mesh.faces.iter().enumerate() {
+            let n = mesh.face_normal(f).normalize();
+            let centre: DVec3 = face
+                .corners
+                .iter()
+                .map(|&c| mesh.positions[c as usize])
+                .sum::<DVec3>()
+                / face.corners.len() as f64;
+            if f < 16 {
+                assert_eq!(face.corners.len(), 3);
+                assert!(n.y < -0.999, "{n}");
+                // the 90° base edge is a crease: normals there stay the base's
+                assert!(face.normals.iter().all(|m| m.y < -0.999));
+            } else {
+                assert_eq!(face.corners.len(), 4);
+                let radial = DVec3::new(centre.x, 0.0, centre.z).normalize();
+                assert!(n.dot(radial) > 0.98, "{n} {radial}");
+                // smooth around: each corner normal is the radial direction of its vertex
+                for (c, m) in face.corners.iter().zip(&face.normals) {
+                    let p = mesh.positions[*c as usize];
+                    let radial = DVec3::new(p.x, 0.0, p.z).normalize();
+                    assert!((m.dot(radial) - 1.0).abs() < 1e-12, "{m} {radial}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn degenerate_and_non_convex_faces_are_refused_with_their_path() {
+        let mut m = spec();
+        m.vertices = Some(vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]]);
+        m.faces = Some(vec![vec![0, 1, 2]]);
+        let Err(BuildError::Scene(e)) = build(&m, 3, None) else {
+            panic!()
+        };
+        assert_eq!(e.field.as_deref(), Some("meshes[3].faces[0]"));
+        assert!(e.message.contains("degenerate"), "{e}");
+        m.vertices = Some(vec![
+            [0.0, 0.0, 0.0],
+            [2.0, 0.0, 0.0],
+            [2.0, 2.0, 0.0],
+            [1.0, 0.5, 0.0],
+            [0.0, 2.0, 0.0],
+        ]);
+        m.faces = Some(vec![vec![0, 1, 2, 3, 4]]);
+        let Err(BuildError::Scene(e)) = build(&m, 0, None) else {
+            panic!()
+        };
+        assert!(e.message.contains("non-convex"), "{e}");
+        m.faces = Some(vec![vec![0, 1, 7]]);
+        let Err(BuildError::Scene(e)) = build(&m, 0, None) else {
+            panic!()
+        };
+        assert_eq!(e.field.as_deref(), Some("meshes[0].faces[0][2]"));
+    }
+
+    #[test]
+    fn transforms_scale_then_rotate_then_translate() {
+        let t = Transform {
+            scale: Some(Scale::Uniform(2.0)),
+            rotate: Some([0.0, 90.0, 0.0]),
+            translate: Some([1.0, 0.0, 0.0]),
+        };
+        let p = placement(&t).transform_point3(DVec3::X);
+        // scaled to (2,0,0), turned 90° about y to (0,0,-2), moved to (1,0,-2)
+        assert!((p - DVec3::new(1.0, 0.0, -2.0)).length() < 1e-12, "{p}");
+    }
+}

@@ -1,0 +1,295 @@
+//! Wavefront OBJ meshes, read with `tobj`.
+//!
+//! Positions (`v`), faces (`f`, any number of corners, negative indices allowed) and
+//! normals (`vn`, used when every corner of the file names one) are read; texture
+//! coordinates, materials (`mtllib`, `usemtl`: the scene gives the material), points and
+//! lines are ignored. All objects and groups of the file become one mesh.
+//!
+//! `tobj` stops at the first bad line but does not say which; this module counts the
+//! lines it hands to `tobj`, so every error names the file and line.
+
+use crate::mesh::Raw;
+use cwisim_ypipe::scene::{SceneError, SceneErrorKind};
+use glam::DVec3;
+use std::io::{BufRead, Cursor, Read};
+use std::path::Path;
+
+/// The largest OBJ file read (bytes).
+pub const MAX_OBJ_BYTES: u64 = 512 << 20;
+
+/// A `BufRead` that counts the lines consumed through it.
+struct Counting<R> {
+    inner: R,
+    newlines: u64,
+    partial: bool,
+    at_end: bool,
+}
+
+impl<R: BufRead> Read for Counting<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = {
+            let available = self.fill_buf()?;
+            let n = available.len().min(buf.len());
+            buf[..n].copy_from_slice(&available[..n]);
+            n
+        };
+        self.consume(n);
+        Ok(n)
+    }
+}
+
+impl<R: BufRead> BufRead for Counting<R> {
+    fn fill_buf(&mut self) -> std::io::Result<&[u8]> {
+        let buf = self.inner.fill_buf()?;
+        if buf.is_empty() {
+            self.at_end = true;
+        }
+        Ok(buf)
+    }
+
+    fn consume(&mut self, amt: usize) {
+        if let Ok(buf) = self.inner.fill_buf() {
+            let taken = &buf[..amt.min(buf.len())];
+            let newlines = taken.iter().filter(|&&b| b == b'\n').count() as u64;
+            self.newlines += newlines;
+            if let Some(last) = taken.iter().rposition(|&b| b == b'\n') {
+                self.partial = last + 1 < taken.len();
+            } else if !taken.is_empty() {
+                self.partial = true;
+            }
+        }
+        self.inner.consume(amt);
+    }
+}
+
+fn error(path: &Path, line: Option<u64>, message: String) -> SceneError {
+    SceneError {
+        path: Some(path.to_path_buf()),
+        line,
+        column: line.map(|_| 1),
+        field: None,
+        kind: SceneErrorKind::Shape,
+        message,
+    }
+}
+
+/// The first `f` line naming a vertex or normal that is not defined before it.
+fn first_bad_index(text: &str) -> Option<u64> {
+    let (mut v, mut vn) = (0i64, 0i64);
+    for (n, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("v") => v += 1,
+            Some("vn") => vn += 1,
+            Some("f") => {
+                for corner in words {
+                    let mut parts = corner.split('/');
+                    let bad = |part: Option<&str>, count: i64| match part {
+                        Some(p) if !p.is_empty() => p
+                            .parse::<i64>()
+                            .map_or(true, |i| i == 0 || i > count || -i > count),
+                        _ => false,
+                    };
+                    let (pv, _, pn) = (parts.next(), parts.next(), parts.next());
+                    if bad(pv, v) || bad(pn, vn) {
+                        return Some(n as u64 + 1);
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    None
+}
+
+/// Reads an OBJ file into positions, faces and (when complete) per-corner normals.
+pub(crate) fn read(path: &Path) -> Result<Raw, SceneError> {
+    let io = |e: std::io::Error| SceneError {
+        kind: SceneErrorKind::Io,
+        ..error(path, None, format!("cannot read the OBJ file: {e}"))
+    };
+    let file = std::fs::File::open(path).map_err(io)?;
+    let mut bytes = Vec::new();
+    file.take(MAX_OBJ_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(io)?;
+    if bytes.len() as u64 > MAX_OBJ_BYTES {
+        return Err(SceneError {
+            kind: SceneErrorKind::Limit,
+            ..error(
+                path,
+                None,
+                format!("the OBJ file is larger than {MAX_OBJ_BYTES} bytes"),
+            )
+        });
+    }
+    let mut reader = Counting {
+        inner: Cursor::new(&bytes),
+        newlines: 0,
+        partial: false,
+        at_end: false,
+    };
+    let options = tobj::LoadOptions {
+        ignore_points: true,
+        ignore_lines: true,
+        ..Default::default()
+    };
+    let loaded = tobj::load_obj_buf(&mut reader, &options, |_| {
+        Ok((Vec::new(), Default::default()))
+    });
+    let models = match loaded {
+        Ok((models, _materials)) => models,
+        Err(e) => {
+            let line = if reader.at_end {
+                // tobj checks some things only once the whole file is read
+                first_bad_index(&String::from_utf8_lossy(&bytes))
+            } else {
+                Some(reader.newlines + u64::from(reader.partial))
+            };
+            let what = match e {
+                tobj::LoadError::PositionParseError => {
+                    "expected a position `v x y z` with 3 (or 4) numbers".into()
+                }
+                tobj::LoadError::NormalParseError => {
+                    "expected a normal `vn x y z` with 3 numbers".into()
+                }
+                tobj::LoadError::FaceParseError | tobj::LoadError::InvalidPolygon => {
+                    "expected a face `f i j k …` of vertex indices (v, v/t, v//n or v/t/n)".into()
+                }
+                tobj::LoadError::FaceVertexOutOfBounds => {
+                    "a face names a vertex that is not defined before it".into()
+                }
+                tobj::LoadError::FaceNormalOutOfBounds => {
+                    "a face names a normal that is not defined before it".into()
+                }
+                other => format!("not a valid OBJ file ({other})"),
+            };
+            return Err(error(path, line, what));
+        }
+    };
+    // the `v` and `vn` lines, to locate non-finite values
+    let text = String::from_utf8_lossy(&bytes);
+    let statement_line = |keyword: &str, index: usize| -> Option<u64> {
+        text.lines()
+            .enumerate()
+            .filter(|(_, l)| l.split_whitespace().next() == Some(keyword))
+            .nth(index)
+            .map(|(n, _)| n as u64 + 1)
+    };
+    let mut positions = Vec::new();
+    let mut faces = Vec::new();
+    let mut normals: Vec<Vec<DVec3>> = Vec::new();
+    let mut all_have_normals = true;
+    let (mut v_seen, mut vn_seen) = (0usize, 0usize);
+    for model in &models {
+        let m = &model.mesh;
+        let base = positions.len() as u32;
+        for (i, p) in m.positions.chunks_exact(3).enumerate() {
+            let v = DVec3::new(p[0], p[1], p[2]);
+            if !v.is_finite() {
+                return Err(SceneError {
+                    kind: SceneErrorKind::NonFinite,
+                    ..error(
+                        path,
+                        statement_line("v", v_seen + i),
+                        format!("expected finite coordinates, found {v}"),
+                    )
+                });
+            }
+            positions.push(v);
+        }
+        v_seen += m.positions.len() / 3;
+        let mesh_normals: Vec<DVec3> = m
+            .normals
+            .chunks_exact(3)
+            .map(|n| DVec3::new(n[0], n[1], n[2]))
+            .collect();
+        if let Some(bad) = mesh_normals.iter().position(|n| !n.is_finite()) {
+            return Err(SceneError {
+                kind: SceneErrorKind::NonFinite,
+                ..error(
+                    path,
+                    statement_line("vn", vn_seen + bad),
+                    "expected a finite normal".into(),
+                )
+            });
+        }
+        vn_seen += mesh_normals.len();
+        let arities: Vec<u32> = if m.face_arities.is_empty() {
+            vec![3; m.indices.len() / 3]
+        } else {
+            m.face_arities.clone()
+        };
+        let has_normals = m.normal_indices.len() == m.indices.len() && !mesh_normals.is_empty();
+        all_have_normals &= has_normals;
+        let mut at = 0usize;
+        for arity in arities {
+            let range = at..at + arity as usize;
+            faces.push(m.indices[range.clone()].iter().map(|i| base + i).collect());
+            if has_normals {
+                normals.push(
+                    m.normal_indices[range]
+                        .iter()
+                        .map(|&n| mesh_normals[n as usize])
+                        .collect(),
+                );
+            }
+            at += arity as usize;
+        }
+    }
+    Ok(Raw {
+        positions,
+        faces,
+        normals: (all_have_normals && !normals.is_empty()).then_some(normals),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn write(name: &str, text: &str) -> std::path::PathBuf {
+        let dir = std::env::temp_dir().join(format!("cwisim-obj-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    }
+
+    #[test]
+    fn reads_quads_triangles_negative_indices_and_normals() {
+        let p = write(
+            "ok.obj",
+            "# a square and a triangle\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\n\
+             f 1//1 2//1 3//1 4//1\nf -4//1 -3//1 -1//1\n",
+        );
+        let raw = read(&p).unwrap();
+        assert_eq!(raw.positions.len(), 4);
+        assert_eq!(raw.faces, vec![vec![0, 1, 2, 3], vec![0, 1, 3]]);
+        assert_eq!(raw.normals.unwrap()[1], vec![DVec3::Z; 3]);
+    }
+
+    #[test]
+    fn errors_name_the_line() {
+        let p = write("bad.obj", "v 0 0 0\nv 1 0 0\nv 1 x 0\nf 1 2 3\n");
+        let e = read(&p).unwrap_err();
+        assert_eq!(e.line, Some(3), "{e}");
+        assert!(
+            e.to_string().contains("bad.obj:3:1: expected a position"),
+            "{e}"
+        );
+        let p = write("oob.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\nf 1 2 9\n");
+        let e = read(&p).unwrap_err();
+        assert_eq!(e.line, Some(5), "{e}");
+        let p = write(
+            "nan.obj",
+            "v 0 0 0\nvn 0 0 1\nv NaN 0 0\nv 1 1 0\nf 1 2 3\n",
+        );
+        let e = read(&p).unwrap_err();
+        assert_eq!(
+            (e.line, e.kind),
+            (Some(3), SceneErrorKind::NonFinite),
+            "{e}"
+        );
+    }
+}

@@ -1,0 +1,157 @@
+//! Transform and lighting: a world scene's meshes become lit screen triangles, with back
+//! faces culled.
+//!
+//! For every face: each fan triangle is **front-facing** when its geometric normal points
+//! to the eye (`n · (eye − p) > 0`); back-facing ones are dropped, unless the mesh is
+//! `two_sided`, in which case they are kept and lit with their normals turned to the
+//! viewer (the inside of an open pot). Intensities follow the report's formula
+//! ([`crate::lighting`]):
+//!
+//! * Gouraud — at every corner, with the corner's shading normal;
+//! * flat — once per face, at its centroid with its geometric normal (the report: "one
+//!   intensity is calculated for each polygon"), the same value at all corners.
+
+use crate::camera::Camera;
+use crate::face::ScreenTriangle;
+use crate::lighting::Lighting;
+use crate::mesh::Mesh;
+use crate::scene::WorldScene;
+use cwisim_ypipe::scene::{SceneError, SceneErrorKind, MAX_COORDINATE};
+use cwisim_ypipe::Shading;
+use glam::DVec3;
+
+/// What projection did.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct ProjectStats {
+    /// Meshes.
+    pub meshes: u64,
+    /// Faces of all meshes.
+    pub faces: u64,
+    /// Triangles after fanning the faces.
+    pub triangles: u64,
+    /// Back-facing triangles dropped.
+    pub culled: u64,
+    /// Back-facing triangles kept (two-sided meshes).
+    pub back_faces_drawn: u64,
+    /// Triangles seen exactly edge-on (zero area on the screen), dropped.
+    pub edge_on: u64,
+}
+
+/// Refuses a mesh with a vertex nearer than the camera's near distance, or behind it:
+/// the camera is inside or behind the object (there is no near-plane clipping).
+pub fn check_in_front(camera: &Camera, mesh: &Mesh, k: usize) -> Result<(), SceneError> {
+    for (i, &p) in mesh.positions.iter().enumerate() {
+        let depth = camera.depth(p);
+        if depth < camera.near {
+            return Err(SceneError::at_field(
+                SceneErrorKind::Geometry,
+                format!("meshes[{k}]"),
+                format!(
+                    "vertex {i} of mesh {:?} at {p} is {} the camera (depth {depth:.6}, near {}): the camera is inside or behind the object; move the camera (there is no near-plane clipping)",
+                    mesh.name,
+                    if depth < 0.0 { "behind" } else { "too close to" },
+                    camera.near
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The lit screen triangles of a scene, in mesh and face order.
+pub fn project(
+    scene: &WorldScene,
+    shading: Shading,
+) -> Result<(Vec<ScreenTriangle>, ProjectStats), SceneError> {
+    let spec = &scene.spec;
+    let channels = scene.channels();
+    let camera = Camera::new(&spec.camera, scene.width(), scene.height());
+    let lighting = Lighting {
+        ambient: spec.ambient.clone(),
+        lights: spec.lights.clone(),
+        channels,
+    };
+    let mut stats = ProjectStats {
+        meshes: scene.meshes.len() as u64,
+        ..ProjectStats::default()
+    };
+    let mut out = Vec::new();
+    for (k, (mesh, mspec)) in scene.meshes.iter().zip(&spec.meshes).enumerate() {
+        check_in_front(&camera, mesh, k)?;
+        // every vertex on a representable screen position
+        let mut screen = Vec::with_capacity(mesh.positions.len());
+        for (i, &p) in mesh.positions.iter().enumerate() {
+            let s = camera.project(p);
+            if !(s[0].abs() <= MAX_COORDINATE && s[1].abs() <= MAX_COORDINATE) {
+                return Err(SceneError::at_field(
+                    SceneErrorKind::Limit,
+                    format!("meshes[{k}]"),
+                    format!(
+                        "vertex {i} of mesh {:?} projects to {s:?}, beyond ±{MAX_COORDINATE:e} pixels: it is nearly in the camera's plane",
+                        mesh.name
+                    ),
+                ));
+            }
+            screen.push(s);
+        }
+        let material = &mspec.material;
+        for (f, face) in mesh.faces.iter().enumerate() {
+            stats.faces += 1;
+            let flat = (shading == Shading::Flat).then(|| {
+                let centroid = face
+                    .corners
+                    .iter()
+                    .map(|&c| mesh.positions[c as usize])
+                    .sum::<DVec3>()
+                    / face.corners.len() as f64;
+                let n = mesh.face_normal(f).normalize();
+                (centroid, n)
+            });
+            for tri in face.triangles() {
+                stats.triangles += 1;
+                let idx = tri.map(|c| face.corners[c] as usize);
+                let p = idx.map(|i| mesh.positions[i]);
+                let normal = (p[1] - p[0]).cross(p[2] - p[0]);
+                let facing = normal.dot(camera.eye - p[0]);
+                let back = facing <= 0.0;
+                if back && !mspec.two_sided {
+                    stats.culled += 1;
+                    continue;
+                }
+                let points = idx.map(|i| screen[i]);
+                let doubled = (points[1][0] - points[0][0]) * (points[2][1] - points[0][1])
+                    - (points[2][0] - points[0][0]) * (points[1][1] - points[0][1]);
+                if doubled == 0.0 || facing == 0.0 {
+                    stats.edge_on += 1;
+                    continue;
+                }
+                if back {
+                    stats.back_faces_drawn += 1;
+                }
+                let toward = if back { -1.0 } else { 1.0 };
+                let intensity = match flat {
+                    Some((centroid, n)) => {
+                        let i = lighting.intensity(material, centroid, toward * n, camera.eye);
+                        [i; 3]
+                    }
+                    None => std::array::from_fn(|c| {
+                        lighting.intensity(
+                            material,
+                            p[c],
+                            toward * face.normals[tri[c]],
+                            camera.eye,
+                        )
+                    }),
+                };
+                out.push(ScreenTriangle {
+                    points,
+                    inv_depth: p.map(|q| 1.0 / camera.depth(q)),
+                    intensity,
+                    mesh: k as u32,
+                    face: f as u32,
+                });
+            }
+        }
+    }
+    Ok((out, stats))
+}

@@ -1,0 +1,531 @@
+//! World scene files: `"kind": "world"`.
+//!
+//! A world scene is a camera, lights and meshes in 3D, with the report's reflection
+//! coefficients per mesh (van Rij, section 1.2). Every number that is an intensity or a
+//! coefficient may be one number (the same in every channel) or an array of `channels`
+//! numbers (per channel: RGB for `"channels": 3`).
+//!
+//! ```json
+//! {
+//!   "kind": "world",
+//!   "width": 320, "height": 240, "channels": 1,
+//!   "camera": { "eye": [0, 2.2, 5], "target": [0, 0.8, 0], "up": [0, 1, 0], "fov_y": 35 },
+//!   "ambient": 0.3,
+//!   "lights": [ { "position": [4, 6, 5], "intensity": 0.9 } ],
+//!   "meshes": [
+//!     { "name": "pot",
+//!       "material": { "k_a": 0.4, "k_d": 0.7, "k_s": 0.4, "n": 16 },
+//!       "two_sided": true,
+//!       "revolution": { "profile": [[0, 0], [0.6, 0], [1, 0.7], [0.5, 1.4]], "segments": 24 } },
+//!     { "name": "floor",
+//!       "material": { "k_a": 0.5, "k_d": 0.5, "k_s": 0, "n": 1 },
+//!       "vertices": [[-2, 0, -2], [-2, 0, 2], [2, 0, 2], [2, 0, -2]],
+//!       "faces": [[0, 1, 2, 3]] },
+//!     { "name": "teapot", "material": { "k_a": 0.3, "k_d": 0.6, "k_s": 0.5, "n": 30 },
+//!       "obj": "teapot.obj", "transform": { "translate": [1.5, 0, 0], "scale": 0.5 } }
+//!   ]
+//! }
+//! ```
+//!
+//! The full reference, with every key, is `docs/SCENES.md`. [`parse_world`] reads and
+//! checks a scene and builds its meshes ([`crate::mesh`]); every fault is a located
+//! [`SceneError`], as for screen scenes.
+
+use crate::mesh::{self, Mesh};
+use cwisim_ypipe::scene::{
+    json_error, locate_error, SceneError, SceneErrorKind, MAX_CHANNELS, MAX_SIDE, MAX_VALUES,
+};
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// The largest coordinate magnitude accepted in world space.
+pub const MAX_WORLD_COORDINATE: f64 = 1e9;
+/// The most triangles a scene may hold after its meshes are built.
+pub const MAX_TRIANGLES: usize = 4_000_000;
+
+/// One number for every channel, or one per channel.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum PerChannel {
+    /// The same value in every channel.
+    All(f64),
+    /// One value per channel.
+    Each(Vec<f64>),
+}
+
+impl PerChannel {
+    /// The value in channel `c`.
+    pub fn get(&self, c: usize) -> f64 {
+        match self {
+            PerChannel::All(v) => *v,
+            PerChannel::Each(v) => v[c],
+        }
+    }
+
+    fn check(&self, field: &str, channels: usize, min: f64) -> Result<(), SceneError> {
+        let values: Vec<f64> = match self {
+            PerChannel::All(v) => vec![*v],
+            PerChannel::Each(v) => {
+                if v.len() != channels {
+                    return Err(SceneError::at_field(
+                        SceneErrorKind::Shape,
+                        field,
+                        format!(
+                            "expected one number or {channels} (the scene's channels), found {}",
+                            v.len()
+                        ),
+                    ));
+                }
+                v.clone()
+            }
+        };
+        for v in values {
+            finite(field, v)?;
+            if v < min {
+                return Err(SceneError::at_field(
+                    SceneErrorKind::Limit,
+                    field,
+                    format!("expected a value ≥ {min}, found {v}"),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The pinhole camera.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraSpec {
+    /// Where the camera is.
+    pub eye: [f64; 3],
+    /// The point it looks at (the image centre).
+    pub target: [f64; 3],
+    /// Which way is up (need not be perpendicular to the view direction).
+    #[serde(default = "default_up")]
+    pub up: [f64; 3],
+    /// The vertical field of view, degrees, in `(0, 180)`.
+    pub fov_y: f64,
+    /// The near plane: every vertex must be at least this far in front of the camera.
+    #[serde(default = "default_near")]
+    pub near: f64,
+}
+
+fn default_up() -> [f64; 3] {
+    [0.0, 1.0, 0.0]
+}
+
+fn default_near() -> f64 {
+    1e-3
+}
+
+/// A point light source.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LightSpec {
+    /// Where it is.
+    pub position: [f64; 3],
+    /// `I_l`.
+    pub intensity: PerChannel,
+}
+
+/// The reflection coefficients of the report's formula.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Material {
+    /// Ambient reflection `k_a`.
+    pub k_a: PerChannel,
+    /// Diffuse reflection `k_d` (the object's colour).
+    pub k_d: PerChannel,
+    /// Specular reflection `k_s`.
+    pub k_s: PerChannel,
+    /// Specular exponent `n` (shininess), ≥ 0.
+    pub n: f64,
+}
+
+/// A placement: scale, then rotate (degrees about x, then y, then z), then translate.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Transform {
+    /// Scale: one factor, or one per axis.
+    #[serde(default)]
+    pub scale: Option<Scale>,
+    /// Rotation in degrees about the x, y and z axes, applied in that order.
+    #[serde(default)]
+    pub rotate: Option<[f64; 3]>,
+    /// Translation.
+    #[serde(default)]
+    pub translate: Option<[f64; 3]>,
+}
+
+/// A uniform or per-axis scale.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Scale {
+    /// The same factor on every axis.
+    Uniform(f64),
+    /// One factor per axis.
+    Axes([f64; 3]),
+}
+
+/// A surface of revolution about the y axis.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Revolution {
+    /// The profile `[radius, height]`, from one end to the other. A point with radius 0
+    /// lies on the axis: the faces there are triangles, elsewhere trapezia.
+    pub profile: Vec<[f64; 2]>,
+    /// Faces around the axis, `3..=1024`.
+    pub segments: u32,
+}
+
+/// One mesh: where its geometry comes from, its material, and how it is placed.
+///
+/// Exactly one geometry source: `vertices` + `faces` (inline), `obj` (a Wavefront OBJ
+/// file, relative to the scene file), or `revolution`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshSpec {
+    /// A name for messages and statistics.
+    #[serde(default)]
+    pub name: Option<String>,
+    /// The reflection coefficients.
+    pub material: Material,
+    /// Draw back faces too (lit with the normal turned to the viewer), for open surfaces
+    /// whose inside shows.
+    #[serde(default)]
+    pub two_sided: bool,
+    /// Normals at a vertex are averaged over its faces whose normals differ by less than
+    /// this angle (degrees); sharper edges stay sharp. 0: faceted.
+    #[serde(default = "default_crease")]
+    pub crease_angle: f64,
+    /// Placement in the world.
+    #[serde(default)]
+    pub transform: Transform,
+    /// Inline vertices `[x, y, z]`.
+    #[serde(default)]
+    pub vertices: Option<Vec<[f64; 3]>>,
+    /// Inline faces: vertex indices, counter-clockwise seen from the front (outside).
+    #[serde(default)]
+    pub faces: Option<Vec<Vec<u64>>>,
+    /// Inline normals, one per vertex (optional: otherwise from the faces).
+    #[serde(default)]
+    pub normals: Option<Vec<[f64; 3]>>,
+    /// A Wavefront OBJ file.
+    #[serde(default)]
+    pub obj: Option<String>,
+    /// A surface of revolution.
+    #[serde(default)]
+    pub revolution: Option<Revolution>,
+}
+
+fn default_crease() -> f64 {
+    50.0
+}
+
+/// A world scene as its file says.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WorldSpec {
+    /// Always `"world"`.
+    pub kind: String,
+    /// Image width, pixels.
+    pub width: u64,
+    /// Image height, pixels.
+    pub height: u64,
+    /// 1 (grey) to 4; 3 is RGB.
+    pub channels: u64,
+    /// The camera.
+    pub camera: CameraSpec,
+    /// Ambient light `I_a`.
+    pub ambient: PerChannel,
+    /// Point lights.
+    #[serde(default)]
+    pub lights: Vec<LightSpec>,
+    /// The meshes.
+    pub meshes: Vec<MeshSpec>,
+}
+
+/// A checked world scene with its meshes built (in world space, transforms applied).
+#[derive(Clone, Debug, PartialEq)]
+pub struct WorldScene {
+    /// The description it was built from.
+    pub spec: WorldSpec,
+    /// The meshes, in the order of `spec.meshes`.
+    pub meshes: Vec<Mesh>,
+}
+
+impl WorldScene {
+    /// Image width.
+    pub fn width(&self) -> u32 {
+        self.spec.width as u32
+    }
+
+    /// Image height.
+    pub fn height(&self) -> u32 {
+        self.spec.height as u32
+    }
+
+    /// Channels.
+    pub fn channels(&self) -> usize {
+        self.spec.channels as usize
+    }
+
+    /// The same scene with another image size (the camera keeps its vertical field of
+    /// view; the horizontal one follows the aspect ratio).
+    pub fn with_size(mut self, width: u32, height: u32) -> Result<Self, SceneError> {
+        self.spec.width = u64::from(width);
+        self.spec.height = u64::from(height);
+        check_image(&self.spec)?;
+        Ok(self)
+    }
+}
+
+fn finite(field: &str, v: f64) -> Result<(), SceneError> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(SceneError::at_field(
+            SceneErrorKind::NonFinite,
+            field,
+            format!("expected a finite number, found {v}"),
+        ))
+    }
+}
+
+pub(crate) fn check_point(field: &str, p: [f64; 3]) -> Result<(), SceneError> {
+    for v in p {
+        finite(field, v)?;
+        if v.abs() > MAX_WORLD_COORDINATE {
+            return Err(SceneError::at_field(
+                SceneErrorKind::Limit,
+                field,
+                format!("coordinate {v:e} is beyond ±{MAX_WORLD_COORDINATE:e}"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn check_image(s: &WorldSpec) -> Result<(), SceneError> {
+    for (name, v) in [("width", s.width), ("height", s.height)] {
+        if !(1..=u64::from(MAX_SIDE)).contains(&v) {
+            return Err(SceneError::at_field(
+                SceneErrorKind::Limit,
+                name,
+                format!("{name} {v} is outside 1..={MAX_SIDE} pixels"),
+            ));
+        }
+    }
+    if !(1..=u64::from(MAX_CHANNELS)).contains(&s.channels) {
+        return Err(SceneError::at_field(
+            SceneErrorKind::Limit,
+            "channels",
+            format!(
+                "channels {} is outside 1..={MAX_CHANNELS} (1 grey, 3 RGB)",
+                s.channels
+            ),
+        ));
+    }
+    let values = s.width * s.height * s.channels;
+    if values > MAX_VALUES {
+        return Err(SceneError::at_field(
+            SceneErrorKind::Limit,
+            "",
+            format!(
+                "the image would hold {} × {} × {} = {values} values; the limit is {MAX_VALUES} (2^28)",
+                s.width, s.height, s.channels
+            ),
+        ));
+    }
+    Ok(())
+}
+
+impl WorldSpec {
+    /// Checks every rule that does not need the meshes built: sizes, channels, camera,
+    /// lights, materials, transforms, and that each mesh names exactly one source.
+    pub fn validate(&self) -> Result<(), SceneError> {
+        use SceneErrorKind as K;
+        check_image(self)?;
+        let channels = self.channels as usize;
+        let c = &self.camera;
+        check_point("camera.eye", c.eye)?;
+        check_point("camera.target", c.target)?;
+        check_point("camera.up", c.up)?;
+        finite("camera.fov_y", c.fov_y)?;
+        if !(c.fov_y > 0.0 && c.fov_y < 180.0) {
+            return Err(SceneError::at_field(
+                K::Limit,
+                "camera.fov_y",
+                format!(
+                    "expected a field of view in (0, 180) degrees, found {}",
+                    c.fov_y
+                ),
+            ));
+        }
+        finite("camera.near", c.near)?;
+        if c.near <= 0.0 {
+            return Err(SceneError::at_field(
+                K::Limit,
+                "camera.near",
+                format!("expected a near distance > 0, found {}", c.near),
+            ));
+        }
+        let view = sub(c.target, c.eye);
+        if norm(view) == 0.0 {
+            return Err(SceneError::at_field(
+                K::Geometry,
+                "camera.target",
+                "the camera looks at its own position: target must differ from eye",
+            ));
+        }
+        if norm(cross(view, c.up)) <= 1e-9 * norm(view) * norm(c.up) {
+            return Err(SceneError::at_field(
+                K::Geometry,
+                "camera.up",
+                "up is zero or parallel to the view direction (target − eye)",
+            ));
+        }
+        self.ambient.check("ambient", channels, 0.0)?;
+        for (k, l) in self.lights.iter().enumerate() {
+            check_point(&format!("lights[{k}].position"), l.position)?;
+            l.intensity
+                .check(&format!("lights[{k}].intensity"), channels, 0.0)?;
+        }
+        if self.meshes.is_empty() {
+            return Err(SceneError::at_field(
+                K::Shape,
+                "meshes",
+                "a world scene needs at least one mesh",
+            ));
+        }
+        for (k, m) in self.meshes.iter().enumerate() {
+            let f = |key: &str| format!("meshes[{k}].{key}");
+            let mat = &m.material;
+            mat.k_a.check(&f("material.k_a"), channels, 0.0)?;
+            mat.k_d.check(&f("material.k_d"), channels, 0.0)?;
+            mat.k_s.check(&f("material.k_s"), channels, 0.0)?;
+            finite(&f("material.n"), mat.n)?;
+            if mat.n < 0.0 {
+                return Err(SceneError::at_field(
+                    K::Limit,
+                    f("material.n"),
+                    format!("expected a specular exponent ≥ 0, found {}", mat.n),
+                ));
+            }
+            finite(&f("crease_angle"), m.crease_angle)?;
+            if !(0.0..=180.0).contains(&m.crease_angle) {
+                return Err(SceneError::at_field(
+                    K::Limit,
+                    f("crease_angle"),
+                    format!(
+                        "expected an angle in 0..=180 degrees, found {}",
+                        m.crease_angle
+                    ),
+                ));
+            }
+            let t = &m.transform;
+            match &t.scale {
+                Some(Scale::Uniform(s)) => nonzero_scale(&f("transform.scale"), &[*s])?,
+                Some(Scale::Axes(s)) => nonzero_scale(&f("transform.scale"), s)?,
+                None => {}
+            }
+            if let Some(r) = t.rotate {
+                check_point(&f("transform.rotate"), r)?;
+            }
+            if let Some(p) = t.translate {
+                check_point(&f("transform.translate"), p)?;
+            }
+            let sources = [
+                m.vertices.is_some() || m.faces.is_some() || m.normals.is_some(),
+                m.obj.is_some(),
+                m.revolution.is_some(),
+            ];
+            match sources.iter().filter(|s| **s).count() {
+                1 => {}
+                0 => {
+                    return Err(SceneError::at_field(
+                        K::Schema,
+                        format!("meshes[{k}]"),
+                        "expected one geometry source: \"vertices\" + \"faces\", \"obj\" or \"revolution\"",
+                    ))
+                }
+                _ => {
+                    return Err(SceneError::at_field(
+                        K::Schema,
+                        format!("meshes[{k}]"),
+                        "expected only one geometry source: \"vertices\" + \"faces\", \"obj\" or \"revolution\"",
+                    ))
+                }
+            }
+            if sources[0] && (m.vertices.is_none() || m.faces.is_none()) {
+                return Err(SceneError::at_field(
+                    K::Schema,
+                    format!("meshes[{k}]"),
+                    "an inline mesh needs both \"vertices\" and \"faces\"",
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+fn nonzero_scale(field: &str, s: &[f64]) -> Result<(), SceneError> {
+    for &v in s {
+        finite(field, v)?;
+        if v == 0.0 || v.abs() > MAX_WORLD_COORDINATE || v.abs() < 1.0 / MAX_WORLD_COORDINATE {
+            return Err(SceneError::at_field(
+                SceneErrorKind::Limit,
+                field,
+                format!("expected a scale factor with 1e-9 ≤ |s| ≤ 1e9, found {v}"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+pub(crate) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+pub(crate) fn norm(a: [f64; 3]) -> f64 {
+    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
+}
+
+/// Reads a world scene from JSON text, checks it and builds its meshes. OBJ files are
+/// read relative to `base` (the scene file's directory; the working directory if
+/// `None`). Errors are located in `text` (or, for OBJ faults, in the OBJ file).
+pub fn parse_world(text: &str, base: Option<&Path>) -> Result<WorldScene, SceneError> {
+    let spec: WorldSpec = serde_json::from_str(text).map_err(|e| json_error(&e))?;
+    let locate = |e: SceneError| locate_error(text, e);
+    spec.validate().map_err(locate)?;
+    let mut meshes = Vec::with_capacity(spec.meshes.len());
+    let mut triangles = 0usize;
+    for (k, m) in spec.meshes.iter().enumerate() {
+        let built = mesh::build(m, k, base).map_err(|e| match e {
+            mesh::BuildError::Scene(e) => locate(e),
+            mesh::BuildError::File(e) => e,
+        })?;
+        triangles += built.triangle_count();
+        if triangles > MAX_TRIANGLES {
+            return Err(locate(SceneError::at_field(
+                SceneErrorKind::Limit,
+                format!("meshes[{k}]"),
+                format!("the scene has more than {MAX_TRIANGLES} triangles"),
+            )));
+        }
+        // the image size does not change depths: any size will do
+        let camera = crate::camera::Camera::new(&spec.camera, 1, 1);
+        crate::project::check_in_front(&camera, &built, k).map_err(locate)?;
+        meshes.push(built);
+    }
+    Ok(WorldScene { spec, meshes })
+}
