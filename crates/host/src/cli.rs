@@ -7,7 +7,9 @@ use crate::commands::convert::ConvertArgs;
 use crate::commands::machine::MachineCmdArgs;
 use crate::commands::run::RunArgs;
 use crate::commands::scene::{EmitArgs, RenderArgs};
-use crate::commands::{convert, diff, dump, history, machine, run, scene, scenes, stats, vcd};
+use crate::commands::{
+    convert, diff, dump, fit, history, machine, run, scene, scenes, stats, tradeoff, vcd,
+};
 use crate::error::CliError;
 use clap::{Parser, Subcommand};
 use std::ffi::OsString;
@@ -112,6 +114,38 @@ Example:\n  cwisim scenes\n  cwisim scenes pot > my-pot.json",
         after_help = AFTER_HELP
     )]
     Scenes(scenes::ScenesArgs),
+
+    /// Speed against accuracy: one scene over a grid of settings, measured
+    #[command(
+        long_about = "Render one scene (a file or an embedded name; default the pot) over a grid of \
+settings — shading flat/gouraud, anti-aliasing none/box, visibility exact/eval0 (world scenes), \
+and the array's numeric formats — and measure each: instructions, bus-busy cycles per frame, \
+the worst scanline against the line period, late scanlines, host wall time (median of \
+--repeat runs), and the error against the exact image (the box-filtered Gouraud shading of \
+the visible surfaces, computed independently of the scan converter and the array): max, \
+RMS, PSNR. Settings on the Pareto front of RMS error against bus cycles are marked *.\n\n\
+--csv writes the table, --plot a PNG of error against cycles (log-log) with the front drawn. \
+Formats: --numeric f64 --numeric f32 --numeric fixed:I=10.22,dI=4.28,ddI=1.35 … (default: f64, \
+f32 and three fixed-point formats; docs/ACCURACY.md). The results are in docs/TRADEOFF.md.\n\n\
+Example:\n  cwisim tradeoff pot --csv pot.csv --plot pot-tradeoff.png",
+        after_help = AFTER_HELP
+    )]
+    Tradeoff(tradeoff::TradeoffArgs),
+
+    /// The narrowest fixed-point registers that draw a scene within an error
+    #[command(
+        long_about = "Find the narrowest fixed-point formats of the array's registers (I, dI, ddI and \
+the accumulator: integer and fraction bits each) whose output stays within --max-error of the \
+exact image of the scene, drawn as the other options say. The scene is scan-converted once \
+and the stream replayed in candidate formats: per register a binary search for the integer \
+bits (no overflow) and the fraction bits, then the registers together, widened a bit at a \
+time where it helps most. Prints the format (ready for --numeric), its error, the f64 \
+array's own error (the floor no format can beat), and per register what one fraction bit \
+fewer would cost — which register needs the bits.\n\n\
+Example:\n  cwisim fit pot --max-error 1/512",
+        after_help = AFTER_HELP
+    )]
+    Fit(fit::FitArgs),
 
     /// Per-scanline statistics of a trace or scene: table, plot, CSV, JSON
     #[command(
@@ -269,6 +303,8 @@ fn dispatch(
         Command::Machine(args) => machine::run(args, stdout, stderr).map(|()| 0),
         Command::Render(args) => scene::run_render(args, stdout, progress).map(|()| 0),
         Command::Scenes(args) => scenes::run(args, stdout).map(|()| 0),
+        Command::Tradeoff(args) => tradeoff::run(args, stdout).map(|()| 0),
+        Command::Fit(args) => fit::run(args, stdout).map(|()| 0),
         Command::Emit(args) => scene::run_emit(args).map(|()| 0),
         Command::Stats(args) => stats::run(args, stdout, stderr).map(|()| 0),
         Command::History(args) => history::run(args, stdout).map(|()| 0),

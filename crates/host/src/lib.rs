@@ -5,12 +5,13 @@
 //! (`cwisim-xproc`), and writes what the array shifted out as a PNG picture or an exact
 //! NumPy array, with per-run statistics in text or JSON.
 //!
-//! * [`cli`] — the `cwisim` command line (`run`, `render`, `emit`, `scenes`, `convert`,
-//!   `machine`, and the study tools `stats`, `history`, `vcd`, `diff`, `dump`) and
+//! * [`cli`] — the `cwisim` command line (`run`, `render`, `emit`, `scenes`, `tradeoff`,
+//!   `fit`, `convert`, `machine`, and the study tools `stats`, `history`, `vcd`, `diff`, `dump`) and
 //!   [`cli::run_cli`], which runs it in-process on any output streams.
 //! * [`prepare`] — from a SCENE argument (a file or an embedded name) to the polygons the
 //!   Y-processor takes, through `cwisim-world` for 3D scenes.
 //! * [`summary`] — what `cwisim render` prints: every stage's figures and wall time.
+//! * [`tradeoff_plot`] — the error-against-cycles chart of `cwisim tradeoff`.
 //! * [`commands`] — one module per subcommand.
 //! * [`demo`] — the embedded demo trace `cwisim run` replays when given no file.
 //! * [`output`] — NumPy `.npy` and PNG encoding of an [`Image`](cwisim_xproc::Image).
@@ -42,5 +43,6 @@ pub mod progress;
 pub mod range;
 pub mod report;
 pub mod summary;
+pub mod tradeoff_plot;
 
 pub use error::CliError;

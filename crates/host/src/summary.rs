@@ -4,7 +4,7 @@
 use crate::prepare::{PreparedScene, VisibilityArg};
 use crate::report::TraceShape;
 use cwisim_isa::Opcode;
-use cwisim_xproc::RunStats;
+use cwisim_xproc::{Numeric, RunStats};
 use cwisim_ypipe::{Antialias, EmitStats, Shading};
 use std::io::{self, Write};
 use std::path::Path;
@@ -67,6 +67,7 @@ pub fn write_render_summary(
     p: &PreparedScene,
     e: &EmitStats,
     stats: &RunStats,
+    numeric: &Numeric,
     t: &StageTimes,
     written: &[&Path],
 ) -> io::Result<()> {
@@ -86,7 +87,7 @@ pub fn write_render_summary(
         out,
         "scene",
         format!(
-            "{} ({}, {}×{}, {}): {} shading, {}{visibility}",
+            "{} ({}, {}×{}, {}): {} shading, {}{visibility}, {numeric} registers",
             p.source.name(),
             p.kind,
             shape.width,

@@ -4,10 +4,16 @@
 //! Each scanline carries a deterministic pseudo-random mix of Eval1/Eval2/Eval3 spans
 //! (about 16 spans of 1–128 processors: ~1000 processor updates per line), a few
 //! preloads and a Refresh; the machine is the default one.
+//!
+//! Group `numeric_frame_1024x1024`: the fast engine on the same frame in each numeric
+//! format, throughput in processor updates per second. Group `wave_4096`: the 4096 values
+//! of a wrapping fixed-point wave, by the adder chain and by the closed form.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use cwisim_isa::{Instruction, Intensity, TraceHeader};
-use cwisim_xproc::{engine, Machine, NullSink, Timing};
+use cwisim_xproc::{
+    engine, numeric_engine, wave_closed_form, Arith, FixedArith, Machine, NullSink, Numeric, Timing,
+};
 use std::hint::black_box;
 
 /// A small deterministic generator (xorshift64*), so the trace is the same every run.
@@ -81,6 +87,70 @@ fn bench(c: &mut Criterion) {
         });
     }
     group.finish();
+
+    let formats = [
+        ("f64", "f64"),
+        ("f32", "f32"),
+        ("fixed", "fixed:I=4.28,dI=4.28,ddI=1.36,acc=12.20"),
+        ("fixed-wrap", "fixed:I=8.24,dI=8.24,ddI=8.24,overflow=wrap"),
+    ];
+    let updates = replay_numeric(&header, &trace, &Numeric::F64).processor_updates;
+    let mut group = c.benchmark_group("numeric_frame_1024x1024");
+    group.sample_size(10);
+    group.throughput(Throughput::Elements(updates));
+    for (name, format) in formats {
+        let numeric: Numeric = format.parse().expect("format");
+        group.bench_with_input(BenchmarkId::new("fast", name), &numeric, |b, n| {
+            b.iter(|| black_box(replay_numeric(&header, black_box(&trace), n).cycles))
+        });
+    }
+    group.finish();
+
+    let Numeric::Fixed(f) = "fixed:I=8.24,dI=8.24,ddI=8.24,overflow=wrap"
+        .parse()
+        .expect("format")
+    else {
+        unreachable!()
+    };
+    let arith = FixedArith::new(&f).expect("format");
+    let (v0, d0, dd0) = (123_456_789i64, -98_765i64, 4_321i64);
+    let mut group = c.benchmark_group("wave_4096");
+    group.throughput(Throughput::Elements(4096));
+    group.bench_function("adder_chain", |b| {
+        b.iter(|| {
+            let (mut v, mut d, mut sum, mut o) = (black_box(v0), black_box(d0), 0i64, 0u64);
+            for _ in 0..4096 {
+                sum = sum.wrapping_add(v);
+                v = arith.advance_v(v, d, &mut o);
+                d = arith.advance_d(d, dd0, &mut o);
+            }
+            black_box((sum, o))
+        })
+    });
+    group.bench_function("closed_form", |b| {
+        b.iter(|| {
+            let mut sum = 0i64;
+            for k in 0..4096 {
+                sum = sum.wrapping_add(wave_closed_form(black_box(v0), d0, dd0, k, 32).0);
+            }
+            black_box(sum)
+        })
+    });
+    group.finish();
+}
+
+/// The fast engine on `trace` in `numeric`; the totals.
+fn replay_numeric(
+    header: &TraceHeader,
+    trace: &[Instruction],
+    numeric: &Numeric,
+) -> cwisim_xproc::Totals {
+    let mut eng = numeric_engine(header, &Machine::default(), Timing::Fast, numeric)
+        .expect("default machine");
+    for i in trace {
+        eng.execute(i, &mut NullSink);
+    }
+    eng.finish(&mut NullSink).totals
 }
 
 criterion_group!(benches, bench);

@@ -1,7 +1,9 @@
 //! The engine interface, the choice of timing model, and replaying a trace.
 
+use crate::arith::{Arith, F32Arith, FixedArith, Native};
 use crate::fast::FastEngine;
-use crate::machine::{Machine, MachineError};
+use crate::machine::{Machine, MachineError, Timeline};
+use crate::numeric::Numeric;
 use crate::output::{Image, ImageSink, LineSink};
 use crate::probe::Probe;
 use crate::sample::Sample;
@@ -35,9 +37,45 @@ pub fn engine<T: Sample>(
     timing: Timing,
 ) -> Result<Box<dyn Engine<T>>, MachineError> {
     let timeline = machine.timeline(header)?;
-    Ok(match timing {
-        Timing::Fast => Box::new(FastEngine::<T>::new(header, timeline)),
-        Timing::Stepped => Box::new(SteppedEngine::<T>::new(header, timeline)),
+    Ok(boxed(header, timeline, timing, Native::<T>::new()))
+}
+
+fn boxed<A: Arith>(
+    header: &TraceHeader,
+    timeline: Timeline,
+    timing: Timing,
+    arith: A,
+) -> Box<dyn Engine<A::Out>> {
+    match timing {
+        Timing::Fast => Box::new(FastEngine::with_arith(header, timeline, arith)),
+        Timing::Stepped => Box::new(SteppedEngine::with_arith(header, timeline, arith)),
+    }
+}
+
+/// An engine of the chosen kind whose registers have the format `numeric`; scanlines
+/// come out as `f64` (the accumulators' values). [`Numeric::F64`] is exactly
+/// [`engine::<f64>`](engine).
+///
+/// A fixed format outside the limits (possible when built from its public fields) is a
+/// [`MachineError::Invalid`] of the parameter `numeric`: register formats are part of
+/// the machine.
+pub fn numeric_engine(
+    header: &TraceHeader,
+    machine: &Machine,
+    timing: Timing,
+    numeric: &Numeric,
+) -> Result<Box<dyn Engine<f64>>, MachineError> {
+    let timeline = machine.timeline(header)?;
+    Ok(match numeric {
+        Numeric::F64 => boxed(header, timeline, timing, Native::<f64>::new()),
+        Numeric::F32 => boxed(header, timeline, timing, F32Arith),
+        Numeric::Fixed(f) => {
+            let arith = FixedArith::new(f).map_err(|e| MachineError::Invalid {
+                name: "numeric".into(),
+                message: e.message().to_string(),
+            })?;
+            boxed(header, timeline, timing, arith)
+        }
     })
 }
 
@@ -62,7 +100,31 @@ pub fn replay<T: Sample>(
     progress: &mut dyn FnMut(u64),
 ) -> Result<RunStats, ReplayError> {
     let header = *reader.header();
-    let mut eng = engine::<T>(&header, machine, timing)?;
+    let eng = engine::<T>(&header, machine, timing)?;
+    drive(reader, eng, sink, progress)
+}
+
+/// [`replay`] with registers of the format `numeric` (see [`numeric_engine`]); the sink
+/// receives the accumulators' values as `f64`.
+pub fn replay_numeric(
+    reader: &mut dyn TraceRead,
+    machine: &Machine,
+    timing: Timing,
+    numeric: &Numeric,
+    sink: &mut dyn LineSink<f64>,
+    progress: &mut dyn FnMut(u64),
+) -> Result<RunStats, ReplayError> {
+    let header = *reader.header();
+    let eng = numeric_engine(&header, machine, timing, numeric)?;
+    drive(reader, eng, sink, progress)
+}
+
+fn drive<T: Sample>(
+    reader: &mut dyn TraceRead,
+    mut eng: Box<dyn Engine<T>>,
+    sink: &mut dyn LineSink<T>,
+    progress: &mut dyn FnMut(u64),
+) -> Result<RunStats, ReplayError> {
     let mut n: u64 = 0;
     while let Some(instr) = reader.next_instruction()? {
         eng.execute(&instr, sink);
@@ -85,7 +147,9 @@ pub fn replay_probed<T: Sample>(
 ) -> Result<RunStats, ReplayError> {
     let header = *reader.header();
     let timeline = machine.timeline(&header)?;
-    let mut eng = Box::new(SteppedEngine::<T>::with_probe(&header, timeline, probe));
+    let mut eng = Box::new(SteppedEngine::<Native<T>>::with_probe(
+        &header, timeline, probe,
+    ));
     while let Some(instr) = reader.next_instruction()? {
         eng.execute(&instr, sink);
     }
@@ -103,7 +167,32 @@ pub fn run<T: Sample>(
     machine: &Machine,
     timing: Timing,
 ) -> Result<(Image, RunStats), MachineError> {
-    let mut eng = engine::<T>(header, machine, timing)?;
+    collect(header, instrs, engine::<T>(header, machine, timing)?)
+}
+
+/// [`run`] with registers of the format `numeric` (see [`numeric_engine`]).
+///
+/// # Panics
+/// As [`run`].
+pub fn run_numeric(
+    header: &TraceHeader,
+    instrs: &[Instruction],
+    machine: &Machine,
+    timing: Timing,
+    numeric: &Numeric,
+) -> Result<(Image, RunStats), MachineError> {
+    collect(
+        header,
+        instrs,
+        numeric_engine(header, machine, timing, numeric)?,
+    )
+}
+
+fn collect<T: Sample>(
+    header: &TraceHeader,
+    instrs: &[Instruction],
+    mut eng: Box<dyn Engine<T>>,
+) -> Result<(Image, RunStats), MachineError> {
     let mut sink = ImageSink::new(
         header.width as usize,
         header.channel_count(),

@@ -5,11 +5,13 @@
 //! the span of processors touched since the previous one, and an empty scanline costs
 //! O(1). State is one scanline: registers and flags per processor, nothing per frame.
 
+use crate::arith::{vector, Arith, Native};
 use crate::engine::Engine;
 use crate::machine::Timeline;
+use crate::numeric::Register;
 use crate::output::{LineOut, LineSink};
-use crate::sample::{vector, Sample};
-use crate::stats::{Recorder, RunStats};
+use crate::sample::Sample;
+use crate::stats::{Recorder, RunStats, Work};
 use cwisim_isa::{Instruction, Opcode, TraceHeader, MAX_CHANNELS};
 
 const HAS_I: u8 = 1;
@@ -17,15 +19,16 @@ const HAS_DI: u8 = 2;
 const HAS_DDI: u8 = 4;
 const LOCKED: u8 = 8;
 
-/// The fast engine (see the module documentation).
-pub struct FastEngine<T: Sample> {
+/// The fast engine (see the module documentation), with registers of arithmetic `A`.
+pub struct FastEngine<A: Arith> {
+    arith: A,
     channels: usize,
     timeline: Timeline,
     recorder: Recorder,
     /// Accumulators, `width × channels`.
-    acc: Vec<T>,
+    acc: Vec<A::Reg>,
     /// Preload registers `I`, `dI`, `ddI`, each `width × channels`.
-    regs: [Vec<T>; 3],
+    regs: [Vec<A::Reg>; 3],
     /// `HAS_*` and `LOCKED` bits per processor.
     flags: Vec<u8>,
     /// A processor is masked (`Dis`) for the next Eval when its stamp equals `evals + 1`.
@@ -42,22 +45,32 @@ pub struct FastEngine<T: Sample> {
     /// Scanlines output so far.
     line: u64,
     last_entry: Option<u64>,
+    /// Scratch space for a scanline converted for output.
+    out: Vec<A::Out>,
 }
 
-impl<T: Sample> FastEngine<T> {
-    /// An array for `header`'s width and channels, timed by `timeline`.
+impl<T: Sample> FastEngine<Native<T>> {
+    /// An array of `T` registers for `header`'s width and channels, timed by `timeline`.
     pub fn new(header: &TraceHeader, timeline: Timeline) -> Self {
+        FastEngine::with_arith(header, timeline, Native::new())
+    }
+}
+
+impl<A: Arith> FastEngine<A> {
+    /// An array with registers of arithmetic `arith`.
+    pub fn with_arith(header: &TraceHeader, timeline: Timeline, arith: A) -> Self {
         let w = header.width as usize;
         let c = header.channel_count();
         FastEngine {
+            arith,
             channels: c,
             recorder: Recorder::new(&timeline),
             timeline,
-            acc: vec![T::ZERO; w * c],
+            acc: vec![A::ZERO; w * c],
             regs: [
-                vec![T::ZERO; w * c],
-                vec![T::ZERO; w * c],
-                vec![T::ZERO; w * c],
+                vec![A::ZERO; w * c],
+                vec![A::ZERO; w * c],
+                vec![A::ZERO; w * c],
             ],
             flags: vec![0; w],
             mask_stamp: vec![0; w],
@@ -68,6 +81,7 @@ impl<T: Sample> FastEngine<T> {
             touched: None,
             line: 0,
             last_entry: None,
+            out: Vec::new(),
         }
     }
 
@@ -98,13 +112,13 @@ impl<T: Sample> FastEngine<T> {
         entry
     }
 
-    fn set(&mut self, slot: usize, p: usize, v: &[T; MAX_CHANNELS]) {
+    fn set(&mut self, slot: usize, p: usize, v: &[A::Reg; MAX_CHANNELS]) {
         let c = self.channels;
         self.regs[slot][p * c..p * c + c].copy_from_slice(&v[..c]);
         self.flags[p] |= 1 << slot;
     }
 
-    fn eval0(&mut self, x: usize, dx: usize, v: &[T; MAX_CHANNELS]) -> u64 {
+    fn eval0(&mut self, x: usize, dx: usize, v: &[A::Reg; MAX_CHANNELS]) -> u64 {
         let c = self.channels;
         let cur = self.evals + 1;
         let mut suppressed = 0;
@@ -120,38 +134,64 @@ impl<T: Sample> FastEngine<T> {
         suppressed
     }
 
-    /// Eval1 (`ORDER` 1), Eval2 (2) and Eval3 (3): forward differencing along
-    /// `[x, x+dx)`, picking up preloaded registers as the wave passes them.
-    fn eval<const ORDER: usize>(
+    /// [`Self::eval`] for the array's channel count, a constant there: the per-channel
+    /// loop unrolls and the running registers stay in machine registers.
+    fn eval_order<const ORDER: usize>(
         &mut self,
         x: usize,
         dx: usize,
-        mut v: [T; MAX_CHANNELS],
-        mut d: [T; MAX_CHANNELS],
-        dd: [T; MAX_CHANNELS],
-    ) -> (u64, u64) {
-        let c = self.channels;
-        let (mut dropped, mut suppressed) = (0u64, 0u64);
+        v: [A::Reg; MAX_CHANNELS],
+        d: [A::Reg; MAX_CHANNELS],
+        dd: [A::Reg; MAX_CHANNELS],
+        w: &mut Work,
+    ) {
+        const { assert!(MAX_CHANNELS == 4) };
+        match self.channels {
+            1 => self.eval::<ORDER, 1>(x, dx, v, d, dd, w),
+            2 => self.eval::<ORDER, 2>(x, dx, v, d, dd, w),
+            3 => self.eval::<ORDER, 3>(x, dx, v, d, dd, w),
+            _ => self.eval::<ORDER, 4>(x, dx, v, d, dd, w),
+        }
+    }
+
+    /// Eval1 (`ORDER` 1), Eval2 (2) and Eval3 (3) on an array of `C` channels: forward
+    /// differencing along `[x, x+dx)`, picking up preloaded registers as the wave passes
+    /// them. Adds the dropped, suppressed and overflow counts to `w`.
+    fn eval<const ORDER: usize, const C: usize>(
+        &mut self,
+        x: usize,
+        dx: usize,
+        mut v: [A::Reg; MAX_CHANNELS],
+        mut d: [A::Reg; MAX_CHANNELS],
+        mut dd: [A::Reg; MAX_CHANNELS],
+        w: &mut Work,
+    ) {
+        debug_assert_eq!(C, self.channels);
+        let c = C;
+        let (mut dropped, mut suppressed, mut ovf) = (0u64, 0u64, 0u64);
         let neg_ok = self.negative_enabled;
+        let ar = &self.arith;
         if !self.any_flags && !self.dis_pending {
             // No preloads, locks or masks on this scanline: the plain adder chain.
             for p in x..x + dx {
                 let acc = &mut self.acc[p * c..p * c + c];
                 for k in 0..c {
-                    if neg_ok || !v[k].is_negative() {
-                        acc[k] = acc[k].add(v[k]);
+                    if neg_ok || !ar.is_negative(v[k]) {
+                        acc[k] = ar.accumulate(acc[k], v[k], &mut ovf);
                     } else {
                         dropped += 1;
                     }
                     if ORDER >= 2 {
-                        v[k] = v[k].add(d[k]);
+                        v[k] = ar.advance_v(v[k], d[k], &mut ovf);
                     }
                     if ORDER >= 3 {
-                        d[k] = d[k].add(dd[k]);
+                        d[k] = ar.advance_d(d[k], dd[k], &mut ovf);
                     }
                 }
             }
-            return (dropped, 0);
+            w.dropped += dropped;
+            w.overflows += ovf;
+            return;
         }
         let reads: u8 = match ORDER {
             1 => HAS_I,
@@ -159,7 +199,6 @@ impl<T: Sample> FastEngine<T> {
             _ => HAS_I | HAS_DI | HAS_DDI,
         };
         let cur = self.evals + 1;
-        let mut dd = dd;
         for p in x..x + dx {
             let f = self.flags[p];
             if f & reads != 0 {
@@ -181,24 +220,26 @@ impl<T: Sample> FastEngine<T> {
             let acc = &mut self.acc[p * c..p * c + c];
             for k in 0..c {
                 if !blocked {
-                    if neg_ok || !v[k].is_negative() {
-                        acc[k] = acc[k].add(v[k]);
+                    if neg_ok || !ar.is_negative(v[k]) {
+                        acc[k] = ar.accumulate(acc[k], v[k], &mut ovf);
                     } else {
                         dropped += 1;
                     }
                 }
                 if ORDER >= 2 {
-                    v[k] = v[k].add(d[k]);
+                    v[k] = ar.advance_v(v[k], d[k], &mut ovf);
                 }
                 if ORDER >= 3 {
-                    d[k] = d[k].add(dd[k]);
+                    d[k] = ar.advance_d(d[k], dd[k], &mut ovf);
                 }
             }
         }
-        (dropped, suppressed)
+        w.dropped += dropped;
+        w.suppressed += suppressed;
+        w.overflows += ovf;
     }
 
-    fn refresh(&mut self, entry: u64, sink: &mut dyn LineSink<T>) {
+    fn refresh(&mut self, entry: u64, sink: &mut dyn LineSink<A::Out>) {
         let ready = entry + self.timeline.traversal();
         self.recorder
             .ready(self.line, ready, self.timeline.deadline(self.line));
@@ -207,9 +248,9 @@ impl<T: Sample> FastEngine<T> {
         sink.line(LineOut {
             index: self.line,
             span: (lo, hi),
-            values: &self.acc[lo * c..hi * c],
+            values: self.arith.emit(&self.acc[lo * c..hi * c], &mut self.out),
         });
-        self.acc[lo * c..hi * c].fill(T::ZERO);
+        self.acc[lo * c..hi * c].fill(A::ZERO);
         self.flags[lo..hi].fill(0);
         self.mask_stamp[lo..hi].fill(0);
         self.any_flags = false;
@@ -218,46 +259,73 @@ impl<T: Sample> FastEngine<T> {
     }
 }
 
-impl<T: Sample> Engine<T> for FastEngine<T> {
-    fn execute(&mut self, instr: &Instruction, sink: &mut dyn LineSink<T>) {
+impl<A: Arith> Engine<A::Out> for FastEngine<A> {
+    fn execute(&mut self, instr: &Instruction, sink: &mut dyn LineSink<A::Out>) {
         let entry = self.issue(instr);
         let (x, dx) = (instr.x as usize, instr.dx as usize);
-        let (mut updates, mut dropped, mut suppressed) = (0u64, 0u64, 0u64);
+        let c = self.channels;
+        let mut w = Work::default();
         match instr.op {
             Opcode::SetI | Opcode::SetdI | Opcode::SetddI => {
                 let slot = instr.op as usize - Opcode::SetI as usize;
-                self.set(slot, x, &vector(&instr.values[slot]));
+                let v = vector(
+                    &self.arith,
+                    Register::of_slot(slot),
+                    &instr.values[slot],
+                    c,
+                    &mut w.overflows,
+                );
+                self.set(slot, x, &v);
                 self.any_flags = true;
                 self.touch(x, x + 1);
-                updates = 1;
+                w.updates = 1;
             }
             Opcode::SetPI | Opcode::SetPdI | Opcode::SetPddI => {
                 let slot = instr.op as usize - Opcode::SetPI as usize;
-                let v = vector(&instr.values[slot]);
+                let v = vector(
+                    &self.arith,
+                    Register::of_slot(slot),
+                    &instr.values[slot],
+                    c,
+                    &mut w.overflows,
+                );
                 let width = self.flags.len();
                 let mut last = x;
                 for p in (x..width).step_by(dx) {
                     self.set(slot, p, &v);
-                    updates += 1;
+                    w.updates += 1;
                     last = p;
                 }
                 self.any_flags = true;
                 self.touch(x, last + 1);
             }
             Opcode::Eval0 => {
-                suppressed = self.eval0(x, dx, &vector(instr.i()));
-                updates = dx as u64;
+                let v = vector(&self.arith, Register::Acc, instr.i(), c, &mut w.overflows);
+                w.suppressed = self.eval0(x, dx, &v);
+                w.updates = dx as u64;
                 self.touch(x, x + dx);
                 self.evals += 1;
             }
             Opcode::Eval1 | Opcode::Eval2 | Opcode::Eval3 => {
-                let (v, d, dd) = (vector(instr.i()), vector(instr.di()), vector(instr.ddi()));
-                (dropped, suppressed) = match instr.op {
-                    Opcode::Eval1 => self.eval::<1>(x, dx, v, d, dd),
-                    Opcode::Eval2 => self.eval::<2>(x, dx, v, d, dd),
-                    _ => self.eval::<3>(x, dx, v, d, dd),
+                let ar = &self.arith;
+                let zero = [A::ZERO; MAX_CHANNELS];
+                let v = vector(ar, Register::I, instr.i(), c, &mut w.overflows);
+                let d = if instr.op == Opcode::Eval1 {
+                    zero
+                } else {
+                    vector(ar, Register::DI, instr.di(), c, &mut w.overflows)
                 };
-                updates = dx as u64;
+                let dd = if instr.op == Opcode::Eval3 {
+                    vector(ar, Register::DDI, instr.ddi(), c, &mut w.overflows)
+                } else {
+                    zero
+                };
+                match instr.op {
+                    Opcode::Eval1 => self.eval_order::<1>(x, dx, v, d, dd, &mut w),
+                    Opcode::Eval2 => self.eval_order::<2>(x, dx, v, d, dd, &mut w),
+                    _ => self.eval_order::<3>(x, dx, v, d, dd, &mut w),
+                };
+                w.updates = dx as u64;
                 self.touch(x, x + dx);
                 self.evals += 1;
                 self.dis_pending = false;
@@ -266,7 +334,7 @@ impl<T: Sample> Engine<T> for FastEngine<T> {
                 let stamp = self.evals + 1;
                 self.mask_stamp[x..x + dx].fill(stamp);
                 self.dis_pending |= dx > 0;
-                updates = dx as u64;
+                w.updates = dx as u64;
                 self.touch(x, x + dx);
             }
             Opcode::AccMode => self.negative_enabled = !self.negative_enabled,
@@ -279,10 +347,10 @@ impl<T: Sample> Engine<T> for FastEngine<T> {
         if instr.op == Opcode::Eval0 {
             self.dis_pending = false;
         }
-        self.recorder.work(self.line, updates, dropped, suppressed);
+        self.recorder.work(self.line, w);
     }
 
-    fn finish(self: Box<Self>, _sink: &mut dyn LineSink<T>) -> RunStats {
+    fn finish(self: Box<Self>, _sink: &mut dyn LineSink<A::Out>) -> RunStats {
         let end = self.last_entry.map_or(0, |e| e + self.timeline.traversal());
         self.recorder.finish(self.line, end)
     }

@@ -2,8 +2,9 @@
 //! [`TraceWrite`], so a Y-processor (or any renderer) can send its stream straight to
 //! the simulator instead of through a file.
 
-use crate::engine::{engine, Engine, Timing};
+use crate::engine::{engine, numeric_engine, Engine, Timing};
 use crate::machine::{Machine, MachineError};
+use crate::numeric::Numeric;
 use crate::output::LineSink;
 use crate::sample::Sample;
 use crate::stats::RunStats;
@@ -37,6 +38,27 @@ impl<'a, T: Sample> EngineWriter<'a, T> {
     /// The statistics, after [`TraceWrite::finish`].
     pub fn into_stats(self) -> Option<RunStats> {
         self.stats
+    }
+}
+
+impl<'a> EngineWriter<'a, f64> {
+    /// An array whose registers have the format `numeric` (see
+    /// [`crate::numeric_engine`]), handing scanlines to `sink` as `f64`: the exact value
+    /// of each accumulator, converted. A fixed format outside the limits is a
+    /// [`MachineError::Invalid`] of the parameter `numeric`.
+    pub fn with_numeric(
+        header: &TraceHeader,
+        machine: &Machine,
+        timing: Timing,
+        numeric: &Numeric,
+        sink: &'a mut dyn LineSink<f64>,
+    ) -> Result<Self, MachineError> {
+        Ok(EngineWriter {
+            header: *header,
+            engine: Some(numeric_engine(header, machine, timing, numeric)?),
+            sink,
+            stats: None,
+        })
     }
 }
 
@@ -87,5 +109,56 @@ mod tests {
         w.finish().unwrap();
         assert_eq!(w.into_stats().unwrap().totals.lines, 1);
         assert_eq!(sink.finish().unwrap().data, [0.0, 0.5, 0.5, 0.0]);
+    }
+
+    #[test]
+    fn a_stream_drives_a_fixed_point_array() {
+        let h = TraceHeader::new(4, 1, 1).unwrap();
+        let mut sink = ImageSink::new(4, 1, 1 << 20);
+        // Q3.1: 0.3 rounds to 0.5; the range is [-4, 3.5], so 3 + 0.5 + 0.5 saturates once
+        let numeric: Numeric = "fixed:I=3.1,dI=3.1,ddI=3.1".parse().unwrap();
+        let mut w = EngineWriter::with_numeric(
+            &h,
+            &Machine::default(),
+            Timing::Stepped,
+            &numeric,
+            &mut sink,
+        )
+        .unwrap();
+        w.write(&Instruction::eval1(0, 2, Intensity::grey(3.0)))
+            .unwrap();
+        w.write(&Instruction::eval1(0, 1, Intensity::grey(0.3)))
+            .unwrap();
+        w.write(&Instruction::eval1(0, 1, Intensity::grey(0.3)))
+            .unwrap();
+        w.write(&Instruction::refresh()).unwrap();
+        w.finish().unwrap();
+        assert_eq!(w.into_stats().unwrap().totals.overflows, 1);
+        assert_eq!(sink.finish().unwrap().data, [3.5, 3.0, 0.0, 0.0]);
+    }
+
+    #[test]
+    fn a_fixed_format_outside_the_limits_is_a_machine_error() {
+        let h = TraceHeader::new(4, 1, 1).unwrap();
+        let mut sink = ImageSink::new(4, 1, 1 << 20);
+        let q = crate::numeric::Q {
+            int_bits: 0,
+            frac_bits: 8,
+        };
+        let numeric = Numeric::Fixed(crate::numeric::FixedFormat {
+            i: q,
+            di: q,
+            ddi: q,
+            acc: q,
+            overflow: crate::numeric::Overflow::Wrap,
+        });
+        let e =
+            EngineWriter::with_numeric(&h, &Machine::default(), Timing::Fast, &numeric, &mut sink)
+                .err()
+                .unwrap();
+        assert_eq!(
+            e.to_string(),
+            "machine parameter `numeric`: fixed format: I=0.8: int_bits must be at least 1 (it includes the sign bit)"
+        );
     }
 }

@@ -7,6 +7,11 @@
 //! * Exact semantics (`docs/ISA.md`): preload registers, `Eval0` locks, `Dis` masks,
 //!   `Acc_mode`, all per processor and channel. The register type is a parameter
 //!   ([`Sample`]); `f64` is the reference.
+//! * Numeric formats ([`Numeric`]: `f64`, `f32`, fixed point with a format per
+//!   register): [`run_numeric`], [`replay_numeric`], [`EngineWriter::with_numeric`] run
+//!   the array with narrower registers, bit-exact with what the hardware's adders do,
+//!   count overflows, and hand scanlines out as `f64`; [`error_bound`] gives the
+//!   fixed-point error analytically (`docs/ACCURACY.md`).
 //! * Cycle-level timing (`docs/TIMING.md`) from an explicit [`Machine`] model: an
 //!   instruction bus feeding a systolic chain, one processor per hop, and a display that
 //!   takes one scanline per line period. Two implementations: [`Timing::Stepped`]
@@ -31,19 +36,28 @@
 
 #![warn(missing_docs)]
 
+pub mod arith;
 pub mod engine;
 pub mod fast;
 pub mod feed;
 pub mod machine;
+pub mod numeric;
 pub mod output;
 pub mod probe;
 pub mod sample;
 pub mod stats;
 pub mod stepped;
 
-pub use engine::{engine, replay, replay_probed, run, Engine, ReplayError, Timing};
+pub use arith::{Arith, F32Arith, FixedArith, Native};
+pub use engine::{
+    engine, numeric_engine, replay, replay_numeric, replay_probed, run, run_numeric, Engine,
+    ReplayError, Timing,
+};
 pub use feed::EngineWriter;
 pub use machine::{Machine, MachineError, Timeline};
+pub use numeric::{
+    error_bound, wave_closed_form, FixedFormat, Numeric, NumericError, Overflow, Register, Q,
+};
 pub use output::{Image, ImageLimit, ImageSink, LineOut, LineSink, NullSink};
 pub use probe::{NoProbe, Probe, ProcessorState};
 pub use sample::Sample;

@@ -5,8 +5,10 @@ use std::fmt::Debug;
 /// A register value: what the accumulators and preload registers hold.
 ///
 /// Instructions carry `f64` operands; an array of `T` converts them on arrival with
-/// [`Sample::from_f64`]. `f64` is the reference; narrower formats (f32, fixed point)
-/// implement this trait to plug in.
+/// [`Sample::from_f64`]. `f64` is the reference. A `Sample` type is its own arithmetic
+/// ([`crate::arith::Native`]); formats that need a runtime description or count
+/// overflows (f32 with overflow counting, fixed point: [`crate::numeric::Numeric`])
+/// implement [`crate::arith::Arith`] instead and output `f64`.
 pub trait Sample: Copy + Debug + Send + Sync + 'static {
     /// The reset value.
     const ZERO: Self;
@@ -38,13 +40,4 @@ impl Sample for f64 {
     fn is_negative(self) -> bool {
         self < 0.0
     }
-}
-
-/// Up to [`cwisim_isa::MAX_CHANNELS`] values of `T`, converted from an intensity operand.
-pub(crate) fn vector<T: Sample>(v: &cwisim_isa::Intensity) -> [T; cwisim_isa::MAX_CHANNELS] {
-    let mut out = [T::ZERO; cwisim_isa::MAX_CHANNELS];
-    for (o, x) in out.iter_mut().zip(v.as_slice()) {
-        *o = T::from_f64(*x);
-    }
-    out
 }

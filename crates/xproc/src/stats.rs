@@ -54,6 +54,10 @@ pub struct LineStats {
     pub dropped_negative: u64,
     /// Processor contributions suppressed by an `Eval0` lock or a `Dis` mask.
     pub suppressed: u64,
+    /// Overflow events of a narrow numeric format (`crate::numeric`), per channel:
+    /// fixed-point wraps and saturations, `f32` results that are not finite, in operand
+    /// conversions and adds. Always 0 for `f64`.
+    pub overflows: u64,
     /// Bus cycles spent issuing this line's instructions.
     pub busy_cycles: u64,
     /// Cycles the bus waited: for the display to free the output registers (before a
@@ -94,6 +98,8 @@ pub struct Totals {
     pub dropped_negative: u64,
     /// Contributions suppressed by locks and masks in all.
     pub suppressed: u64,
+    /// Overflow events in all (see [`LineStats::overflows`]).
+    pub overflows: u64,
     /// Instructions after the last `Refresh`: executed but never output.
     pub unrefreshed_instructions: u64,
     /// Cycle the last token left the array (0 for an empty trace).
@@ -111,6 +117,19 @@ pub struct RunStats {
     pub totals: Totals,
     /// One record per scanline output.
     pub lines: Vec<LineStats>,
+}
+
+/// What one instruction did in the processors.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Work {
+    /// Processors addressed.
+    pub(crate) updates: u64,
+    /// Negative contributions dropped.
+    pub(crate) dropped: u64,
+    /// Contributions suppressed by locks and masks.
+    pub(crate) suppressed: u64,
+    /// Overflow events.
+    pub(crate) overflows: u64,
 }
 
 /// Collects events from an engine into [`RunStats`]. Events name the scanline they
@@ -167,11 +186,12 @@ impl Recorder {
     }
 
     /// Work an instruction of scanline `line` did in the processors.
-    pub(crate) fn work(&mut self, line: u64, updates: u64, dropped_negative: u64, suppressed: u64) {
+    pub(crate) fn work(&mut self, line: u64, w: Work) {
         let l = self.line_mut(line);
-        l.processor_updates += updates;
-        l.dropped_negative += dropped_negative;
-        l.suppressed += suppressed;
+        l.processor_updates += w.updates;
+        l.dropped_negative += w.dropped;
+        l.suppressed += w.suppressed;
+        l.overflows += w.overflows;
     }
 
     /// Scanline `line` is complete at `ready`; the display takes it at `deadline`.
@@ -195,6 +215,7 @@ impl Recorder {
             t.processor_updates += l.processor_updates;
             t.dropped_negative += l.dropped_negative;
             t.suppressed += l.suppressed;
+            t.overflows += l.overflows;
             if (i as u64) < refreshed {
                 if l.slack < 0 {
                     t.late_lines += 1;

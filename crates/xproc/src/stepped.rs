@@ -7,12 +7,14 @@
 //! processor, one hop at a time. Obviously right, and slow: the property tests hold the
 //! fast engine to it.
 
+use crate::arith::{vector, Arith, Native};
 use crate::engine::Engine;
 use crate::machine::Timeline;
+use crate::numeric::Register;
 use crate::output::{LineOut, LineSink};
 use crate::probe::{NoProbe, Probe, ProcessorState};
-use crate::sample::{vector, Sample};
-use crate::stats::{Recorder, RunStats};
+use crate::sample::Sample;
+use crate::stats::{Recorder, RunStats, Work};
 use cwisim_isa::{Instruction, Opcode, TraceHeader, MAX_CHANNELS};
 
 type Vector<T> = [T; MAX_CHANNELS];
@@ -34,24 +36,27 @@ struct Processor<T> {
 }
 
 /// An instruction travelling along the chain.
-struct Token<T> {
+struct Token<T, O> {
     instr: Instruction,
     /// Its number in the trace.
     index: u64,
     /// The scanline it belongs to.
     line: u64,
-    /// Running value, first and second difference.
+    /// Its value operands, converted when it entered the chain: `I` (for `Eval0` in the
+    /// accumulator's format), `dI`, `ddI`. An Eval's wave runs in them: running value,
+    /// first and second difference.
     v: Vector<T>,
     d: Vector<T>,
     dd: Vector<T>,
     /// The cycle it moves on to the next processor.
     leave_at: u64,
     /// What a `Refresh` collects as it passes.
-    out: Vec<T>,
-    updates: u64,
-    dropped: u64,
-    suppressed: u64,
+    out: Vec<O>,
+    work: Work,
 }
+
+/// What one stage of the chain holds: a token or nothing.
+type Stage<A> = Option<Box<Token<<A as Arith>::Reg, <A as Arith>::Out>>>;
 
 /// The instruction on the bus.
 struct Bus {
@@ -63,14 +68,16 @@ struct Bus {
     issued_at: u64,
 }
 
-/// The cycle-stepped engine (see the module documentation).
-pub struct SteppedEngine<'p, T: Sample> {
+/// The cycle-stepped engine (see the module documentation), with registers of
+/// arithmetic `A`.
+pub struct SteppedEngine<'p, A: Arith> {
+    arith: A,
     channels: usize,
     timeline: Timeline,
     recorder: Recorder,
-    procs: Vec<Processor<T>>,
+    procs: Vec<Processor<A::Reg>>,
     /// The token in each processor's stage.
-    stages: Vec<Option<Box<Token<T>>>>,
+    stages: Vec<Stage<A>>,
     bus: Option<Bus>,
     /// The current cycle.
     t: u64,
@@ -86,27 +93,47 @@ pub struct SteppedEngine<'p, T: Sample> {
     probe: &'p mut dyn Probe,
 }
 
-impl<T: Sample> SteppedEngine<'static, T> {
-    /// An array for `header`'s width and channels, timed by `timeline`.
+impl<T: Sample> SteppedEngine<'static, Native<T>> {
+    /// An array of `T` registers for `header`'s width and channels, timed by `timeline`.
     pub fn new(header: &TraceHeader, timeline: Timeline) -> Self {
-        // NoProbe has no state; leaking one zero-sized value costs nothing.
-        SteppedEngine::with_probe(header, timeline, Box::leak(Box::new(NoProbe)))
+        SteppedEngine::with_arith(header, timeline, Native::new())
     }
 }
 
-impl<'p, T: Sample> SteppedEngine<'p, T> {
-    /// An array that reports to `probe` as it steps.
+impl<A: Arith> SteppedEngine<'static, A> {
+    /// An array with registers of arithmetic `arith`.
+    pub fn with_arith(header: &TraceHeader, timeline: Timeline, arith: A) -> Self {
+        // NoProbe has no state; leaking one zero-sized value costs nothing.
+        SteppedEngine::with_probe_arith(header, timeline, arith, Box::leak(Box::new(NoProbe)))
+    }
+}
+
+impl<'p, T: Sample> SteppedEngine<'p, Native<T>> {
+    /// An array of `T` registers that reports to `probe` as it steps.
     pub fn with_probe(header: &TraceHeader, timeline: Timeline, probe: &'p mut dyn Probe) -> Self {
+        SteppedEngine::with_probe_arith(header, timeline, Native::new(), probe)
+    }
+}
+
+impl<'p, A: Arith> SteppedEngine<'p, A> {
+    /// An array with registers of arithmetic `arith` that reports to `probe` as it steps.
+    pub fn with_probe_arith(
+        header: &TraceHeader,
+        timeline: Timeline,
+        arith: A,
+        probe: &'p mut dyn Probe,
+    ) -> Self {
         let w = header.width as usize;
         let blank = Processor {
-            acc: [T::ZERO; MAX_CHANNELS],
-            reg: [[T::ZERO; MAX_CHANNELS]; 3],
+            acc: [A::ZERO; MAX_CHANNELS],
+            reg: [[A::ZERO; MAX_CHANNELS]; 3],
             has: [false; 3],
             locked: false,
             masked: false,
             negative_enabled: false,
         };
         SteppedEngine {
+            arith,
             channels: header.channel_count(),
             recorder: Recorder::new(&timeline),
             timeline,
@@ -125,20 +152,25 @@ impl<'p, T: Sample> SteppedEngine<'p, T> {
 
     /// Moves tokens whose time in a stage is up, then lets the bus hand its instruction
     /// to the first processor if the issue is complete and the stage is free.
-    fn move_tokens(&mut self, sink: &mut dyn LineSink<T>) {
+    fn move_tokens(&mut self, sink: &mut dyn LineSink<A::Out>) {
         let t = self.t;
         let w = self.stages.len();
-        for p in (0..w).rev() {
-            if self.stages[p].as_ref().is_some_and(|tok| tok.leave_at == t) {
-                let mut tok = self.stages[p].take().expect("checked");
-                if p + 1 == w {
-                    self.exit(*tok, sink);
-                } else {
-                    assert!(self.stages[p + 1].is_none(), "two tokens in one processor");
-                    self.apply(p + 1, &mut tok);
-                    tok.leave_at = t + self.timeline.hop;
-                    self.stages[p + 1] = Some(tok);
-                }
+        // From the last processor to the first, each token whose time is up moves on (a
+        // moved token is not visited again: the search continues below it).
+        let mut end = w;
+        while let Some(p) = self.stages[..end]
+            .iter()
+            .rposition(|s| s.as_ref().is_some_and(|tok| tok.leave_at == t))
+        {
+            end = p;
+            let mut tok = self.stages[p].take().expect("checked");
+            if p + 1 == w {
+                self.exit(*tok, sink);
+            } else {
+                assert!(self.stages[p + 1].is_none(), "two tokens in one processor");
+                self.apply(p + 1, &mut tok);
+                tok.leave_at = t + self.timeline.hop;
+                self.stages[p + 1] = Some(tok);
             }
         }
         if self.stages[0].is_none() && self.bus.as_ref().is_some_and(|b| b.issued_at <= t) {
@@ -147,12 +179,14 @@ impl<'p, T: Sample> SteppedEngine<'p, T> {
             let cost = bus.issued_at - bus.begin;
             self.recorder
                 .issue(bus.line, bus.instr.op, bus.begin, t, cost);
+            let mut work = Work::default();
+            let [v, d, dd] = self.operands(&bus.instr, &mut work.overflows);
             let mut tok = Box::new(Token {
-                v: vector(bus.instr.i()),
-                d: vector(bus.instr.di()),
-                dd: vector(bus.instr.ddi()),
+                v,
+                d,
+                dd,
                 out: if bus.instr.op == Opcode::Refresh {
-                    vec![T::ZERO; w * self.channels]
+                    vec![<A::Out as Sample>::ZERO; w * self.channels]
                 } else {
                     Vec::new()
                 },
@@ -160,9 +194,7 @@ impl<'p, T: Sample> SteppedEngine<'p, T> {
                 index: bus.index,
                 line: bus.line,
                 leave_at: t + self.timeline.hop,
-                updates: 0,
-                dropped: 0,
-                suppressed: 0,
+                work,
             });
             self.apply(0, &mut tok);
             self.stages[0] = Some(tok);
@@ -170,15 +202,37 @@ impl<'p, T: Sample> SteppedEngine<'p, T> {
         self.moved = true;
     }
 
+    /// The value operands of `instr`, converted into the registers they are written to;
+    /// operands the opcode does not have are zero.
+    fn operands(&self, instr: &Instruction, overflows: &mut u64) -> [Vector<A::Reg>; 3] {
+        let mut out = [[A::ZERO; MAX_CHANNELS]; 3];
+        for kind in instr.op.operands() {
+            if let Some(slot) = kind.value_slot() {
+                let reg = if instr.op == Opcode::Eval0 {
+                    Register::Acc
+                } else {
+                    Register::of_slot(slot)
+                };
+                out[slot] = vector(
+                    &self.arith,
+                    reg,
+                    &instr.values[slot],
+                    self.channels,
+                    overflows,
+                );
+            }
+        }
+        out
+    }
+
     fn next_cycle(&mut self) {
         self.t += 1;
         self.moved = false;
     }
 
-    fn exit(&mut self, tok: Token<T>, sink: &mut dyn LineSink<T>) {
+    fn exit(&mut self, tok: Token<A::Reg, A::Out>, sink: &mut dyn LineSink<A::Out>) {
         self.last_exit = self.t;
-        self.recorder
-            .work(tok.line, tok.updates, tok.dropped, tok.suppressed);
+        self.recorder.work(tok.line, tok.work);
         if tok.instr.op == Opcode::Refresh {
             self.probe.line_ready(self.t, tok.line);
             self.recorder
@@ -193,17 +247,17 @@ impl<'p, T: Sample> SteppedEngine<'p, T> {
     }
 
     /// What the token does in processor `p`, reported to the probe if it watches `p`.
-    fn apply(&mut self, p: usize, tok: &mut Token<T>) {
+    fn apply(&mut self, p: usize, tok: &mut Token<A::Reg, A::Out>) {
         if !self.probe.watches(p) {
             self.act(p, tok);
             return;
         }
         let before = self.state(p);
-        let updates = tok.updates;
+        let updates = tok.work.updates;
         self.act(p, tok);
         let after = self.state(p);
         let addressed =
-            tok.updates > updates || matches!(tok.instr.op, Opcode::AccMode | Opcode::Refresh);
+            tok.work.updates > updates || matches!(tok.instr.op, Opcode::AccMode | Opcode::Refresh);
         self.probe.visit(
             self.t, p, tok.index, tok.line, &tok.instr, addressed, &before, &after,
         );
@@ -213,10 +267,19 @@ impl<'p, T: Sample> SteppedEngine<'p, T> {
     fn state(&self, p: usize) -> ProcessorState {
         let pr = &self.procs[p];
         let c = self.channels;
-        let v = |x: &Vector<T>| x[..c].iter().map(|s| s.to_f64()).collect::<Vec<f64>>();
+        let v = |reg: Register, x: &Vector<A::Reg>| {
+            x[..c]
+                .iter()
+                .map(|s| self.arith.value(reg, *s))
+                .collect::<Vec<f64>>()
+        };
         ProcessorState {
-            acc: v(&pr.acc),
-            reg: [v(&pr.reg[0]), v(&pr.reg[1]), v(&pr.reg[2])],
+            acc: v(Register::Acc, &pr.acc),
+            reg: [
+                v(Register::I, &pr.reg[0]),
+                v(Register::DI, &pr.reg[1]),
+                v(Register::DDI, &pr.reg[2]),
+            ],
             has: pr.has,
             locked: pr.locked,
             masked: pr.masked,
@@ -225,34 +288,36 @@ impl<'p, T: Sample> SteppedEngine<'p, T> {
     }
 
     /// The token's effect in processor `p`.
-    fn act(&mut self, p: usize, tok: &mut Token<T>) {
+    fn act(&mut self, p: usize, tok: &mut Token<A::Reg, A::Out>) {
         let c = self.channels;
         let i = &tok.instr;
         let (x, dx) = (i.x as usize, i.dx as usize);
         let in_range = p >= x && p < x + dx;
+        let ar = &self.arith;
         let pr = &mut self.procs[p];
+        let work = &mut tok.work;
         match i.op {
             Opcode::SetI | Opcode::SetdI | Opcode::SetddI => {
                 if p == x {
                     let slot = i.op as usize - Opcode::SetI as usize;
-                    pr.reg[slot] = vector(&i.values[slot]);
+                    pr.reg[slot] = [tok.v, tok.d, tok.dd][slot];
                     pr.has[slot] = true;
-                    tok.updates += 1;
+                    work.updates += 1;
                 }
             }
             Opcode::SetPI | Opcode::SetPdI | Opcode::SetPddI => {
                 if p >= x && (p - x).is_multiple_of(dx) {
                     let slot = i.op as usize - Opcode::SetPI as usize;
-                    pr.reg[slot] = vector(&i.values[slot]);
+                    pr.reg[slot] = [tok.v, tok.d, tok.dd][slot];
                     pr.has[slot] = true;
-                    tok.updates += 1;
+                    work.updates += 1;
                 }
             }
             Opcode::Eval0 => {
                 if in_range {
-                    tok.updates += 1;
+                    work.updates += 1;
                     if pr.locked || pr.masked {
-                        tok.suppressed += 1;
+                        work.suppressed += 1;
                     } else {
                         pr.acc = tok.v;
                         pr.locked = true;
@@ -263,7 +328,7 @@ impl<'p, T: Sample> SteppedEngine<'p, T> {
             Opcode::Eval1 | Opcode::Eval2 | Opcode::Eval3 => {
                 let order = 1 + i.op as usize - Opcode::Eval1 as usize;
                 if in_range {
-                    tok.updates += 1;
+                    work.updates += 1;
                     if pr.has[0] {
                         tok.v = pr.reg[0];
                         pr.has[0] = false;
@@ -278,21 +343,21 @@ impl<'p, T: Sample> SteppedEngine<'p, T> {
                     }
                     let blocked = pr.locked || pr.masked;
                     if blocked {
-                        tok.suppressed += 1;
+                        work.suppressed += 1;
                     }
                     for k in 0..c {
                         if !blocked {
-                            if pr.negative_enabled || !tok.v[k].is_negative() {
-                                pr.acc[k] = pr.acc[k].add(tok.v[k]);
+                            if pr.negative_enabled || !ar.is_negative(tok.v[k]) {
+                                pr.acc[k] = ar.accumulate(pr.acc[k], tok.v[k], &mut work.overflows);
                             } else {
-                                tok.dropped += 1;
+                                work.dropped += 1;
                             }
                         }
                         if order >= 2 {
-                            tok.v[k] = tok.v[k].add(tok.d[k]);
+                            tok.v[k] = ar.advance_v(tok.v[k], tok.d[k], &mut work.overflows);
                         }
                         if order >= 3 {
-                            tok.d[k] = tok.d[k].add(tok.dd[k]);
+                            tok.d[k] = ar.advance_d(tok.d[k], tok.dd[k], &mut work.overflows);
                         }
                     }
                 }
@@ -301,13 +366,15 @@ impl<'p, T: Sample> SteppedEngine<'p, T> {
             Opcode::Dis => {
                 if in_range {
                     pr.masked = true;
-                    tok.updates += 1;
+                    work.updates += 1;
                 }
             }
             Opcode::AccMode => pr.negative_enabled = !pr.negative_enabled,
             Opcode::Refresh => {
-                tok.out[p * c..p * c + c].copy_from_slice(&pr.acc[..c]);
-                pr.acc = [T::ZERO; MAX_CHANNELS];
+                for k in 0..c {
+                    tok.out[p * c + k] = ar.out(pr.acc[k]);
+                }
+                pr.acc = [A::ZERO; MAX_CHANNELS];
                 pr.has = [false; 3];
                 pr.locked = false;
                 pr.masked = false;
@@ -317,8 +384,8 @@ impl<'p, T: Sample> SteppedEngine<'p, T> {
     }
 }
 
-impl<T: Sample> Engine<T> for SteppedEngine<'_, T> {
-    fn execute(&mut self, instr: &Instruction, sink: &mut dyn LineSink<T>) {
+impl<A: Arith> Engine<A::Out> for SteppedEngine<'_, A> {
+    fn execute(&mut self, instr: &Instruction, sink: &mut dyn LineSink<A::Out>) {
         let (gate, line) = if instr.op == Opcode::Refresh {
             (
                 self.timeline.refresh_gate(self.refreshes_issued),
@@ -351,7 +418,7 @@ impl<T: Sample> Engine<T> for SteppedEngine<'_, T> {
         }
     }
 
-    fn finish(mut self: Box<Self>, sink: &mut dyn LineSink<T>) -> RunStats {
+    fn finish(mut self: Box<Self>, sink: &mut dyn LineSink<A::Out>) -> RunStats {
         loop {
             if !self.moved {
                 self.move_tokens(sink);

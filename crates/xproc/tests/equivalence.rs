@@ -1,8 +1,12 @@
 //! The fast engine against the cycle-stepped reference on random traces and random
-//! machines: identical scanlines (bit for bit) and identical statistics, cycle for cycle.
+//! machines: identical scanlines (bit for bit) and identical statistics, cycle for cycle
+//! — in `f64` and in every numeric format (f32, fixed point down to formats so tiny that
+//! they wrap or saturate all the time).
+
+mod common;
 
 use cwisim_isa::{Instruction, Intensity, Opcode, OperandKind, TraceHeader};
-use cwisim_xproc::{run, Machine, Timing};
+use cwisim_xproc::{run, run_numeric, Machine, Numeric, Timing};
 use proptest::prelude::*;
 
 fn value() -> impl Strategy<Value = f64> {
@@ -98,5 +102,64 @@ proptest! {
         let sb: Vec<u64> = si.data.iter().map(|v| v.to_bits()).collect();
         prop_assert_eq!(fb, sb);
         prop_assert_eq!(fs, ss);
+    }
+}
+
+fn numeric_case() -> impl Strategy<Value = (Numeric, TraceHeader, Machine, Vec<Instruction>)> {
+    (
+        common::numeric(),
+        1u32..40,
+        1u32..5,
+        prop_oneof![Just(1u8), Just(3u8)],
+        1u32..3,
+        1u64..200,
+    )
+        .prop_flat_map(|(numeric, width, lines, channels, hop, period)| {
+            let header = TraceHeader::new(width, lines, channels).unwrap();
+            let m = Machine {
+                hop_cycles: hop,
+                line_period_cycles: Some(period),
+                vblank_lines: 1,
+                ..Machine::default()
+            };
+            (
+                Just(numeric),
+                Just(header),
+                Just(m),
+                proptest::collection::vec(
+                    common::instruction(width, usize::from(channels), common::value()),
+                    0..80,
+                ),
+            )
+        })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(400))]
+
+    #[test]
+    fn fast_equals_stepped_in_every_numeric_format(
+        (numeric, header, machine, trace) in numeric_case()
+    ) {
+        let (fi, fs) = run_numeric(&header, &trace, &machine, Timing::Fast, &numeric).unwrap();
+        let (si, ss) = run_numeric(&header, &trace, &machine, Timing::Stepped, &numeric).unwrap();
+        prop_assert_eq!(fi.lines, si.lines);
+        let fb: Vec<u64> = fi.data.iter().map(|v| v.to_bits()).collect();
+        let sb: Vec<u64> = si.data.iter().map(|v| v.to_bits()).collect();
+        prop_assert_eq!(fb, sb);
+        prop_assert_eq!(fs, ss);
+    }
+
+    #[test]
+    fn numeric_f64_is_the_reference_bit_for_bit((header, machine, trace) in case()) {
+        for timing in [Timing::Fast, Timing::Stepped] {
+            let (ri, rs) = run::<f64>(&header, &trace, &machine, timing).unwrap();
+            let (ni, ns) = run_numeric(&header, &trace, &machine, timing, &Numeric::F64).unwrap();
+            let rb: Vec<u64> = ri.data.iter().map(|v| v.to_bits()).collect();
+            let nb: Vec<u64> = ni.data.iter().map(|v| v.to_bits()).collect();
+            prop_assert_eq!(rb, nb);
+            prop_assert_eq!(&rs, &ns);
+            prop_assert_eq!(ns.totals.overflows, 0);
+        }
     }
 }

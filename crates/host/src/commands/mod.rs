@@ -3,12 +3,14 @@
 pub mod convert;
 pub mod diff;
 pub mod dump;
+pub mod fit;
 pub mod history;
 pub mod machine;
 pub mod run;
 pub mod scene;
 pub mod scenes;
 pub mod stats;
+pub mod tradeoff;
 pub mod until;
 pub mod vcd;
 

@@ -9,7 +9,7 @@ use crate::progress::Progress;
 use crate::report::{timing_name, unrefreshed_warning, write_summary, StatsReport};
 use clap::{Args, ValueEnum};
 use cwisim_isa::{Encoding, FileReader, TraceRead};
-use cwisim_xproc::{replay, Image, ImageSink, NullSink, RunStats, Timing};
+use cwisim_xproc::{replay_numeric, Image, ImageSink, NullSink, Numeric, RunStats, Timing};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -55,6 +55,12 @@ pub struct RunArgs {
     /// Timing model. Both give identical images and cycle counts.
     #[arg(long, value_enum, default_value_t = TimingArg::Fast)]
     pub timing: TimingArg,
+
+    /// The array's registers: f64 (the reference), f32, or fixed point
+    /// fixed:I=M.N,dI=M.N,ddI=M.N[,acc=M.N][,overflow=wrap|saturate] (M integer bits with
+    /// the sign, N fraction bits; docs/ACCURACY.md).
+    #[arg(long, value_name = "FORMAT", default_value = "f64")]
+    pub numeric: Numeric,
 
     /// Print a summary of the statistics to standard output.
     #[arg(long)]
@@ -106,9 +112,14 @@ pub fn run(
             }
             None => &mut *reader,
         };
-        replay_file(reader, &machine, timing, want_image, &mut |bytes| {
-            bar.update(bytes)
-        })?
+        replay_file(
+            reader,
+            &machine,
+            timing,
+            &args.numeric,
+            want_image,
+            &mut |bytes| bar.update(bytes),
+        )?
     };
     if let Some(image) = &replayed.image {
         args.image.write(image)?;
@@ -185,6 +196,7 @@ pub fn replay_file(
     reader: &mut dyn TraceRead,
     machine: &cwisim_xproc::Machine,
     timing: Timing,
+    numeric: &Numeric,
     want_image: bool,
     progress: &mut dyn FnMut(u64),
 ) -> Result<Replayed, CliError> {
@@ -195,13 +207,13 @@ pub fn replay_file(
             header.channel_count(),
             ImageSink::DEFAULT_LIMIT_BYTES,
         );
-        let stats = replay::<f64>(reader, machine, timing, &mut sink, progress)?;
+        let stats = replay_numeric(reader, machine, timing, numeric, &mut sink, progress)?;
         Ok(Replayed {
             stats,
             image: Some(sink.finish()?),
         })
     } else {
-        let stats = replay::<f64>(reader, machine, timing, &mut NullSink, progress)?;
+        let stats = replay_numeric(reader, machine, timing, numeric, &mut NullSink, progress)?;
         Ok(Replayed { stats, image: None })
     }
 }

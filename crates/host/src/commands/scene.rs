@@ -13,7 +13,7 @@ use crate::report::{timing_name, write_summary, StatsReport};
 use crate::summary::{write_render_summary, StageTimes};
 use clap::Args;
 use cwisim_isa::{Encoding, Instruction, Opcode, TraceWrite};
-use cwisim_xproc::{EngineWriter, ImageSink, LineSink, Machine, RunStats, Timing};
+use cwisim_xproc::{EngineWriter, ImageSink, LineSink, Machine, Numeric, RunStats, Timing};
 use cwisim_ypipe::scene::ScreenScene;
 use cwisim_ypipe::{emit, header, EmitStats, Options};
 use std::io::{self, Write};
@@ -61,6 +61,11 @@ pub struct RenderArgs {
     /// Timing model. Both give identical images and cycle counts.
     #[arg(long, value_enum, default_value_t = TimingArg::Fast)]
     pub timing: TimingArg,
+    /// The array's registers: f64 (the reference), f32, or fixed point
+    /// fixed:I=M.N,dI=M.N,ddI=M.N[,acc=M.N][,overflow=wrap|saturate] (M integer bits with
+    /// the sign, N fraction bits; docs/ACCURACY.md).
+    #[arg(long, value_name = "FORMAT", default_value = "f64")]
+    pub numeric: Numeric,
     /// Also print the array's full statistics summary.
     #[arg(long)]
     pub stats: bool,
@@ -145,17 +150,19 @@ pub struct Rendered {
 
 /// Scan-converts `scene` straight into the array on `machine`, handing its scanlines to
 /// `sink`, and every instruction also to `also` when given.
+#[allow(clippy::too_many_arguments)]
 pub fn render_scene<'a>(
     scene: &ScreenScene,
     options: &Options,
     machine: &Machine,
+    numeric: &Numeric,
     timing: Timing,
     sink: &mut dyn LineSink<f64>,
     also: Option<&'a mut dyn TraceWrite>,
     progress: Option<&'a mut Progress>,
 ) -> Result<Rendered, CliError> {
     let h = header(scene);
-    let array = EngineWriter::<f64>::new(&h, machine, timing, sink)?;
+    let array = EngineWriter::with_numeric(&h, machine, timing, numeric, sink)?;
     let mut feed = ScanlineFeed {
         array,
         also,
@@ -270,6 +277,7 @@ pub fn run_render(
         scene,
         &prepared.options,
         &machine,
+        &args.numeric,
         timing,
         &mut sink,
         cost.as_mut().map(|c| c as &mut dyn TraceWrite),
@@ -303,6 +311,7 @@ pub fn run_render(
         json["emit"] =
             serde_json::to_value(&rendered.emitted).map_err(|e| CliError::write(path, e.into()))?;
         json["scene"] = crate::summary::scene_json(&prepared);
+        json["numeric"] = serde_json::Value::from(args.numeric.to_string());
         let text = serde_json::to_string_pretty(&json)
             .map_err(|e| CliError::write(path, e.into()))?
             + "\n";
@@ -337,6 +346,7 @@ pub fn run_render(
             &prepared,
             &rendered.emitted,
             &rendered.stats,
+            &args.numeric,
             &times,
             &written,
         )

@@ -184,7 +184,14 @@ pub fn run(
         Input::Trace => {
             let (mut reader, _) = open_trace(Some(&args.input))?;
             let header = *reader.header();
-            let replayed = replay_file(&mut *reader, &machine, timing, false, &mut |_| {})?;
+            let replayed = replay_file(
+                &mut *reader,
+                &machine,
+                timing,
+                &cwisim_xproc::Numeric::F64,
+                false,
+                &mut |_| {},
+            )?;
             (header, replayed.stats)
         }
         Input::Scene => {
@@ -193,6 +200,7 @@ pub fn run(
                 &prepared.screen,
                 &prepared.options,
                 &machine,
+                &cwisim_xproc::Numeric::F64,
                 timing,
                 &mut NullSink,
                 None,

@@ -1,0 +1,492 @@
+//! `cwisim tradeoff`: one scene rendered over a grid of settings, each measured — what
+//! it costs (instructions, bus cycles, the worst scanline, host time) against how far it
+//! is from the exact image (max, RMS, PSNR) — with the Pareto front of error against
+//! cycles marked.
+//!
+//! The exact image is the same for every setting: the box filter (exact area-weighted
+//! mean per pixel) of the Gouraud-shaded visible surfaces, computed by
+//! `cwisim_ypipe::exact::scene_box_filtered` — for a world scene on the exact visible
+//! fragments, for a screen scene on its polygons — independently of the scan converter
+//! and of the array.
+
+use super::MachineArgs;
+use crate::commands::scene::render_scene;
+use crate::error::CliError;
+use crate::files::{check_outputs, write_atomic};
+use crate::prepare::{prepare, AaArg, DrawArgs, ShadingArg, Size, VisibilityArg};
+use crate::tradeoff_plot::render_tradeoff_plot;
+use clap::Args;
+use cwisim_xproc::{ImageSink, Machine, Numeric, Timing};
+use cwisim_ypipe::exact::scene_box_filtered;
+use serde::Serialize;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+/// The numeric formats `tradeoff` tries unless told otherwise.
+pub const DEFAULT_FORMATS: &[&str] = &[
+    "f64",
+    "f32",
+    "fixed:I=10.22,dI=4.28,ddI=1.35",
+    "fixed:I=10.14,dI=4.20,ddI=1.27",
+    "fixed:I=10.10,dI=4.14,ddI=1.20",
+];
+
+/// The arguments of `cwisim tradeoff`.
+#[derive(Args, Clone, Debug, PartialEq)]
+pub struct TradeoffArgs {
+    /// The scene: a file or an embedded name (default: the pot).
+    #[arg(value_name = "SCENE")]
+    pub scene: Option<PathBuf>,
+    /// Draw at this size, WIDTHxHEIGHT (default: the scene's).
+    #[arg(long, value_name = "WxH")]
+    pub size: Option<Size>,
+    /// The numeric formats of the array to try, comma-separated or repeated (f64, f32,
+    /// fixed:I=M.N,dI=M.N,ddI=M.N[,acc=M.N][,overflow=wrap|saturate]).
+    #[arg(long = "numeric", value_name = "FORMAT", value_delimiter = ';')]
+    pub numeric: Vec<Numeric>,
+    /// Write the table as CSV.
+    #[arg(long, value_name = "OUT.csv")]
+    pub csv: Option<PathBuf>,
+    /// Draw error against bus cycles, the Pareto front marked, as a PNG.
+    #[arg(long, value_name = "OUT.png")]
+    pub plot: Option<PathBuf>,
+    /// Time each setting this many times and report the median host time.
+    #[arg(long, default_value_t = 3, value_name = "N")]
+    pub repeat: u32,
+    /// The machine model.
+    #[command(flatten)]
+    pub machine: MachineArgs,
+}
+
+/// One setting of the grid, measured.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Row {
+    /// The renderer feeding the array.
+    pub renderer: &'static str,
+    /// `flat` or `gouraud`.
+    pub shading: &'static str,
+    /// `none` or `box`.
+    pub aa: &'static str,
+    /// `exact`, `eval0`, or `-` (screen scenes).
+    pub visibility: &'static str,
+    /// The array's numeric format.
+    pub numeric: String,
+    /// Register bits per processor and channel (I, dI, ddI and the accumulator).
+    pub register_bits: u32,
+    /// Instructions sent, `Refresh` included.
+    pub instructions: u64,
+    /// Bus-busy cycles over the frame: the array's work.
+    pub busy_cycles: u64,
+    /// The busiest scanline's bus cycles as a share of the line period.
+    pub worst_line_share: f64,
+    /// Scanlines not ready by their deadline.
+    pub late_lines: u64,
+    /// Wall time of preparing, scan-converting and executing (median), milliseconds.
+    pub host_ms: f64,
+    /// Largest absolute error of any value against the exact image.
+    pub max_error: f64,
+    /// Root-mean-square error over all values.
+    pub rms_error: f64,
+    /// Peak signal-to-noise ratio for a peak of 1, dB (infinite for an exact image).
+    pub psnr_db: f64,
+    /// Register overflows (wraps or saturations) in the array.
+    pub overflows: u64,
+    /// Pareto-optimal: no other setting is at least as good in bus cycles, register bits
+    /// and RMS error and better in one of them.
+    pub pareto: bool,
+}
+
+/// The settings of the grid, in order.
+fn grid(world: bool, formats: &[Numeric]) -> Vec<(DrawArgs, Numeric)> {
+    let mut out = Vec::new();
+    let visibilities: &[VisibilityArg] = if world {
+        &[VisibilityArg::Exact, VisibilityArg::Eval0]
+    } else {
+        &[VisibilityArg::Exact]
+    };
+    for &visibility in visibilities {
+        for shading in [ShadingArg::Gouraud, ShadingArg::Flat] {
+            for aa in [AaArg::Box, AaArg::None] {
+                for numeric in formats {
+                    out.push((
+                        DrawArgs {
+                            shading,
+                            aa,
+                            visibility,
+                            ..DrawArgs::default()
+                        },
+                        *numeric,
+                    ));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// A format as the table shows it: the canonical form without the defaults (an
+/// accumulator like I, saturation).
+pub fn short_numeric(numeric: &Numeric) -> String {
+    let mut s = numeric.to_string();
+    if let Numeric::Fixed(f) = numeric {
+        if f.acc == f.i {
+            s = s.replace(&format!(",acc={}.{}", f.acc.int_bits, f.acc.frac_bits), "");
+        }
+        s = s.replace(",overflow=saturate", "");
+    }
+    s
+}
+
+/// Errors of `image` against `reference`: max, RMS, PSNR (peak 1).
+pub fn errors(image: &[f64], reference: &[f64]) -> (f64, f64, f64) {
+    let mut max = 0.0f64;
+    let mut sum_sq = 0.0;
+    for (a, b) in image.iter().zip(reference) {
+        let e = (a - b).abs();
+        max = max.max(e);
+        sum_sq += e * e;
+    }
+    let mse = sum_sq / reference.len().max(1) as f64;
+    let psnr = if mse == 0.0 {
+        f64::INFINITY
+    } else {
+        -10.0 * mse.log10()
+    };
+    (max, mse.sqrt(), psnr)
+}
+
+/// Register bits per processor and channel: I, dI, ddI and the accumulator.
+pub fn register_bits(numeric: &Numeric) -> u32 {
+    match numeric {
+        Numeric::F64 => 4 * 64,
+        Numeric::F32 => 4 * 32,
+        Numeric::Fixed(f) => [f.i, f.di, f.ddi, f.acc]
+            .iter()
+            .map(|q| q.int_bits + q.frac_bits)
+            .sum(),
+    }
+}
+
+/// Marks the Pareto-optimal rows: no other row has fewer or equal bus cycles, register
+/// bits and RMS error, and fewer of one. (The numeric format changes bits and error but
+/// not cycles; cycles alone would hide the format's trade.)
+pub fn mark_pareto(rows: &mut [Row]) {
+    let points: Vec<(u64, u32, f64)> = rows
+        .iter()
+        .map(|r| (r.busy_cycles, r.register_bits, r.rms_error))
+        .collect();
+    for (k, row) in rows.iter_mut().enumerate() {
+        let (c, b, e) = points[k];
+        row.pareto = !points
+            .iter()
+            .any(|&(c2, b2, e2)| c2 <= c && b2 <= b && e2 <= e && (c2 < c || b2 < b || e2 < e));
+    }
+}
+
+/// The exact image of the scene SCENE names, at `size`.
+pub fn exact_image(scene: Option<&Path>, size: Option<Size>) -> Result<Vec<f64>, CliError> {
+    let draw = DrawArgs {
+        size,
+        ..DrawArgs::default()
+    };
+    let p = prepare(scene, &draw)?;
+    Ok(scene_box_filtered(&p.screen))
+}
+
+/// Renders one setting; the image, its statistics and the wall time.
+pub fn measure(
+    scene: Option<&Path>,
+    draw: &DrawArgs,
+    numeric: &Numeric,
+    machine: &Machine,
+) -> Result<
+    (
+        Vec<f64>,
+        cwisim_ypipe::EmitStats,
+        cwisim_xproc::RunStats,
+        Duration,
+    ),
+    CliError,
+> {
+    let start = Instant::now();
+    let p = prepare(scene, draw)?;
+    let h = cwisim_ypipe::header(&p.screen);
+    let mut sink = ImageSink::new(
+        h.width as usize,
+        h.channel_count(),
+        ImageSink::DEFAULT_LIMIT_BYTES,
+    );
+    let rendered = render_scene(
+        &p.screen,
+        &p.options,
+        machine,
+        numeric,
+        Timing::Fast,
+        &mut sink,
+        None,
+        None,
+    )?;
+    let elapsed = start.elapsed();
+    let image = sink.finish()?;
+    Ok((image.data, rendered.emitted, rendered.stats, elapsed))
+}
+
+fn shading_name(s: ShadingArg) -> &'static str {
+    match s {
+        ShadingArg::Flat => "flat",
+        ShadingArg::Gouraud => "gouraud",
+    }
+}
+
+fn aa_name(a: AaArg) -> &'static str {
+    match a {
+        AaArg::None => "none",
+        AaArg::Box => "box",
+    }
+}
+
+fn visibility_name(v: VisibilityArg) -> &'static str {
+    match v {
+        VisibilityArg::Exact => "exact",
+        VisibilityArg::Eval0 => "eval0",
+    }
+}
+
+/// Measures every setting of the grid.
+pub fn tradeoff_rows(
+    scene: Option<&Path>,
+    size: Option<Size>,
+    formats: &[Numeric],
+    machine: &Machine,
+    repeat: u32,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<Vec<Row>, CliError> {
+    let probe = prepare(scene, &DrawArgs::default())?;
+    let world = probe.kind == "world";
+    let reference = exact_image(scene, size)?;
+    let settings = grid(world, formats);
+    let mut rows = Vec::with_capacity(settings.len());
+    for (k, (mut draw, numeric)) in settings.into_iter().enumerate() {
+        progress(k, rows.capacity());
+        draw.size = size;
+        let mut times = Vec::new();
+        let (image, _, stats, t) = measure(scene, &draw, &numeric, machine)?;
+        times.push(t);
+        for _ in 1..repeat.max(1) {
+            times.push(measure(scene, &draw, &numeric, machine)?.3);
+        }
+        times.sort();
+        let (max_error, rms_error, psnr_db) = errors(&image, &reference);
+        let worst = stats.lines.iter().map(|l| l.busy_cycles).max().unwrap_or(0);
+        rows.push(Row {
+            renderer: "van Rij DO_FILL",
+            shading: shading_name(draw.shading),
+            aa: aa_name(draw.aa),
+            visibility: if world {
+                visibility_name(draw.visibility)
+            } else {
+                "-"
+            },
+            numeric: short_numeric(&numeric),
+            register_bits: register_bits(&numeric),
+            instructions: stats.totals.instructions,
+            busy_cycles: stats.lines.iter().map(|l| l.busy_cycles).sum(),
+            worst_line_share: if stats.line_period > 0 {
+                worst as f64 / stats.line_period as f64
+            } else {
+                0.0
+            },
+            late_lines: stats.totals.late_lines,
+            host_ms: times[times.len() / 2].as_secs_f64() * 1e3,
+            max_error,
+            rms_error,
+            psnr_db,
+            overflows: stats.totals.overflows,
+            pareto: false,
+        });
+    }
+    mark_pareto(&mut rows);
+    Ok(rows)
+}
+
+/// The table, as `tradeoff` prints it.
+pub fn write_table(out: &mut dyn Write, rows: &[Row]) -> std::io::Result<()> {
+    writeln!(
+        out,
+        "{:<8} {:<4} {:<5} {:<34} {:>4} {:>8} {:>9} {:>6} {:>4} {:>8} {:>9} {:>9} {:>6} {:>5}  pareto",
+        "shading", "aa", "vis", "numeric", "bits", "instr", "busy cyc", "worst", "late", "host ms", "max err", "RMS err", "PSNR", "ovfl"
+    )?;
+    for r in rows {
+        writeln!(
+            out,
+            "{:<8} {:<4} {:<5} {:<34} {:>4} {:>8} {:>9} {:>5.1}% {:>4} {:>8.2} {:>9.2e} {:>9.2e} {:>6} {:>5}  {}",
+            r.shading,
+            r.aa,
+            r.visibility,
+            r.numeric,
+            r.register_bits,
+            r.instructions,
+            r.busy_cycles,
+            100.0 * r.worst_line_share,
+            r.late_lines,
+            r.host_ms,
+            r.max_error,
+            r.rms_error,
+            if r.psnr_db.is_finite() {
+                format!("{:.1}", r.psnr_db)
+            } else {
+                "inf".into()
+            },
+            r.overflows,
+            if r.pareto { "*" } else { "" }
+        )?;
+    }
+    Ok(())
+}
+
+/// The table as CSV (one header line, one line per setting).
+pub fn csv(rows: &[Row]) -> String {
+    let mut s = String::from(
+        "renderer,shading,aa,visibility,numeric,register_bits,instructions,busy_cycles,worst_line_share,late_lines,host_ms,max_error,rms_error,psnr_db,overflows,pareto\n",
+    );
+    for r in rows {
+        s.push_str(&format!(
+            "{},{},{},{},\"{}\",{},{},{},{},{},{},{:e},{:e},{},{},{}\n",
+            r.renderer,
+            r.shading,
+            r.aa,
+            r.visibility,
+            r.numeric,
+            r.register_bits,
+            r.instructions,
+            r.busy_cycles,
+            r.worst_line_share,
+            r.late_lines,
+            r.host_ms,
+            r.max_error,
+            r.rms_error,
+            r.psnr_db,
+            r.overflows,
+            r.pareto
+        ));
+    }
+    s
+}
+
+/// Runs `cwisim tradeoff`.
+pub fn run(args: &TradeoffArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
+    check_outputs(
+        None,
+        &[
+            ("--csv", args.csv.as_deref()),
+            ("--plot", args.plot.as_deref()),
+        ],
+    )?;
+    let machine = args.machine.load()?;
+    let formats: Vec<Numeric> = if args.numeric.is_empty() {
+        DEFAULT_FORMATS
+            .iter()
+            .map(|f| f.parse().expect("the default formats parse"))
+            .collect()
+    } else {
+        args.numeric.clone()
+    };
+    let rows = tradeoff_rows(
+        args.scene.as_deref(),
+        args.size,
+        &formats,
+        &machine,
+        args.repeat,
+        &mut |_, _| {},
+    )?;
+    write_table(stdout, &rows).map_err(CliError::Stdout)?;
+    if let Some(path) = &args.csv {
+        let text = csv(&rows);
+        write_atomic(path, |w| {
+            w.write_all(text.as_bytes())
+                .map_err(|e| CliError::write(path, e))
+        })?;
+    }
+    if let Some(path) = &args.plot {
+        let name = crate::prepare::Source::resolve(args.scene.as_deref())?.name();
+        let img = render_tradeoff_plot(&rows, &name).map_err(CliError::Usage)?;
+        img.write_png(path)?;
+    }
+    stdout.flush().map_err(CliError::Stdout)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(busy: u64, rms: f64) -> Row {
+        Row {
+            renderer: "r",
+            shading: "gouraud",
+            aa: "box",
+            visibility: "exact",
+            numeric: "f64".into(),
+            register_bits: 256,
+            instructions: 0,
+            busy_cycles: busy,
+            worst_line_share: 0.0,
+            late_lines: 0,
+            host_ms: 0.0,
+            max_error: 0.0,
+            rms_error: rms,
+            psnr_db: 0.0,
+            overflows: 0,
+            pareto: false,
+        }
+    }
+
+    #[test]
+    fn the_pareto_front_keeps_only_undominated_points() {
+        let mut rows = vec![
+            row(100, 0.5),
+            row(200, 0.1),
+            row(150, 0.6), // dominated by (100, 0.5)
+            row(300, 0.1), // dominated by (200, 0.1)
+            row(400, 0.0),
+        ];
+        mark_pareto(&mut rows);
+        let front: Vec<bool> = rows.iter().map(|r| r.pareto).collect();
+        assert_eq!(front, [true, true, false, false, true]);
+        // fewer register bits at the same cycles and error dominates; more bits with a
+        // smaller error does not
+        let mut rows = vec![row(100, 0.5), row(100, 0.5), row(100, 0.4)];
+        rows[1].register_bits = 80;
+        rows[2].register_bits = 128;
+        mark_pareto(&mut rows);
+        let front: Vec<bool> = rows.iter().map(|r| r.pareto).collect();
+        assert_eq!(front, [false, true, true]);
+    }
+
+    #[test]
+    fn short_formats_parse_back() {
+        for f in [
+            "f64",
+            "f32",
+            "fixed:I=10.22,dI=4.28,ddI=1.35,acc=10.22,overflow=saturate",
+            "fixed:I=3.4,dI=2.8,ddI=1.9,acc=6.4,overflow=wrap",
+        ] {
+            let n: Numeric = f.parse().unwrap();
+            let back: Numeric = short_numeric(&n).parse().unwrap();
+            assert_eq!(back, n, "{f}");
+        }
+        assert_eq!(
+            short_numeric(&"fixed:I=10.22,dI=4.28,ddI=1.35".parse().unwrap()),
+            "fixed:I=10.22,dI=4.28,ddI=1.35"
+        );
+    }
+
+    #[test]
+    fn errors_and_psnr() {
+        let (max, rms, psnr) = errors(&[0.0, 0.5, 1.0, 1.0], &[0.0, 0.5, 1.0, 0.9]);
+        assert!((max - 0.1).abs() < 1e-12);
+        assert!((rms - 0.05).abs() < 1e-12);
+        assert!((psnr - 26.0206).abs() < 1e-3, "{psnr}");
+        assert_eq!(errors(&[1.0], &[1.0]).2, f64::INFINITY);
+    }
+}

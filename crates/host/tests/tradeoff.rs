@@ -1,0 +1,172 @@
+//! `cwisim tradeoff` and `cwisim fit` through the real binary.
+
+mod common;
+
+use common::{cwisim, cwisim_ok, scratch};
+use cwisim_ypipe::exact::scene_box_filtered;
+use cwisim_ypipe::scene::{parse_scene, Scene};
+use std::path::Path;
+
+fn npy(path: &Path) -> Vec<f64> {
+    let bytes = std::fs::read(path).expect("npy written");
+    npyz::NpyFile::new(&bytes[..])
+        .expect("valid npy")
+        .into_vec::<f64>()
+        .expect("f64 data")
+}
+
+struct CsvRow {
+    fields: Vec<String>,
+}
+
+impl CsvRow {
+    fn get(&self, header: &[String], name: &str) -> String {
+        let k = header.iter().position(|h| h == name).expect(name);
+        self.fields[k].trim_matches('"').to_string()
+    }
+}
+
+fn read_csv(path: &Path) -> (Vec<String>, Vec<CsvRow>) {
+    let text = std::fs::read_to_string(path).expect("csv");
+    let mut lines = text.lines();
+    let header: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
+    let rows = lines
+        .map(|l| {
+            // the numeric format is quoted and holds commas
+            let mut fields = Vec::new();
+            let mut cur = String::new();
+            let mut quoted = false;
+            for c in l.chars() {
+                match c {
+                    '"' => quoted = !quoted,
+                    ',' if !quoted => fields.push(std::mem::take(&mut cur)),
+                    _ => cur.push(c),
+                }
+            }
+            fields.push(cur);
+            CsvRow { fields }
+        })
+        .collect();
+    (header, rows)
+}
+
+#[test]
+fn tradeoff_measures_against_the_exact_image_and_marks_the_pareto_front() {
+    let dir = scratch("tradeoff");
+    let out = cwisim_ok(
+        &dir,
+        &[
+            "tradeoff",
+            "fig25",
+            "--repeat",
+            "1",
+            "--numeric",
+            "f64",
+            "--numeric",
+            "f32",
+            "--numeric",
+            "fixed:I=2.6,dI=2.6,ddI=2.6,overflow=wrap",
+            "--csv",
+            "t.csv",
+            "--plot",
+            "t.png",
+        ],
+    );
+    assert!(out.contains("pareto"), "{out}");
+    let (header, rows) = read_csv(&dir.join("t.csv"));
+    // a screen scene: shading × aa × formats
+    assert_eq!(rows.len(), 2 * 2 * 3);
+    // the f64, Gouraud, box-filter row against an independent computation of the same
+    // error: the array's image (render --npy) against the exact box filter
+    cwisim_ok(&dir, &["render", "fig25", "-q", "--npy", "f.npy"]);
+    let image = npy(&dir.join("f.npy"));
+    let text = cwisim_ok(&dir, &["scenes", "fig25"]);
+    let Scene::Screen(scene) = parse_scene(&text).unwrap();
+    let exact = scene_box_filtered(&scene);
+    let max = image
+        .iter()
+        .zip(&exact)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    let row = rows
+        .iter()
+        .find(|r| {
+            r.get(&header, "shading") == "gouraud"
+                && r.get(&header, "aa") == "box"
+                && r.get(&header, "numeric") == "f64"
+        })
+        .expect("the reference row");
+    let reported: f64 = row.get(&header, "max_error").parse().unwrap();
+    assert!((reported - max).abs() < 1e-15, "{reported} vs {max}");
+    // the Pareto marks: exactly the undominated rows in (cycles, bits, RMS)
+    let pts: Vec<(u64, u64, f64, bool)> = rows
+        .iter()
+        .map(|r| {
+            (
+                r.get(&header, "busy_cycles").parse().unwrap(),
+                r.get(&header, "register_bits").parse().unwrap(),
+                r.get(&header, "rms_error").parse().unwrap(),
+                r.get(&header, "pareto") == "true",
+            )
+        })
+        .collect();
+    for &(c, b, e, p) in &pts {
+        let dominated = pts
+            .iter()
+            .any(|&(c2, b2, e2, _)| c2 <= c && b2 <= b && e2 <= e && (c2 < c || b2 < b || e2 < e));
+        assert_eq!(p, !dominated, "({c}, {b}, {e})");
+    }
+    assert!(pts.iter().any(|p| p.3));
+    let plot = image::open(dir.join("t.png")).expect("plot");
+    assert_eq!((plot.width(), plot.height()), (1100, 700));
+}
+
+#[test]
+fn fit_finds_formats_that_hold_and_cannot_lose_a_bit() {
+    let dir = scratch("fit");
+    let out = cwisim_ok(&dir, &["fit", "fig25", "--max-error", "1/512"]);
+    let format = out
+        .lines()
+        .find_map(|l| l.strip_prefix("narrowest"))
+        .expect("a format")
+        .trim()
+        .to_string();
+    // the format, used by render, stays within the budget of the f64 array
+    cwisim_ok(&dir, &["render", "fig25", "-q", "--npy", "f64.npy"]);
+    cwisim_ok(
+        &dir,
+        &[
+            "render",
+            "fig25",
+            "-q",
+            "--npy",
+            "fx.npy",
+            "--numeric",
+            &format,
+        ],
+    );
+    let (a, b) = (npy(&dir.join("f64.npy")), npy(&dir.join("fx.npy")));
+    let worst = a
+        .iter()
+        .zip(&b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max);
+    assert!(worst <= 1.0 / 512.0, "{format}: {worst}");
+    assert!(worst > 0.0, "a narrow format is not exact");
+    // and no register can lose a fraction bit
+    let mut checked = 0;
+    for line in out.lines().filter(|l| l.contains("one fraction bit fewer")) {
+        let cost = line.rsplit("max error ").next().unwrap().trim();
+        if cost == "-" {
+            continue;
+        }
+        if cost != "overflow" {
+            let e: f64 = cost.parse().unwrap();
+            assert!(e > 1.0 / 512.0, "{line}");
+        }
+        checked += 1;
+    }
+    assert!(checked >= 3, "{out}");
+    let bad = cwisim(&dir, &["fit", "fig25", "--max-error", "0"]);
+    assert_eq!(bad.status.code(), Some(2));
+}

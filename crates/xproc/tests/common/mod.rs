@@ -1,0 +1,133 @@
+//! Strategies shared by the numeric-format tests.
+
+#![allow(dead_code)]
+
+use cwisim_isa::{Instruction, Intensity, Opcode, OperandKind};
+use cwisim_xproc::{FixedFormat, Numeric, Overflow, Q};
+use proptest::prelude::*;
+
+/// Any valid `Q`: 1..=64 integer bits, the rest of at most 64 bits fraction.
+pub fn any_q() -> impl Strategy<Value = Q> + Clone {
+    (1u32..=64)
+        .prop_flat_map(|int| (Just(int), 0..=64 - int))
+        .prop_map(|(int_bits, frac_bits)| Q {
+            int_bits,
+            frac_bits,
+        })
+}
+
+/// Tiny formats (at most 8 bits wide) that wrap or saturate all the time.
+pub fn tiny_q() -> impl Strategy<Value = Q> + Clone {
+    (1u32..=4, 0u32..=4).prop_map(|(int_bits, frac_bits)| Q {
+        int_bits,
+        frac_bits,
+    })
+}
+
+/// Moderate formats: 8..=24 integer bits, 0..=30 fraction bits.
+pub fn moderate_q() -> impl Strategy<Value = Q> + Clone {
+    (8u32..=24, 0u32..=30).prop_map(|(int_bits, frac_bits)| Q {
+        int_bits,
+        frac_bits,
+    })
+}
+
+pub fn overflow() -> impl Strategy<Value = Overflow> {
+    prop_oneof![Just(Overflow::Wrap), Just(Overflow::Saturate)]
+}
+
+fn format_of(q: impl Strategy<Value = Q> + Clone) -> impl Strategy<Value = FixedFormat> {
+    (q.clone(), q.clone(), q.clone(), q, overflow()).prop_map(|(i, di, ddi, acc, overflow)| {
+        FixedFormat {
+            i,
+            di,
+            ddi,
+            acc,
+            overflow,
+        }
+    })
+}
+
+/// A random fixed format: tiny, moderate, any, or one `Q` shared by every register.
+pub fn fixed_format() -> impl Strategy<Value = FixedFormat> {
+    prop_oneof![
+        2 => format_of(tiny_q()),
+        3 => format_of(moderate_q()),
+        2 => format_of(any_q()),
+        1 => (any_q(), overflow()).prop_map(|(q, overflow)| FixedFormat {
+            i: q,
+            di: q,
+            ddi: q,
+            acc: q,
+            overflow,
+        }),
+    ]
+}
+
+/// Any numeric format, fixed point most often.
+pub fn numeric() -> impl Strategy<Value = Numeric> {
+    prop_oneof![
+        1 => Just(Numeric::F64),
+        2 => Just(Numeric::F32),
+        6 => fixed_format().prop_map(Numeric::Fixed),
+    ]
+}
+
+/// Operand values over every scale a format may have: small, large, huge (beyond i64 at
+/// the finest scale), exact ties of dyadic grids, zeros.
+pub fn value() -> impl Strategy<Value = f64> + Clone {
+    prop_oneof![
+        4 => -2.0f64..2.0,
+        2 => (-(1i64 << 20)..(1i64 << 20), -70i32..40).prop_map(|(m, e)| m as f64 * 2f64.powi(e)),
+        1 => Just(0.0),
+        1 => Just(-0.0),
+        1 => -1e6f64..1e6,
+        1 => -1e-12f64..1e-12,
+        1 => (1e15f64..1e30, any::<bool>()).prop_map(|(v, neg)| if neg { -v } else { v }),
+        1 => -4e38f64..4e38,
+    ]
+}
+
+/// A valid instruction for a `width`-wide array of `channels` channels, weighted towards
+/// Evals, preloads and Refresh, every opcode reachable.
+pub fn instruction(
+    width: u32,
+    channels: usize,
+    value: impl Strategy<Value = f64> + Clone,
+) -> impl Strategy<Value = Instruction> {
+    let op = prop_oneof![
+        6 => 6usize..10,    // Eval0..Eval3
+        2 => Just(12usize), // Refresh
+        4 => 0usize..6,     // Set*
+        1 => Just(10usize), // Dis
+        1 => Just(11usize), // Acc_mode
+        1 => Just(13usize), // Nop
+    ];
+    (
+        op,
+        0..width,
+        0..=width,
+        proptest::collection::vec(value, 3 * channels),
+    )
+        .prop_map(move |(k, x, n, vals)| {
+            let op = Opcode::ALL[k];
+            let mut i = Instruction {
+                op,
+                x: 0,
+                dx: 0,
+                values: [Intensity::NONE; 3],
+            };
+            for kind in op.operands() {
+                match kind {
+                    OperandKind::X => i.x = x,
+                    OperandKind::Count => i.dx = n.min(width - x),
+                    OperandKind::Period => i.dx = n.clamp(1, 5),
+                    _ => {
+                        let s = kind.value_slot().unwrap();
+                        i.values[s] = Intensity::new(&vals[s * channels..(s + 1) * channels]);
+                    }
+                }
+            }
+            i
+        })
+}
