@@ -212,6 +212,10 @@ impl TraceWrite for Tee<'_> {
         self.first.comment(text)?;
         self.second.comment(text)
     }
+
+    fn wants_comments(&self) -> bool {
+        self.first.wants_comments() || self.second.wants_comments()
+    }
     fn finish(&mut self) -> io::Result<()> {
         self.first.finish()?;
         self.second.finish()

@@ -192,3 +192,41 @@ fn the_stats_json_describes_the_scene() {
     assert!(v["emit"]["claims"].as_u64().unwrap() > 0);
     assert!(v["stats"]["totals"]["suppressed"].as_u64().unwrap() > 0);
 }
+
+#[test]
+fn parallel_bands_give_the_serial_output_byte_for_byte() {
+    let dir = scratch("threads");
+    for mode in [
+        &["--visibility", "exact"][..],
+        &["--visibility", "eval0", "--aa", "none"],
+    ] {
+        let mut outputs = Vec::new();
+        for threads in ["1", "2", "3"] {
+            let (npy, trace, json) = (
+                format!("t{threads}.npy"),
+                format!("t{threads}.cwt"),
+                format!("t{threads}.json"),
+            );
+            let mut args = vec![
+                "render",
+                "still-life",
+                "-q",
+                "--size",
+                "150x110",
+                "--threads",
+                threads,
+                "--npy",
+                &npy,
+                "--trace",
+                &trace,
+                "--stats-json",
+                &json,
+            ];
+            args.extend_from_slice(mode);
+            cwisim_ok(&dir, &args);
+            outputs.push([npy, trace, json].map(|f| std::fs::read(dir.join(f)).expect("written")));
+        }
+        assert_eq!(outputs[0], outputs[1], "{mode:?}");
+        assert_eq!(outputs[0], outputs[2], "{mode:?}");
+    }
+}

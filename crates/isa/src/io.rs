@@ -39,6 +39,11 @@ pub trait TraceWrite {
     fn comment(&mut self, _text: &str) -> io::Result<()> {
         Ok(())
     }
+    /// Whether [`comment`](Self::comment) keeps anything: writers of remarks may skip
+    /// composing them when it does not (the default).
+    fn wants_comments(&self) -> bool {
+        false
+    }
     /// Writes what ends the trace (footer, flush). Call once, last.
     fn finish(&mut self) -> io::Result<()>;
 }

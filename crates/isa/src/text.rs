@@ -93,6 +93,10 @@ impl<W: Write> TraceWrite for TextWriter<W> {
         Ok(())
     }
 
+    fn wants_comments(&self) -> bool {
+        true
+    }
+
     fn finish(&mut self) -> io::Result<()> {
         self.out.flush()
     }

@@ -63,14 +63,22 @@ impl Procedure {
 }
 
 /// One row's instructions, with what produced them.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct RowFill {
     /// The case of the row (box filter only).
     pub case: Option<Case>,
     /// The instructions, each with its procedure.
     pub instructions: Vec<(Procedure, Instruction)>,
-    /// A one-line account, for the text trace.
+    /// A one-line account, for the text trace (empty when notes were not asked for).
     pub note: String,
+}
+
+impl RowFill {
+    fn reset(&mut self, case: Option<Case>) {
+        self.case = case;
+        self.instructions.clear();
+        self.note.clear();
+    }
 }
 
 /// The intensity model of one row: value at a pixel centre and change per pixel.
@@ -153,34 +161,39 @@ pub fn claim_chunk(di: &[f64], tolerance: f64, n: u32) -> u32 {
     k
 }
 
-/// The `Eval0`s that claim pixels `first ..= last` of a row: one when the row is flat,
-/// else a staircase of [`claim_chunk`] pixels each, holding the Gouraud value at the
-/// chunk's centre (the mean of its first and last pixel-centre values).
-fn claim_run(rs: &RowShade, first: i64, last: i64, tolerance: f64) -> Vec<Instruction> {
+/// Pushes the `Eval0`s that claim pixels `first ..= last` of a row: one when the row is
+/// flat, else a staircase of [`claim_chunk`] pixels each, holding the Gouraud value at the
+/// chunk's centre (the mean of its first and last pixel-centre values). Returns how many.
+fn claim_run(
+    rs: &RowShade,
+    first: i64,
+    last: i64,
+    tolerance: f64,
+    out: &mut Vec<(Procedure, Instruction)>,
+) -> usize {
     let ch = rs.channels;
     let n = (last - first + 1) as u32;
     if rs.flat() {
-        return vec![Instruction::eval0(
-            first as u32,
-            n,
-            intensity(&rs.at(first), ch),
-        )];
+        out.push((
+            Procedure::Claim,
+            Instruction::eval0(first as u32, n, intensity(&rs.at(first), ch)),
+        ));
+        return 1;
     }
     let k = i64::from(claim_chunk(&rs.di[..ch], tolerance, n));
-    let mut out = Vec::new();
+    let before = out.len();
     let mut a = first;
     while a <= last {
         let b = (a + k - 1).min(last);
         let (va, vb) = (rs.at(a), rs.at(b));
         let centre = vector(ch, |c| 0.5 * (va[c] + vb[c]));
-        out.push(Instruction::eval0(
-            a as u32,
-            (b - a + 1) as u32,
-            intensity(&centre, ch),
+        out.push((
+            Procedure::Claim,
+            Instruction::eval0(a as u32, (b - a + 1) as u32, intensity(&centre, ch)),
         ));
         a = b + 1;
     }
-    out
+    out.len() - before
 }
 
 fn intensity(v: &Vector, channels: usize) -> Intensity {
@@ -201,20 +214,48 @@ pub fn box_row(
     channels: usize,
     claim: Claim,
 ) -> Option<RowFill> {
-    let s = Slice::of(t, row)?;
+    let mut fill = RowFill::default();
+    box_row_into(t, row, width, shade, channels, claim, true, &mut fill).then_some(fill)
+}
+
+/// [`box_row`] into a reused `fill` (cleared first), writing its note only when `notes`;
+/// false when the row emits nothing. What [`crate::emit`] calls: no allocation per row.
+#[allow(clippy::too_many_arguments)]
+pub fn box_row_into(
+    t: &Trapezium,
+    row: u32,
+    width: u32,
+    shade: &Shade,
+    channels: usize,
+    claim: Claim,
+    notes: bool,
+    fill: &mut RowFill,
+) -> bool {
+    let Some(s) = Slice::of(t, row) else {
+        return false;
+    };
     let h = s.height();
     let rs = RowShade::new(t, shade, 0.5 * (s.y0 + s.y1), channels);
     let (l0, l1, r0, r1) = s.edge_pixels();
-    let mut specials = vec![l0, l1, r0, r1];
+    let mut specials = [l0, l1, r0, r1];
     specials.sort_unstable();
-    specials.dedup();
+    let mut n_specials = 1;
+    for k in 1..4 {
+        if specials[k] != specials[n_specials - 1] {
+            specials[n_specials] = specials[k];
+            n_specials += 1;
+        }
+    }
+    let specials = &specials[..n_specials];
     let in_left = |p: i64| p > l0 && p < l1;
     let in_right = |p: i64| p > r0 && p < r1;
     let (s_left, s_right) = (s.left.increment(h), s.right.increment(h));
-    // (procedure, first, last, coverage increment)
-    let mut stretches: Vec<(Procedure, i64, i64, f64)> = Vec::new();
+    // (procedure, first, last, coverage increment): at most 4 pixels and 3 runs
+    let mut stretches = [(Procedure::Single, 0i64, 0i64, 0.0f64); 7];
+    let mut n_stretches = 0;
     for (k, &p) in specials.iter().enumerate() {
-        stretches.push((Procedure::Single, p, p, 0.0));
+        stretches[n_stretches] = (Procedure::Single, p, p, 0.0);
+        n_stretches += 1;
         if let Some(&next) = specials.get(k + 1) {
             if next - p >= 2 {
                 let q = p + 1;
@@ -224,23 +265,22 @@ pub fn box_row(
                     (false, true) => (Procedure::Sequence, -s_right),
                     (false, false) => (Procedure::MiddlePart, 0.0),
                 };
-                stretches.push((run.0, q, next - 1, run.1));
+                stretches[n_stretches] = (run.0, q, next - 1, run.1);
+                n_stretches += 1;
             }
         }
     }
     let case = s.case();
-    let mut fill = RowFill {
-        case: Some(case),
-        instructions: Vec::new(),
-        note: String::new(),
-    };
-    let _ = write!(
-        fill.note,
-        "row {row} trapezium {} (polygon {}): case {}:",
-        t.id, t.polygon, case.0
-    );
+    fill.reset(Some(case));
+    if notes {
+        let _ = write!(
+            fill.note,
+            "row {row} trapezium {} (polygon {}): case {}:",
+            t.id, t.polygon, case.0
+        );
+    }
     let last_pixel = i64::from(width) - 1;
-    for (proc_, first, last, inc) in stretches {
+    for &(proc_, first, last, inc) in &stretches[..n_stretches] {
         let (first, last) = (first.max(0), last.min(last_pixel));
         if first > last {
             continue;
@@ -252,7 +292,7 @@ pub fn box_row(
         if let Claim::Eval0 { tolerance } = claim {
             let full = matches!(proc_, Procedure::Single | Procedure::MiddlePart) && ac == 1.0;
             if full {
-                push_claim(&mut fill, &rs, first, last, tolerance);
+                push_claim(fill, &rs, first, last, tolerance, notes);
                 continue;
             }
         }
@@ -286,30 +326,37 @@ pub fn box_row(
                 map(&rs.di, channels, |d, _| 2.0 * d * inc),
             ),
         };
-        if n == 1 {
-            let _ = write!(fill.note, " {} {first}", proc_.name());
-        } else {
-            let _ = write!(fill.note, " {} {first}..={last}", proc_.name());
+        if notes {
+            if n == 1 {
+                let _ = write!(fill.note, " {} {first}", proc_.name());
+            } else {
+                let _ = write!(fill.note, " {} {first}..={last}", proc_.name());
+            }
         }
         fill.instructions.push((proc_, instr));
     }
-    if fill.instructions.is_empty() {
-        return None;
-    }
-    Some(fill)
+    !fill.instructions.is_empty()
 }
 
-/// Claims pixels `first ..= last` into `fill`, with its note (` claim 3..=9 (2 Eval0)`).
-fn push_claim(fill: &mut RowFill, rs: &RowShade, first: i64, last: i64, tolerance: f64) {
-    let run = claim_run(rs, first, last, tolerance);
-    if first == last {
-        let _ = write!(fill.note, " claim {first}");
-    } else {
-        let _ = write!(fill.note, " claim {first}..={last}");
+/// Claims pixels `first ..= last` into `fill`, with its note (` claim 3..=9 (2 Eval0)`)
+/// when `notes`.
+fn push_claim(
+    fill: &mut RowFill,
+    rs: &RowShade,
+    first: i64,
+    last: i64,
+    tolerance: f64,
+    notes: bool,
+) {
+    let count = claim_run(rs, first, last, tolerance, &mut fill.instructions);
+    if notes {
+        if first == last {
+            let _ = write!(fill.note, " claim {first}");
+        } else {
+            let _ = write!(fill.note, " claim {first}..={last}");
+        }
+        let _ = write!(fill.note, " ({count} Eval0)");
     }
-    let _ = write!(fill.note, " ({} Eval0)", run.len());
-    fill.instructions
-        .extend(run.into_iter().map(|i| (Procedure::Claim, i)));
 }
 
 /// Point-sampled fill (no anti-aliasing) of `t` in pixel row `row`: the pixels whose
@@ -324,28 +371,45 @@ pub fn sampled_row(
     channels: usize,
     claim: Claim,
 ) -> Option<RowFill> {
+    let mut fill = RowFill::default();
+    sampled_row_into(t, row, width, shade, channels, claim, true, &mut fill).then_some(fill)
+}
+
+/// [`sampled_row`] into a reused `fill` (cleared first), writing its note only when
+/// `notes`; false when the row emits nothing.
+#[allow(clippy::too_many_arguments)]
+pub fn sampled_row_into(
+    t: &Trapezium,
+    row: u32,
+    width: u32,
+    shade: &Shade,
+    channels: usize,
+    claim: Claim,
+    notes: bool,
+    fill: &mut RowFill,
+) -> bool {
     let y = f64::from(row) + 0.5;
     if !(t.y_top <= y && y < t.y_bot) {
-        return None;
+        return false;
     }
     let (xl, xr) = (t.left.x_at(y), t.right.x_at(y));
     let first = ((xl - 0.5).ceil() as i64).max(0);
     let end = ((xr - 0.5).ceil() as i64).min(i64::from(width));
     if end <= first {
-        return None;
+        return false;
     }
     let rs = RowShade::new(t, shade, y, channels);
+    fill.reset(None);
     if let Claim::Eval0 { tolerance } = claim {
-        let mut fill = RowFill {
-            case: None,
-            instructions: Vec::new(),
-            note: format!(
+        if notes {
+            let _ = write!(
+                fill.note,
                 "row {row} trapezium {} (polygon {}): point-sampled",
                 t.id, t.polygon
-            ),
-        };
-        push_claim(&mut fill, &rs, first, end - 1, tolerance);
-        return Some(fill);
+            );
+        }
+        push_claim(fill, &rs, first, end - 1, tolerance, notes);
+        return true;
     }
     let (x, n) = (first as u32, (end - first) as u32);
     let fpi = rs.at(first);
@@ -354,21 +418,29 @@ pub fn sampled_row(
     } else {
         Instruction::eval2(x, n, intensity(&fpi, channels), intensity(&rs.di, channels))
     };
-    Some(RowFill {
-        case: None,
-        instructions: vec![(Procedure::MiddlePart, instr)],
-        note: format!(
+    fill.instructions.push((Procedure::MiddlePart, instr));
+    if notes {
+        let _ = write!(
+            fill.note,
             "row {row} trapezium {} (polygon {}): point-sampled span {first}..={}",
             t.id,
             t.polygon,
             end - 1
-        ),
-    })
+        );
+    }
+    true
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn claim_vec(rs: &RowShade, first: i64, last: i64, tolerance: f64) -> Vec<Instruction> {
+        let mut out = Vec::new();
+        let n = claim_run(rs, first, last, tolerance, &mut out);
+        assert_eq!(n, out.len());
+        out.into_iter().map(|(_, i)| i).collect()
+    }
     use cwisim_isa::{Opcode, MAX_CHANNELS};
 
     fn shade(x_left: f64, i_left: &[f64], di: &[f64]) -> RowShade {
@@ -462,7 +534,7 @@ mod tests {
         for rs in &rows {
             for tolerance in [0.0, 1.0 / 4096.0, 1.0 / 512.0, 0.01, 0.1, 1e9] {
                 for (first, last) in [(3, 3), (3, 4), (0, 63), (17, 211)] {
-                    let run = claim_run(rs, first, last, tolerance);
+                    let run = claim_vec(rs, first, last, tolerance);
                     let values = staircase(&run, first, last);
                     let n = (last - first + 1) as u32;
                     let k = claim_chunk(&rs.di[..rs.channels], tolerance, n);
@@ -498,7 +570,7 @@ mod tests {
     fn each_step_holds_the_value_at_its_centre() {
         // di = 0.01, tolerance 0.02: k = 5, so the steps hold the values at 2, 7, 12
         let rs = shade(0.5, &[0.0], &[0.01]);
-        let run = claim_run(&rs, 0, 13, 0.02);
+        let run = claim_vec(&rs, 0, 13, 0.02);
         let got: Vec<(u32, u32, f64)> = run
             .iter()
             .map(|i| (i.x, i.dx, i.i().as_slice()[0]))
@@ -514,7 +586,7 @@ mod tests {
     #[test]
     fn a_flat_run_is_one_eval0() {
         let rs = shade(0.0, &[0.3, 0.6], &[0.0, 0.0]);
-        let run = claim_run(&rs, 5, 40, 0.0);
+        let run = claim_vec(&rs, 5, 40, 0.0);
         assert_eq!(
             run,
             [Instruction::eval0(5, 36, Intensity::new(&[0.3, 0.6]))]

@@ -30,7 +30,7 @@ pub mod scan;
 pub mod scene;
 pub mod trapezoid;
 
-use crate::dofill::{box_row, sampled_row, Procedure, Shade};
+use crate::dofill::{box_row_into, sampled_row_into, Procedure, RowFill, Shade};
 use crate::scene::ScreenScene;
 use cwisim_isa::{Instruction, TraceHeader, TraceWrite, MAX_CHANNELS};
 use std::io;
@@ -139,6 +139,63 @@ fn flat_intensity(p: &scene::Polygon, channels: usize) -> [f64; MAX_CHANNELS] {
     })
 }
 
+/// A scene made ready to scan-convert: its trapezia (clipped, numbered) and each
+/// polygon's shading. Built once by [`ScanPlan::new`]; [`emit_rows`] then emits any band
+/// of rows from it, so that bands can be emitted independently (in parallel) and their
+/// streams concatenated into exactly [`emit`]'s.
+#[derive(Clone, Debug)]
+pub struct ScanPlan<'s> {
+    scene: &'s ScreenScene,
+    trapezia: Vec<trapezoid::Trapezium>,
+    shades: Vec<Shade>,
+}
+
+impl<'s> ScanPlan<'s> {
+    /// The plan of `scene` under `options`.
+    pub fn new(scene: &'s ScreenScene, options: &Options) -> ScanPlan<'s> {
+        let channels = usize::from(scene.channels);
+        ScanPlan {
+            scene,
+            trapezia: scene_trapezia(scene),
+            shades: scene
+                .polygons
+                .iter()
+                .map(|p| match options.shading {
+                    Shading::Flat => Shade::Flat(flat_intensity(p, channels)),
+                    Shading::Gouraud => Shade::Gouraud,
+                })
+                .collect(),
+        }
+    }
+
+    /// The statistics that belong to the whole scene, not to a band: polygons and
+    /// trapezia.
+    pub fn scene_stats(&self) -> EmitStats {
+        EmitStats {
+            polygons: self.scene.polygons.len() as u64,
+            trapezia: self.trapezia.len() as u64,
+            ..EmitStats::default()
+        }
+    }
+}
+
+impl EmitStats {
+    /// Adds a band's counts (everything but `polygons` and `trapezia`, which
+    /// [`ScanPlan::scene_stats`] gives once).
+    pub fn add_band(&mut self, band: &EmitStats) {
+        self.rows_filled += band.rows_filled;
+        for (a, b) in self.cases.iter_mut().zip(&band.cases) {
+            *a += b;
+        }
+        self.single_pixels += band.single_pixels;
+        self.middle_parts += band.middle_parts;
+        self.sequences += band.sequences;
+        self.share_sequences += band.share_sequences;
+        self.claims += band.claims;
+        self.instructions += band.instructions;
+    }
+}
+
 /// Scan-converts a scene into `sink`: every scanline's instructions, then its `Refresh`
 /// (one per image row, empty rows included). Text sinks also get a comment per
 /// trapezium row naming its DO_FILL case and stretches.
@@ -147,41 +204,57 @@ pub fn emit(
     options: &Options,
     sink: &mut dyn TraceWrite,
 ) -> io::Result<EmitStats> {
+    let plan = ScanPlan::new(scene, options);
+    let mut stats = plan.scene_stats();
+    stats.add_band(&emit_rows(&plan, options, 0..scene.height, sink)?);
+    Ok(stats)
+}
+
+/// The pixel rows `rows` of [`emit`]'s stream, each ending with its `Refresh`. The
+/// statistics count this band only (`polygons` and `trapezia` are 0: see
+/// [`ScanPlan::scene_stats`]).
+pub fn emit_rows(
+    plan: &ScanPlan<'_>,
+    options: &Options,
+    rows: std::ops::Range<u32>,
+    sink: &mut dyn TraceWrite,
+) -> io::Result<EmitStats> {
+    let scene = plan.scene;
     let channels = usize::from(scene.channels);
-    let trapezia = scene_trapezia(scene);
-    let shades: Vec<Shade> = scene
-        .polygons
-        .iter()
-        .map(|p| match options.shading {
-            Shading::Flat => Shade::Flat(flat_intensity(p, channels)),
-            Shading::Gouraud => Shade::Gouraud,
-        })
-        .collect();
-    let mut stats = EmitStats {
-        polygons: scene.polygons.len() as u64,
-        trapezia: trapezia.len() as u64,
-        ..EmitStats::default()
-    };
+    let (trapezia, shades) = (&plan.trapezia, &plan.shades);
+    let mut stats = EmitStats::default();
     let mut result = Ok(());
-    scan::scan(&trapezia, scene.height, channels, |visit| {
+    let notes = sink.wants_comments();
+    let mut fill = RowFill::default();
+    scan::scan_rows(trapezia, rows, channels, |visit| {
         if result.is_err() {
             return;
         }
         match visit {
             scan::Visit::Fill(row, t) => {
                 let shade = &shades[t.polygon as usize];
-                let fill = match options.aa {
-                    Antialias::Box => box_row(t, row, scene.width, shade, channels, options.claim),
+                let (w, claim) = (scene.width, options.claim);
+                let filled = match options.aa {
+                    Antialias::Box => {
+                        box_row_into(t, row, w, shade, channels, claim, notes, &mut fill)
+                    }
                     Antialias::None => {
-                        sampled_row(t, row, scene.width, shade, channels, options.claim)
+                        sampled_row_into(t, row, w, shade, channels, claim, notes, &mut fill)
                     }
                 };
-                let Some(fill) = fill else { return };
+                if !filled {
+                    return;
+                }
                 stats.rows_filled += 1;
                 if let Some(case) = fill.case {
                     stats.cases[usize::from(case.0) - 1] += 1;
                 }
-                result = sink.comment(&fill.note).and_then(|()| {
+                let commented = if notes {
+                    sink.comment(&fill.note)
+                } else {
+                    Ok(())
+                };
+                result = commented.and_then(|()| {
                     for (proc_, instr) in &fill.instructions {
                         match proc_ {
                             Procedure::Single => stats.single_pixels += 1,

@@ -96,9 +96,16 @@ pub enum Visit<'a> {
 
 /// Scans `trapezia` (already inside the image) over pixel rows `0..height`, calling
 /// `visit` for each trapezium active in a row and at the end of every row.
-pub fn scan(
+pub fn scan(trapezia: &[Trapezium], height: u32, channels: usize, visit: impl FnMut(Visit<'_>)) {
+    scan_rows(trapezia, 0..height, channels, visit);
+}
+
+/// [`scan`] over the pixel rows `rows` only: the same visits, in the same order, as the
+/// whole scan makes in those rows. Bands of rows can so be scanned independently (in
+/// parallel) and their streams concatenated into exactly the whole scan's.
+pub fn scan_rows(
     trapezia: &[Trapezium],
-    height: u32,
+    rows: std::ops::Range<u32>,
     channels: usize,
     mut visit: impl FnMut(Visit<'_>),
 ) {
@@ -121,13 +128,16 @@ pub fn scan(
     });
     let mut next = 0;
     let mut aet: Vec<EdgeNode> = Vec::new();
-    for row in 0..height {
+    for row in rows {
         let r = i64::from(row);
-        // 4.1: insert the nodes whose trapezium starts in this row
+        // 4.1: insert the nodes whose trapezium starts in this row (and, when a band
+        // starts below a trapezium's top, those that started above and still go on)
         while next < edge_list.len() && edge_list[next].top_row() <= r {
             let mut node = edge_list[next];
-            node.update_to(r, channels);
-            aet.push(node);
+            if node.bottom_row() >= r {
+                node.update_to(r, channels);
+                aet.push(node);
+            }
             next += 1;
         }
         // sorted on Identifier, then Xmax (the side breaks ties at a shared apex)
