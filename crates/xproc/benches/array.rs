@@ -88,23 +88,13 @@ fn bench(c: &mut Criterion) {
     }
     group.finish();
 
-    let formats = [
-        ("f64", "f64"),
-        ("f32", "f32"),
-        ("fixed", "fixed:I=4.28,dI=4.28,ddI=1.36,acc=12.20"),
-        ("fixed-wrap", "fixed:I=8.24,dI=8.24,ddI=8.24,overflow=wrap"),
-    ];
-    let updates = replay_numeric(&header, &trace, &Numeric::F64).processor_updates;
-    let mut group = c.benchmark_group("numeric_frame_1024x1024");
-    group.sample_size(10);
-    group.throughput(Throughput::Elements(updates));
-    for (name, format) in formats {
-        let numeric: Numeric = format.parse().expect("format");
-        group.bench_with_input(BenchmarkId::new("fast", name), &numeric, |b, n| {
-            b.iter(|| black_box(replay_numeric(&header, black_box(&trace), n).cycles))
-        });
-    }
-    group.finish();
+    numeric_group(c, "numeric_frame_1024x1024", &header, &trace);
+    numeric_group(
+        c,
+        "numeric_short_spans_1024x1024",
+        &header,
+        &short_span_trace(1024, 1024),
+    );
 
     let Numeric::Fixed(f) = "fixed:I=8.24,dI=8.24,ddI=8.24,overflow=wrap"
         .parse()
@@ -137,6 +127,58 @@ fn bench(c: &mut Criterion) {
         })
     });
     group.finish();
+}
+
+/// The numeric formats of the `numeric_*` groups: the reference, `f32`, a uniform and a
+/// mixed saturating fixed format, and a uniform wrapping one.
+const FORMATS: [(&str, &str); 5] = [
+    ("f64", "f64"),
+    ("f32", "f32"),
+    ("fixed-uniform", "fixed:I=4.28,dI=4.28,ddI=4.28"),
+    ("fixed-mixed", "fixed:I=4.28,dI=4.28,ddI=1.36,acc=12.20"),
+    ("fixed-wrap", "fixed:I=8.24,dI=8.24,ddI=8.24,overflow=wrap"),
+];
+
+/// The fast engine on `trace` in each of [`FORMATS`], throughput in processor updates.
+fn numeric_group(c: &mut Criterion, name: &str, header: &TraceHeader, trace: &[Instruction]) {
+    let updates = replay_numeric(header, trace, &Numeric::F64).processor_updates;
+    let mut group = c.benchmark_group(name);
+    group.sample_size(10);
+    group.throughput(Throughput::Elements(updates));
+    for (name, format) in FORMATS {
+        let numeric: Numeric = format.parse().expect("format");
+        group.bench_with_input(BenchmarkId::new("fast", name), &numeric, |b, n| {
+            b.iter(|| black_box(replay_numeric(header, black_box(trace), n).cycles))
+        });
+    }
+    group.finish();
+}
+
+/// Short spans, as the edge pixels of a box-filtered scene produce: per scanline 64
+/// Evals of 4–16 processors each (~640 processor updates), the same mix of orders as
+/// [`frame_trace`], no preloads, then a Refresh.
+fn short_span_trace(width: u32, lines: u32) -> Vec<Instruction> {
+    let mut rng = Rng(0xD1B5_4A32_D192_ED03);
+    let mut out = Vec::new();
+    let g = Intensity::grey;
+    for _ in 0..lines {
+        for _ in 0..64 {
+            let dx = 4 + rng.below(13) as u32;
+            let x = rng.below(u64::from(width - dx + 1)) as u32;
+            let (i, di, ddi) = (
+                rng.unit(),
+                (rng.unit() - 0.5) / 16.0,
+                (rng.unit() - 0.5) / 256.0,
+            );
+            out.push(match rng.below(4) {
+                0 => Instruction::eval1(x, dx, g(i)),
+                1 => Instruction::eval3(x, dx, g(i), g(di), g(ddi)),
+                _ => Instruction::eval2(x, dx, g(i), g(di)),
+            });
+        }
+        out.push(Instruction::refresh());
+    }
+    out
 }
 
 /// The fast engine on `trace` in `numeric`; the totals.

@@ -17,6 +17,10 @@ pub trait Engine<T: Sample> {
     fn execute(&mut self, instr: &Instruction, sink: &mut dyn LineSink<T>);
     /// Drains the array and returns the statistics.
     fn finish(self: Box<Self>, sink: &mut dyn LineSink<T>) -> RunStats;
+    /// Whether [`RunStats::lines`] gets every scanline's record (the default) or stays
+    /// empty, so that memory stays flat however long the trace (the totals are the
+    /// same). Call before the first instruction.
+    fn keep_line_stats(&mut self, keep: bool);
 }
 
 /// Which implementation of the timing model to run. Both give identical scanlines and
@@ -114,8 +118,24 @@ pub fn replay_numeric(
     sink: &mut dyn LineSink<f64>,
     progress: &mut dyn FnMut(u64),
 ) -> Result<RunStats, ReplayError> {
+    replay_streaming(reader, machine, timing, numeric, true, sink, progress)
+}
+
+/// [`replay_numeric`], choosing whether the statistics keep a record per scanline
+/// (`keep_line_stats`; [`Engine::keep_line_stats`]). Without them the replay holds one
+/// scanline of array state and the scanlines in flight, whatever the trace's length.
+pub fn replay_streaming(
+    reader: &mut dyn TraceRead,
+    machine: &Machine,
+    timing: Timing,
+    numeric: &Numeric,
+    keep_line_stats: bool,
+    sink: &mut dyn LineSink<f64>,
+    progress: &mut dyn FnMut(u64),
+) -> Result<RunStats, ReplayError> {
     let header = *reader.header();
-    let eng = numeric_engine(&header, machine, timing, numeric)?;
+    let mut eng = numeric_engine(&header, machine, timing, numeric)?;
+    eng.keep_line_stats(keep_line_stats);
     drive(reader, eng, sink, progress)
 }
 

@@ -260,6 +260,10 @@ impl<A: Arith> FastEngine<A> {
 }
 
 impl<A: Arith> Engine<A::Out> for FastEngine<A> {
+    fn keep_line_stats(&mut self, keep: bool) {
+        self.recorder.keep_lines(keep);
+    }
+
     fn execute(&mut self, instr: &Instruction, sink: &mut dyn LineSink<A::Out>) {
         let entry = self.issue(instr);
         let (x, dx) = (instr.x as usize, instr.dx as usize);

@@ -50,8 +50,8 @@ pub mod stepped;
 
 pub use arith::{Arith, F32Arith, FixedArith, Native};
 pub use engine::{
-    engine, numeric_engine, replay, replay_numeric, replay_probed, run, run_numeric, Engine,
-    ReplayError, Timing,
+    engine, numeric_engine, replay, replay_numeric, replay_probed, replay_streaming, run,
+    run_numeric, Engine, ReplayError, Timing,
 };
 pub use feed::EngineWriter;
 pub use machine::{Machine, MachineError, Timeline};

@@ -135,17 +135,37 @@ pub(crate) struct Work {
 /// Collects events from an engine into [`RunStats`]. Events name the scanline they
 /// belong to, since in the cycle-stepped engine work on one scanline finishes while the
 /// next one is already being issued.
+///
+/// Memory is bounded: a scanline's record is folded into the totals once the scanline is
+/// complete (a margin of [`Recorder::MARGIN`] complete scanlines stays open), so only the
+/// scanlines in flight are held — unless the per-scanline records are kept for
+/// [`RunStats::lines`] ([`Recorder::keep_lines`], the default).
 pub(crate) struct Recorder {
-    lines: Vec<LineStats>,
+    /// Open records, from scanline `base` on.
+    open: std::collections::VecDeque<LineStats>,
+    base: u64,
+    /// Scanlines whose `ready` has been recorded (they complete in order).
+    ready_lines: u64,
+    keep: bool,
+    kept: Vec<LineStats>,
+    folded: Totals,
     lines_per_frame: u64,
     last_entry: u64,
     stats: RunStats,
 }
 
 impl Recorder {
+    /// Complete scanlines kept open before they are folded into the totals.
+    pub(crate) const MARGIN: u64 = 2;
+
     pub(crate) fn new(timeline: &crate::machine::Timeline) -> Self {
         Recorder {
-            lines: Vec::new(),
+            open: std::collections::VecDeque::new(),
+            base: 0,
+            ready_lines: 0,
+            keep: true,
+            kept: Vec::new(),
+            folded: Totals::default(),
             lines_per_frame: timeline.lines_per_frame,
             last_entry: 0,
             stats: RunStats {
@@ -156,18 +176,63 @@ impl Recorder {
         }
     }
 
+    /// Whether to keep every scanline's record for [`RunStats::lines`] (memory grows with
+    /// the trace) or only the totals (memory stays flat). Set before the first event.
+    pub(crate) fn keep_lines(&mut self, keep: bool) {
+        self.keep = keep;
+    }
+
     fn line_mut(&mut self, line: u64) -> &mut LineStats {
-        let i = line as usize;
-        while self.lines.len() <= i {
-            let n = self.lines.len() as u64;
-            self.lines.push(LineStats {
+        assert!(
+            line >= self.base,
+            "an event for scanline {line}, folded already (the margin is too small)"
+        );
+        let i = (line - self.base) as usize;
+        while self.open.len() <= i {
+            let n = self.base + self.open.len() as u64;
+            self.open.push_back(LineStats {
                 line: n,
                 frame: n / self.lines_per_frame,
                 row: n % self.lines_per_frame,
                 ..LineStats::default()
             });
         }
-        &mut self.lines[i]
+        &mut self.open[i]
+    }
+
+    /// Adds a record to the totals; `refreshed`: the scanline was output.
+    fn fold(t: &mut Totals, l: &LineStats, refreshed: bool) {
+        t.opcodes.add(&l.opcodes);
+        t.instructions += l.instructions;
+        t.processor_updates += l.processor_updates;
+        t.dropped_negative += l.dropped_negative;
+        t.suppressed += l.suppressed;
+        t.overflows += l.overflows;
+        if refreshed {
+            if l.slack < 0 {
+                t.late_lines += 1;
+            }
+            if t.worst_slack.is_none_or(|w| l.slack < w) {
+                t.worst_slack = Some(l.slack);
+                t.worst_line = Some(l.line);
+            }
+        } else {
+            t.unrefreshed_instructions += l.instructions;
+        }
+    }
+
+    /// Folds the complete scanlines beyond the margin.
+    fn retire(&mut self) {
+        while self.base + Self::MARGIN < self.ready_lines {
+            let Some(l) = self.open.pop_front() else {
+                break;
+            };
+            Self::fold(&mut self.folded, &l, true);
+            if self.keep {
+                self.kept.push(l);
+            }
+            self.base += 1;
+        }
     }
 
     /// An instruction of scanline `line` started issuing at `begin` and entered the first
@@ -195,45 +260,34 @@ impl Recorder {
     }
 
     /// Scanline `line` is complete at `ready`; the display takes it at `deadline`.
+    /// Scanlines complete in order.
     pub(crate) fn ready(&mut self, line: u64, ready: u64, deadline: u64) {
         let l = self.line_mut(line);
         l.ready = ready;
         l.deadline = deadline;
         l.slack = deadline as i64 - ready as i64;
+        self.ready_lines = self.ready_lines.max(line + 1);
+        self.retire();
     }
 
     /// The totals, once every token has left the array at cycle `end`; `refreshed` is
     /// the number of scanlines output.
     pub(crate) fn finish(mut self, refreshed: u64, end: u64) -> RunStats {
-        let mut t = Totals {
-            cycles: end,
-            ..Totals::default()
-        };
-        for (i, l) in self.lines.iter().enumerate() {
-            t.opcodes.add(&l.opcodes);
-            t.instructions += l.instructions;
-            t.processor_updates += l.processor_updates;
-            t.dropped_negative += l.dropped_negative;
-            t.suppressed += l.suppressed;
-            t.overflows += l.overflows;
-            if (i as u64) < refreshed {
-                if l.slack < 0 {
-                    t.late_lines += 1;
-                }
-                if t.worst_slack.is_none_or(|w| l.slack < w) {
-                    t.worst_slack = Some(l.slack);
-                    t.worst_line = Some(l.line);
-                }
-            } else {
-                t.unrefreshed_instructions += l.instructions;
+        let mut t = self.folded;
+        t.cycles = end;
+        let open = std::mem::take(&mut self.open);
+        for l in open {
+            let output = l.line < refreshed;
+            Self::fold(&mut t, &l, output);
+            if self.keep && output {
+                self.kept.push(l);
             }
         }
-        self.lines.truncate(refreshed as usize);
         t.lines = refreshed;
         t.frames = refreshed / self.lines_per_frame;
         t.partial_frame_lines = refreshed % self.lines_per_frame;
         self.stats.totals = t;
-        self.stats.lines = self.lines;
+        self.stats.lines = self.kept;
         self.stats
     }
 }

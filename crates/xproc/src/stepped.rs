@@ -385,6 +385,10 @@ impl<'p, A: Arith> SteppedEngine<'p, A> {
 }
 
 impl<A: Arith> Engine<A::Out> for SteppedEngine<'_, A> {
+    fn keep_line_stats(&mut self, keep: bool) {
+        self.recorder.keep_lines(keep);
+    }
+
     fn execute(&mut self, instr: &Instruction, sink: &mut dyn LineSink<A::Out>) {
         let (gate, line) = if instr.op == Opcode::Refresh {
             (

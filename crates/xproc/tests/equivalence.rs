@@ -163,3 +163,44 @@ proptest! {
         }
     }
 }
+
+/// Without per-scanline records the totals are the same, on both engines, and the
+/// records are not kept (memory stays flat in the trace's length).
+#[test]
+fn streaming_statistics_have_the_same_totals() {
+    use cwisim_isa::{Instruction, Intensity, TraceHeader};
+    use cwisim_xproc::{numeric_engine, Machine, NullSink, Numeric, Timing};
+    let h = TraceHeader::new(32, 5, 1).unwrap();
+    let mut trace = Vec::new();
+    for line in 0..23u32 {
+        trace.push(Instruction::eval2(
+            line % 7,
+            20,
+            Intensity::grey(0.5),
+            Intensity::grey(-0.01),
+        ));
+        if line % 3 == 0 {
+            trace.push(Instruction::eval0(2, 5, Intensity::grey(0.25)));
+            trace.push(Instruction::eval1(0, 32, Intensity::grey(0.125)));
+        }
+        trace.push(Instruction::refresh());
+    }
+    trace.push(Instruction::eval1(0, 3, Intensity::grey(1.0))); // never refreshed
+    for timing in [Timing::Fast, Timing::Stepped] {
+        let machine = Machine::default();
+        let run = |keep: bool| {
+            let mut e = numeric_engine(&h, &machine, timing, &Numeric::F64).unwrap();
+            e.keep_line_stats(keep);
+            for i in &trace {
+                e.execute(i, &mut NullSink);
+            }
+            e.finish(&mut NullSink)
+        };
+        let (kept, streamed) = (run(true), run(false));
+        assert_eq!(kept.totals, streamed.totals, "{timing:?}");
+        assert_eq!(kept.lines.len(), 23);
+        assert!(streamed.lines.is_empty());
+        assert_eq!(kept.totals.unrefreshed_instructions, 1);
+        assert!(kept.totals.suppressed > 0);
+    }
+}

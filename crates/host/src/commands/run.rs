@@ -9,7 +9,7 @@ use crate::progress::Progress;
 use crate::report::{timing_name, unrefreshed_warning, write_summary, StatsReport};
 use clap::{Args, ValueEnum};
 use cwisim_isa::{Encoding, FileReader, TraceRead};
-use cwisim_xproc::{replay_numeric, Image, ImageSink, NullSink, Numeric, RunStats, Timing};
+use cwisim_xproc::{replay_streaming, Image, ImageSink, NullSink, Numeric, RunStats, Timing};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -112,12 +112,16 @@ pub fn run(
             }
             None => &mut *reader,
         };
-        replay_file(
+        // per-scanline records only when asked for: otherwise memory stays flat however
+        // long the trace
+        let keep_lines = args.stats_json.is_some();
+        replay_file_streaming(
             reader,
             &machine,
             timing,
             &args.numeric,
             want_image,
+            keep_lines,
             &mut |bytes| bar.update(bytes),
         )?
     };
@@ -200,6 +204,19 @@ pub fn replay_file(
     want_image: bool,
     progress: &mut dyn FnMut(u64),
 ) -> Result<Replayed, CliError> {
+    replay_file_streaming(reader, machine, timing, numeric, want_image, true, progress)
+}
+
+/// [`replay_file`], keeping a record per scanline only when `keep_lines`.
+pub fn replay_file_streaming(
+    reader: &mut dyn TraceRead,
+    machine: &cwisim_xproc::Machine,
+    timing: Timing,
+    numeric: &Numeric,
+    want_image: bool,
+    keep_lines: bool,
+    progress: &mut dyn FnMut(u64),
+) -> Result<Replayed, CliError> {
     let header = *reader.header();
     if want_image {
         let mut sink = ImageSink::new(
@@ -207,13 +224,23 @@ pub fn replay_file(
             header.channel_count(),
             ImageSink::DEFAULT_LIMIT_BYTES,
         );
-        let stats = replay_numeric(reader, machine, timing, numeric, &mut sink, progress)?;
+        let stats = replay_streaming(
+            reader, machine, timing, numeric, keep_lines, &mut sink, progress,
+        )?;
         Ok(Replayed {
             stats,
             image: Some(sink.finish()?),
         })
     } else {
-        let stats = replay_numeric(reader, machine, timing, numeric, &mut NullSink, progress)?;
+        let stats = replay_streaming(
+            reader,
+            machine,
+            timing,
+            numeric,
+            keep_lines,
+            &mut NullSink,
+            progress,
+        )?;
         Ok(Replayed { stats, image: None })
     }
 }
