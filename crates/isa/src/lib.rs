@@ -11,6 +11,8 @@
 //! * [`TraceHeader`] — format version, array width, scanlines per frame, channels.
 //! * Three encodings, chosen by extension ([`Encoding`]): [`text`] (`.cwt`), [`jsonl`]
 //!   (`.jsonl`), [`binary`] (`.cwb`). All are lossless (f64 bit-exact) and interconvert.
+//! * [`PackedStream`] — instructions buffered in memory at the size of the values they
+//!   carry (a band of scanlines handed from one thread to another).
 //! * [`TraceError`] — every decoding fault is typed ([`ErrorKind`]), located
 //!   ([`Location`]: line and column, or byte offset) and says what was expected.
 //!
@@ -40,6 +42,7 @@ pub mod instruction;
 pub mod io;
 pub mod jsonl;
 pub mod opcode;
+pub mod packed;
 pub mod text;
 
 pub use encoding::{create_trace, Encoding, FileReader};
@@ -48,3 +51,4 @@ pub use header::{HeaderFault, TraceHeader, FORMAT_VERSION, MAX_CHANNELS, MAX_LIN
 pub use instruction::{Instruction, Intensity, OperandError};
 pub use io::{TraceRead, TraceWrite};
 pub use opcode::{Opcode, OperandKind};
+pub use packed::PackedStream;

@@ -48,6 +48,78 @@ pub trait Arith: Send + Sync + 'static {
         buf.extend(acc.iter().map(|&r| self.out(r)));
         buf
     }
+
+    /// The plain adder chain of one `Eval` of order `ORDER` (1–3) on processors of `C`
+    /// channels, with no preload, lock or mask in its range: `acc` holds the range's
+    /// accumulators (`C` per processor, processor-major) and `wave` the running
+    /// registers at its first processor. Per processor and channel: `acc ← acc + v`
+    /// (unless `v` is negative and `neg_ok` is false: then the contribution is dropped),
+    /// then `v ← v + d` (`ORDER >= 2`), then `d ← d + dd` (`ORDER >= 3`).
+    ///
+    /// The default is exactly that, step by step ([`chain_steps`]); an implementation
+    /// may compute it another way but must give the same registers and the same counts,
+    /// bit for bit.
+    #[inline]
+    fn chain<const ORDER: usize, const C: usize>(
+        &self,
+        acc: &mut [Self::Reg],
+        wave: Wave<Self::Reg>,
+        neg_ok: bool,
+    ) -> Counts {
+        chain_steps::<Self, ORDER, C>(self, acc, wave, neg_ok)
+    }
+}
+
+/// The running registers of a wave at one processor: `v`, `d`, `dd` per channel.
+#[derive(Clone, Copy, Debug)]
+pub struct Wave<R> {
+    /// The value (`I` register role).
+    pub v: [R; MAX_CHANNELS],
+    /// The first difference (`dI`).
+    pub d: [R; MAX_CHANNELS],
+    /// The second difference (`ddI`).
+    pub dd: [R; MAX_CHANNELS],
+}
+
+/// What an [`Arith::chain`] counted.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Counts {
+    /// Contributions dropped by the `Acc_mode` rule.
+    pub dropped: u64,
+    /// Overflow events.
+    pub overflows: u64,
+}
+
+/// [`Arith::chain`] step by step, with the arithmetic's adders: the definition every
+/// implementation of `chain` must equal.
+#[inline]
+pub fn chain_steps<A: Arith + ?Sized, const ORDER: usize, const C: usize>(
+    ar: &A,
+    acc: &mut [A::Reg],
+    wave: Wave<A::Reg>,
+    neg_ok: bool,
+) -> Counts {
+    let Wave { mut v, mut d, dd } = wave;
+    let (mut dropped, mut ovf) = (0u64, 0u64);
+    for acc in acc.chunks_exact_mut(C) {
+        for k in 0..C {
+            if neg_ok || !ar.is_negative(v[k]) {
+                acc[k] = ar.accumulate(acc[k], v[k], &mut ovf);
+            } else {
+                dropped += 1;
+            }
+            if ORDER >= 2 {
+                v[k] = ar.advance_v(v[k], d[k], &mut ovf);
+            }
+            if ORDER >= 3 {
+                d[k] = ar.advance_d(d[k], dd[k], &mut ovf);
+            }
+        }
+    }
+    Counts {
+        dropped,
+        overflows: ovf,
+    }
 }
 
 /// Up to [`MAX_CHANNELS`] operand values for register `reg`; channels from `channels` on
@@ -184,6 +256,104 @@ impl Arith for F32Arith {
     fn out(&self, acc: f32) -> f64 {
         f64::from(acc)
     }
+
+    /// Without a check per add: a non-finite value stays non-finite along `v ← v + d`
+    /// and `d ← d + dd` (`±inf + finite` is `±inf`, `inf − inf` and `NaN + x` are NaN),
+    /// so the chains overflowed somewhere iff their last values are not finite, and an
+    /// accumulator's add overflowed iff the value it left is not finite. The common
+    /// case (everything finite: no events) costs one vectorized pass over `acc`; the
+    /// rare case counts the events exactly again ([`F32Arith::recount`]).
+    ///
+    /// A dropped contribution adds `-0.0` instead, which leaves every `f32` as it is
+    /// (`-0.0 + -0.0 = -0.0`; a quiet NaN stays the same NaN; registers never hold a
+    /// signalling NaN, since every value comes from a conversion or an add).
+    #[inline]
+    fn chain<const ORDER: usize, const C: usize>(
+        &self,
+        acc: &mut [f32],
+        wave: Wave<f32>,
+        neg_ok: bool,
+    ) -> Counts {
+        let (dropped, mut bad, end) = if neg_ok {
+            f32_chain::<ORDER, C, false>(acc, wave)
+        } else {
+            f32_chain::<ORDER, C, true>(acc, wave)
+        };
+        for k in 0..C {
+            bad |= non_finite(end.v[k]) | non_finite(end.d[k]);
+        }
+        let overflows = if bad & 0x8000_0000 == 0 {
+            0
+        } else {
+            Self::recount::<ORDER, C>(acc, wave, neg_ok)
+        };
+        Counts { dropped, overflows }
+    }
+}
+
+/// Bit 31 set iff `x` is not finite: `(bits & exponent) + 2^23` carries into bit 31
+/// iff the exponent is all ones.
+#[inline]
+fn non_finite(x: f32) -> u32 {
+    (x.to_bits() & 0x7f80_0000) + 0x0080_0000
+}
+
+/// The `f32` chain without overflow checks; returns the dropped count, the OR of
+/// [`non_finite`] over the accumulators it left, and the wave's registers after the
+/// last processor. `DROP`: the `Acc_mode` rule is on (negative contributions are
+/// dropped).
+#[inline]
+fn f32_chain<const ORDER: usize, const C: usize, const DROP: bool>(
+    acc: &mut [f32],
+    wave: Wave<f32>,
+) -> (u64, u32, Wave<f32>) {
+    let Wave { mut v, mut d, dd } = wave;
+    let (mut dropped, mut bad) = (0u64, 0u32);
+    for a in acc.chunks_exact_mut(C) {
+        for k in 0..C {
+            let x = v[k];
+            let drop = DROP && x < 0.0;
+            dropped += u64::from(drop);
+            let s = a[k] + if drop { -0.0 } else { x };
+            a[k] = s;
+            bad |= non_finite(s);
+            if ORDER >= 2 {
+                v[k] += d[k];
+            }
+            if ORDER >= 3 {
+                d[k] += dd[k];
+            }
+        }
+    }
+    (dropped, bad, Wave { v, d, dd })
+}
+
+impl F32Arith {
+    /// The overflow events of an `f32` chain that has run on `acc` from `wave`: its
+    /// `v`/`d` adds again, counted, and each accumulator add that left a non-finite value.
+    #[cold]
+    fn recount<const ORDER: usize, const C: usize>(
+        acc: &[f32],
+        wave: Wave<f32>,
+        neg_ok: bool,
+    ) -> u64 {
+        let Wave { mut v, mut d, dd } = wave;
+        let mut ovf = 0u64;
+        for a in acc.chunks_exact(C) {
+            for k in 0..C {
+                if (neg_ok || !F32Arith.is_negative(v[k])) && !a[k].is_finite() {
+                    ovf += 1;
+                }
+                if ORDER >= 2 {
+                    v[k] = Self::check(v[k] + d[k], &mut ovf);
+                }
+                if ORDER >= 3 {
+                    d[k] = Self::check(d[k] + dd[k], &mut ovf);
+                }
+            }
+        }
+        ovf
+    }
 }
 
 /// One register's format, ready for use.
@@ -196,6 +366,8 @@ struct Fit {
     wrap: bool,
     /// `2^-frac`.
     scale: f64,
+    /// `2^frac`.
+    up: f64,
 }
 
 impl Fit {
@@ -207,6 +379,7 @@ impl Fit {
             max: q.max_raw(),
             wrap: overflow == Overflow::Wrap,
             scale: q.quantum(),
+            up: f64::from(q.frac_bits).exp2(),
         }
     }
 
@@ -229,7 +402,30 @@ impl Fit {
     /// An operand: rounded to the nearest multiple of `2^-frac`, ties to even, exactly,
     /// then fitted. Non-finite values (never in a checked trace) saturate, NaN to 0, and
     /// count as overflows.
+    ///
+    /// The common case in `f64`: `y = x · 2^frac` is exact (a power-of-two scaling of a
+    /// finite value that does not overflow; a subnormal `x` only gains exponent), so when
+    /// `|y| < 2^63` its rounding ([`rounded_small`] below `2^51`, [`round_ties_even`]
+    /// then; both exact) is the integer [`round_scaled`] computes, and it converts to
+    /// `i64` exactly. Otherwise (huge, or not finite) the bit-level path.
+    #[inline]
     fn operand(&self, x: f64, overflows: &mut u64) -> i64 {
+        let y = x * self.up;
+        let r = if y.abs() < TWO_51 {
+            rounded_small(y)
+        } else if y.abs() < TWO_63 {
+            round_ties_even(y) as i64
+        } else {
+            return self.operand_bits(x, overflows);
+        };
+        if r >= self.min && r <= self.max {
+            return r;
+        }
+        self.fit(i128::from(r), overflows)
+    }
+
+    /// [`Fit::operand`] from the bits of `x`, for every `x`.
+    fn operand_bits(&self, x: f64, overflows: &mut u64) -> i64 {
         if !x.is_finite() {
             *overflows += 1;
             return if x.is_nan() {
@@ -254,6 +450,39 @@ impl Fit {
                 self.max
             }
         }
+    }
+}
+
+/// `2^63`.
+const TWO_63: f64 = 9_223_372_036_854_775_808.0;
+/// `2^51`.
+const TWO_51: f64 = 2_251_799_813_685_248.0;
+/// `2^52 + 2^51`.
+const MAGIC: f64 = 6_755_399_441_055_744.0;
+
+/// `y` rounded to an integer, ties to even, as `i64`, for `|y| < 2^51`: `t = y + M`
+/// with `M = 2^52 + 2^51` lies in `(2^52, 2^53]`, where the spacing is 1, so the add
+/// rounds `y` at the units (ties to even, `M` being even), and the bits of `t` minus
+/// those of `M` are `t − M` (the significand field counts units there, and crossing
+/// into `2^53` carries into the exponent field exactly).
+#[inline]
+fn rounded_small(y: f64) -> i64 {
+    ((y + MAGIC).to_bits() as i64).wrapping_sub(MAGIC.to_bits() as i64)
+}
+
+/// `y` rounded to an integer, ties to even, for `|y| < 2^63`: below `2^52`, adding and
+/// subtracting `±2^52` (the sign of `y`) rounds at the units (the sum lies in
+/// `[2^52, 2^53)` in magnitude, where the spacing is 1, and `2^52` is even, so ties go to
+/// the even integer) and the subtraction is exact; from `2^52` on every `f64` is an
+/// integer. (`f64::round_ties_even` is a library call on x86-64 without SSE4.1.)
+#[inline]
+fn round_ties_even(y: f64) -> f64 {
+    const TWO_52: f64 = 4_503_599_627_370_496.0;
+    if y.abs() < TWO_52 {
+        let c = TWO_52.copysign(y);
+        (y + c) - c
+    } else {
+        y
     }
 }
 
@@ -334,8 +563,21 @@ impl Adder {
                 return s;
             }
         }
-        let b = i128::from(b >> self.right) << self.left;
-        self.dst.fit(i128::from(a) + b, overflows)
+        self.dst.fit(i128::from(a) + self.aligned(b), overflows)
+    }
+
+    /// `b` aligned to the destination's fraction bits, exactly: `(b >> right) << left`.
+    #[inline]
+    fn aligned(&self, b: i64) -> i128 {
+        i128::from(b >> self.right) << self.left
+    }
+
+    /// [`Adder::aligned`] if it fits `i64`.
+    #[inline]
+    fn aligned_i64(&self, b: i64) -> Option<i64> {
+        let y = b >> self.right;
+        let z = y << self.left;
+        (z >> self.left == y).then_some(z)
     }
 }
 
@@ -348,6 +590,11 @@ pub struct FixedArith {
     acc: Adder,
     v: Adder,
     d: Adder,
+    /// `acc + aligned(v)` fits `i64` for every `acc` and `v` in their formats.
+    acc_in_i64: bool,
+    /// The bits of `acc − acc_min` (as `u64`) that only a sum outside `acc`'s range sets:
+    /// those from bit `width` on (none when `acc` is 64 bits wide).
+    acc_out_bits: u64,
 }
 
 impl FixedArith {
@@ -361,13 +608,104 @@ impl FixedArith {
             fit(Register::DDI),
             fit(Register::Acc),
         ];
+        let acc = Adder::new(fits[3], fits[0]);
+        // `aligned` is monotone, so the extremes of `I` give the extremes of its image.
+        let (lo, hi) = (acc.aligned(fits[0].min), acc.aligned(fits[0].max));
+        let i64_range = i128::from(i64::MIN)..=i128::from(i64::MAX);
+        let acc_in_i64 = i64_range.contains(&(i128::from(fits[3].min) + lo))
+            && i64_range.contains(&(i128::from(fits[3].max) + hi))
+            && i64_range.contains(&lo)
+            && i64_range.contains(&hi);
+        let acc_out_bits = if fits[3].width >= 64 {
+            0
+        } else {
+            u64::MAX << fits[3].width
+        };
         Ok(FixedArith {
             format: *format,
-            acc: Adder::new(fits[3], fits[0]),
+            acc,
             v: Adder::new(fits[0], fits[1]),
             d: Adder::new(fits[1], fits[2]),
             fits,
+            acc_in_i64,
+            acc_out_bits,
         })
+    }
+
+    /// If the wave's `v` and `d` adders provably stay in range (no overflow event, so no
+    /// fitting) for `n` processors from `wave` (the advances at the last processor
+    /// included), and every aligned `d` and `dd` the chain adds fits `i64`: `dd` aligned
+    /// to `d`'s format, per channel. Then the chain is plain `i64` arithmetic:
+    ///
+    /// * `d` (`ORDER` 3) gains the same `s = aligned(dd)` every step, so
+    ///   `d_k = d_0 + k·s` exactly, and it stays in range for `k <= n` iff `d_n` does
+    ///   (`d_0` is in range, and the range is an interval);
+    /// * `v` gains `a_k = aligned(d_k)` at step `k`, a monotone function of a monotone
+    ///   sequence, so every `a_k` (`k < n`) lies between `a_0` and `a_{n−1}`, and
+    ///   `v_k − v_0 = Σ_{j<k} a_j` lies in `[min(0, n·a_min), max(0, n·a_max)]` for
+    ///   `k <= n`.
+    ///
+    /// The bounds are computed with checked `i64` operations; one that overflows gives
+    /// `None` (the step-by-step chain then runs, so a bound that is merely not proved
+    /// costs time, never exactness).
+    #[inline]
+    fn quiet_wave<const ORDER: usize, const C: usize>(
+        &self,
+        wave: &Wave<i64>,
+        n: usize,
+    ) -> Option<[i64; MAX_CHANNELS]> {
+        let mut steps = [0i64; MAX_CHANNELS];
+        if ORDER < 2 || n == 0 {
+            return Some(steps);
+        }
+        let n = i64::try_from(n).ok()?;
+        let [fi, fd] = [self.fits[0], self.fits[1]];
+        for (k, step) in steps[..C].iter_mut().enumerate() {
+            let d0 = wave.d[k];
+            let mut last = d0;
+            if ORDER >= 3 {
+                let s = self.d.aligned_i64(wave.dd[k])?;
+                *step = s;
+                let dn = n.checked_mul(s)?.checked_add(d0)?;
+                if dn < fd.min || dn > fd.max {
+                    return None;
+                }
+                // d_{n-1} lies between d_0 and d_n
+                last = dn - s;
+            }
+            let (a0, a1) = (self.v.aligned_i64(d0)?, self.v.aligned_i64(last)?);
+            let (lo, hi) = (a0.min(a1), a0.max(a1));
+            let v0 = wave.v[k];
+            let low = v0.checked_add(n.checked_mul(lo)?.min(0))?;
+            let high = v0.checked_add(n.checked_mul(hi)?.max(0))?;
+            if low < fi.min || high > fi.max {
+                return None;
+            }
+        }
+        Some(steps)
+    }
+
+    /// Brings accumulators holding exact `i64` sums into range: nothing to do unless a
+    /// sum left the range, which `bits`, the OR of `acc − acc_min` (as `u64`) over the
+    /// sums, shows: a value in range sets no bit from `width` on, one outside sets one
+    /// (`width <= 63` there, since `acc + aligned(v)` fits `i64`). Returns the overflow
+    /// events: one per sum outside the range, fitted as its adder would have.
+    #[inline]
+    fn settle(&self, acc: &mut [i64], bits: u64) -> u64 {
+        if bits & self.acc_out_bits == 0 {
+            return 0;
+        }
+        self.settle_all(acc)
+    }
+
+    #[cold]
+    fn settle_all(&self, acc: &mut [i64]) -> u64 {
+        let f = self.fits[3];
+        let mut ovf = 0;
+        for s in acc {
+            *s = f.fit(i128::from(*s), &mut ovf);
+        }
+        ovf
     }
 
     /// The format.
@@ -408,6 +746,97 @@ impl Arith for FixedArith {
     fn out(&self, acc: i64) -> f64 {
         acc as f64 * self.fits[3].scale
     }
+
+    /// As [`Arith::out`] each; for an accumulator at most 52 bits wide through
+    /// [`small_to_f64`], which vectorizes (`i64 as f64` does not, before AVX-512).
+    fn emit<'s>(&self, acc: &'s [i64], buf: &'s mut Vec<f64>) -> &'s [f64] {
+        buf.clear();
+        let scale = self.fits[3].scale;
+        if self.fits[3].width <= 52 {
+            buf.extend(acc.iter().map(|&r| small_to_f64(r) * scale));
+        } else {
+            buf.extend(acc.iter().map(|&r| r as f64 * scale));
+        }
+        buf
+    }
+
+    /// In `i64` without a check per add when [`FixedArith::quiet_wave`] proves that `v`
+    /// and `d` stay in range and every `acc + aligned(v)` fits `i64` (decided once per
+    /// format): the accumulators then hold the exact sums, which
+    /// [`FixedArith::settle`] fits afterwards, counting the sums outside the range (each
+    /// accumulator is added to at most once per channel). A dropped contribution adds 0,
+    /// which changes nothing. Otherwise [`chain_steps`].
+    #[inline]
+    fn chain<const ORDER: usize, const C: usize>(
+        &self,
+        acc: &mut [i64],
+        wave: Wave<i64>,
+        neg_ok: bool,
+    ) -> Counts {
+        let quiet = if self.acc_in_i64 {
+            self.quiet_wave::<ORDER, C>(&wave, acc.len() / C)
+        } else {
+            None
+        };
+        let Some(steps) = quiet else {
+            return chain_steps::<Self, ORDER, C>(self, acc, wave, neg_ok);
+        };
+        let (dropped, bits) = if neg_ok {
+            self.fixed_chain::<ORDER, C, false>(acc, wave, steps)
+        } else {
+            self.fixed_chain::<ORDER, C, true>(acc, wave, steps)
+        };
+        Counts {
+            dropped,
+            overflows: self.settle(acc, bits),
+        }
+    }
+}
+
+impl FixedArith {
+    /// The chain in plain `i64` arithmetic (see [`Arith::chain`] for `FixedArith`):
+    /// `steps` are the aligned `dd`s. Returns the dropped count and the OR of
+    /// `acc − acc_min` over the sums ([`FixedArith::settle`]). `DROP`: the `Acc_mode`
+    /// rule is on.
+    #[inline]
+    fn fixed_chain<const ORDER: usize, const C: usize, const DROP: bool>(
+        &self,
+        acc: &mut [i64],
+        wave: Wave<i64>,
+        steps: [i64; MAX_CHANNELS],
+    ) -> (u64, u64) {
+        let Wave { mut v, mut d, .. } = wave;
+        let (ra, la) = (self.acc.right, self.acc.left);
+        let (rv, lv) = (self.v.right, self.v.left);
+        let min = self.fits[3].min;
+        let (mut dropped, mut bits) = (0u64, 0u64);
+        for a in acc.chunks_exact_mut(C) {
+            for k in 0..C {
+                let x = v[k];
+                let drop = DROP && x < 0;
+                dropped += u64::from(drop);
+                let s = a[k] + if drop { 0 } else { (x >> ra) << la };
+                a[k] = s;
+                bits |= s.wrapping_sub(min) as u64;
+                if ORDER >= 2 {
+                    v[k] += (d[k] >> rv) << lv;
+                }
+                if ORDER >= 3 {
+                    d[k] += steps[k];
+                }
+            }
+        }
+        (dropped, bits)
+    }
+}
+
+/// `r as f64`, exactly, for `|r| <= 2^51`, in operations that vectorize: the bits of
+/// `2^52 + 2^51` plus `r` are the `f64` `2^52 + 2^51 + r` (the sum stays in
+/// `[2^52, 2^53)`, where the spacing is 1), and subtracting `2^52 + 2^51` is exact (`+0.0`
+/// for 0, as `0 as f64`).
+#[inline]
+fn small_to_f64(r: i64) -> f64 {
+    f64::from_bits(MAGIC.to_bits().wrapping_add(r as u64)) - MAGIC
 }
 
 #[cfg(test)]
@@ -520,5 +949,30 @@ mod tests {
             a.operand(Register::I, 1.0 + 3.0 * 2f64.powi(-24), &mut o),
             1.0 + 2f32.powi(-22)
         );
+    }
+
+    proptest::proptest! {
+        #[test]
+        fn rounding_tricks_equal_the_standard_library(bits in proptest::prelude::any::<u64>()) {
+            let y = f64::from_bits(bits);
+            if y.abs() < TWO_51 {
+                proptest::prop_assert_eq!(rounded_small(y), y.round_ties_even() as i64);
+            }
+            if y.abs() < TWO_63 {
+                proptest::prop_assert_eq!(round_ties_even(y), y.round_ties_even());
+            }
+        }
+
+        #[test]
+        fn small_integers_convert_exactly(r in -(1i64 << 51)..=(1i64 << 51)) {
+            proptest::prop_assert_eq!(small_to_f64(r).to_bits(), (r as f64).to_bits());
+        }
+
+        #[test]
+        fn rounding_tricks_at_half_integers(n in -(1i64 << 50)..(1i64 << 50)) {
+            let y = n as f64 + 0.5;
+            proptest::prop_assert_eq!(rounded_small(y), y.round_ties_even() as i64);
+            proptest::prop_assert_eq!(round_ties_even(y), y.round_ties_even());
+        }
     }
 }

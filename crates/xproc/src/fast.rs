@@ -5,19 +5,38 @@
 //! the span of processors touched since the previous one, and an empty scanline costs
 //! O(1). State is one scanline: registers and flags per processor, nothing per frame.
 
-use crate::arith::{vector, Arith, Native};
+use crate::arith::{vector, Arith, Native, Wave};
 use crate::engine::Engine;
 use crate::machine::Timeline;
 use crate::numeric::Register;
 use crate::output::{LineOut, LineSink};
 use crate::sample::Sample;
 use crate::stats::{Recorder, RunStats, Work};
-use cwisim_isa::{Instruction, Opcode, TraceHeader, MAX_CHANNELS};
+use cwisim_isa::{Instruction, Intensity, Opcode, TraceHeader, MAX_CHANNELS};
 
 const HAS_I: u8 = 1;
 const HAS_DI: u8 = 2;
 const HAS_DDI: u8 = 4;
 const LOCKED: u8 = 8;
+
+/// Up to [`MAX_CHANNELS`] operand values for register `reg` on an array of `C` channels
+/// (a constant, so the loop unrolls and the values stay in machine registers); channels
+/// from `C` on stay zero. The same values and counts as [`vector`]. Always inlined: an
+/// array returned through memory, written element by element and read back whole,
+/// stalls store-to-load forwarding.
+#[inline(always)]
+fn operands<A: Arith, const C: usize>(
+    arith: &A,
+    reg: Register,
+    v: &Intensity,
+    overflows: &mut u64,
+) -> [A::Reg; MAX_CHANNELS] {
+    let mut out = [A::ZERO; MAX_CHANNELS];
+    for (o, x) in out[..C].iter_mut().zip(v.as_slice()) {
+        *o = arith.operand(reg, *x, overflows);
+    }
+    out
+}
 
 /// The fast engine (see the module documentation), with registers of arithmetic `A`.
 pub struct FastEngine<A: Arith> {
@@ -42,8 +61,13 @@ pub struct FastEngine<A: Arith> {
     dis_pending: bool,
     /// Processors touched since the last `Refresh`, half-open.
     touched: Option<(usize, usize)>,
+    /// Some processor has been masked (`Dis`) since the last `Refresh`.
+    any_masks: bool,
     /// Scanlines output so far.
     line: u64,
+    /// The work of the current scanline's instructions so far, recorded at its `Refresh`
+    /// (or at the end): one record per scanline instead of one per instruction.
+    line_work: Work,
     last_entry: Option<u64>,
     /// Scratch space for a scanline converted for output.
     out: Vec<A::Out>,
@@ -78,10 +102,21 @@ impl<A: Arith> FastEngine<A> {
             negative_enabled: false,
             any_flags: false,
             dis_pending: false,
+            any_masks: false,
             touched: None,
             line: 0,
+            line_work: Work::default(),
             last_entry: None,
             out: Vec::new(),
+        }
+    }
+
+    /// Records the current scanline's work so far (nothing if there was none, so that
+    /// no record is opened for a scanline without instructions).
+    fn flush_work(&mut self) {
+        let w = std::mem::take(&mut self.line_work);
+        if w.updates | w.dropped | w.suppressed | w.overflows != 0 {
+            self.recorder.work(self.line, w);
         }
     }
 
@@ -135,62 +170,48 @@ impl<A: Arith> FastEngine<A> {
     }
 
     /// [`Self::eval`] for the array's channel count, a constant there: the per-channel
-    /// loop unrolls and the running registers stay in machine registers.
-    fn eval_order<const ORDER: usize>(
-        &mut self,
-        x: usize,
-        dx: usize,
-        v: [A::Reg; MAX_CHANNELS],
-        d: [A::Reg; MAX_CHANNELS],
-        dd: [A::Reg; MAX_CHANNELS],
-        w: &mut Work,
-    ) {
+    /// loops unroll and the operands and running registers stay in machine registers.
+    fn eval_order<const ORDER: usize>(&mut self, instr: &Instruction) {
         const { assert!(MAX_CHANNELS == 4) };
         match self.channels {
-            1 => self.eval::<ORDER, 1>(x, dx, v, d, dd, w),
-            2 => self.eval::<ORDER, 2>(x, dx, v, d, dd, w),
-            3 => self.eval::<ORDER, 3>(x, dx, v, d, dd, w),
-            _ => self.eval::<ORDER, 4>(x, dx, v, d, dd, w),
+            1 => self.eval::<ORDER, 1>(instr),
+            2 => self.eval::<ORDER, 2>(instr),
+            3 => self.eval::<ORDER, 3>(instr),
+            _ => self.eval::<ORDER, 4>(instr),
         }
     }
 
-    /// Eval1 (`ORDER` 1), Eval2 (2) and Eval3 (3) on an array of `C` channels: forward
-    /// differencing along `[x, x+dx)`, picking up preloaded registers as the wave passes
-    /// them. Adds the dropped, suppressed and overflow counts to `w`.
-    fn eval<const ORDER: usize, const C: usize>(
-        &mut self,
-        x: usize,
-        dx: usize,
-        mut v: [A::Reg; MAX_CHANNELS],
-        mut d: [A::Reg; MAX_CHANNELS],
-        mut dd: [A::Reg; MAX_CHANNELS],
-        w: &mut Work,
-    ) {
+    /// Eval1 (`ORDER` 1), Eval2 (2) and Eval3 (3) on an array of `C` channels: the
+    /// operands converted, then forward differencing along `[x, x+dx)`, picking up
+    /// preloaded registers as the wave passes them. Adds its work to the scanline's
+    /// (field by field, from machine registers: a `Work` written piecewise through
+    /// memory and read back whole stalls store-to-load forwarding).
+    fn eval<const ORDER: usize, const C: usize>(&mut self, instr: &Instruction) {
         debug_assert_eq!(C, self.channels);
-        let c = C;
-        let (mut dropped, mut suppressed, mut ovf) = (0u64, 0u64, 0u64);
-        let neg_ok = self.negative_enabled;
+        let (x, dx) = (instr.x as usize, instr.dx as usize);
         let ar = &self.arith;
+        let (mut dropped, mut suppressed, mut ovf) = (0u64, 0u64, 0u64);
+        let mut v = operands::<A, C>(ar, Register::I, instr.i(), &mut ovf);
+        let mut d = [A::ZERO; MAX_CHANNELS];
+        if ORDER >= 2 {
+            d = operands::<A, C>(ar, Register::DI, instr.di(), &mut ovf);
+        }
+        let mut dd = [A::ZERO; MAX_CHANNELS];
+        if ORDER >= 3 {
+            dd = operands::<A, C>(ar, Register::DDI, instr.ddi(), &mut ovf);
+        }
+        let c = C;
+        let neg_ok = self.negative_enabled;
+        self.line_work.updates += dx as u64;
         if !self.any_flags && !self.dis_pending {
             // No preloads, locks or masks on this scanline: the plain adder chain.
-            for p in x..x + dx {
-                let acc = &mut self.acc[p * c..p * c + c];
-                for k in 0..c {
-                    if neg_ok || !ar.is_negative(v[k]) {
-                        acc[k] = ar.accumulate(acc[k], v[k], &mut ovf);
-                    } else {
-                        dropped += 1;
-                    }
-                    if ORDER >= 2 {
-                        v[k] = ar.advance_v(v[k], d[k], &mut ovf);
-                    }
-                    if ORDER >= 3 {
-                        d[k] = ar.advance_d(d[k], dd[k], &mut ovf);
-                    }
-                }
-            }
-            w.dropped += dropped;
-            w.overflows += ovf;
+            let counts = ar.chain::<ORDER, C>(
+                &mut self.acc[x * c..(x + dx) * c],
+                Wave { v, d, dd },
+                neg_ok,
+            );
+            self.line_work.dropped += counts.dropped;
+            self.line_work.overflows += ovf + counts.overflows;
             return;
         }
         let reads: u8 = match ORDER {
@@ -234,12 +255,13 @@ impl<A: Arith> FastEngine<A> {
                 }
             }
         }
-        w.dropped += dropped;
-        w.suppressed += suppressed;
-        w.overflows += ovf;
+        self.line_work.dropped += dropped;
+        self.line_work.suppressed += suppressed;
+        self.line_work.overflows += ovf;
     }
 
     fn refresh(&mut self, entry: u64, sink: &mut dyn LineSink<A::Out>) {
+        self.flush_work();
         let ready = entry + self.timeline.traversal();
         self.recorder
             .ready(self.line, ready, self.timeline.deadline(self.line));
@@ -251,10 +273,16 @@ impl<A: Arith> FastEngine<A> {
             values: self.arith.emit(&self.acc[lo * c..hi * c], &mut self.out),
         });
         self.acc[lo * c..hi * c].fill(A::ZERO);
-        self.flags[lo..hi].fill(0);
-        self.mask_stamp[lo..hi].fill(0);
+        // flags are only set with `any_flags`, stamps only by a `Dis`
+        if self.any_flags {
+            self.flags[lo..hi].fill(0);
+        }
+        if self.any_masks {
+            self.mask_stamp[lo..hi].fill(0);
+        }
         self.any_flags = false;
         self.dis_pending = false;
+        self.any_masks = false;
         self.line += 1;
     }
 }
@@ -311,33 +339,22 @@ impl<A: Arith> Engine<A::Out> for FastEngine<A> {
                 self.evals += 1;
             }
             Opcode::Eval1 | Opcode::Eval2 | Opcode::Eval3 => {
-                let ar = &self.arith;
-                let zero = [A::ZERO; MAX_CHANNELS];
-                let v = vector(ar, Register::I, instr.i(), c, &mut w.overflows);
-                let d = if instr.op == Opcode::Eval1 {
-                    zero
-                } else {
-                    vector(ar, Register::DI, instr.di(), c, &mut w.overflows)
-                };
-                let dd = if instr.op == Opcode::Eval3 {
-                    vector(ar, Register::DDI, instr.ddi(), c, &mut w.overflows)
-                } else {
-                    zero
-                };
                 match instr.op {
-                    Opcode::Eval1 => self.eval_order::<1>(x, dx, v, d, dd, &mut w),
-                    Opcode::Eval2 => self.eval_order::<2>(x, dx, v, d, dd, &mut w),
-                    _ => self.eval_order::<3>(x, dx, v, d, dd, &mut w),
+                    Opcode::Eval1 => self.eval_order::<1>(instr),
+                    Opcode::Eval2 => self.eval_order::<2>(instr),
+                    _ => self.eval_order::<3>(instr),
                 };
-                w.updates = dx as u64;
                 self.touch(x, x + dx);
                 self.evals += 1;
                 self.dis_pending = false;
+                // `eval` recorded its work
+                return;
             }
             Opcode::Dis => {
                 let stamp = self.evals + 1;
                 self.mask_stamp[x..x + dx].fill(stamp);
                 self.dis_pending |= dx > 0;
+                self.any_masks |= dx > 0;
                 w.updates = dx as u64;
                 self.touch(x, x + dx);
             }
@@ -351,10 +368,15 @@ impl<A: Arith> Engine<A::Out> for FastEngine<A> {
         if instr.op == Opcode::Eval0 {
             self.dis_pending = false;
         }
-        self.recorder.work(self.line, w);
+        let l = &mut self.line_work;
+        l.updates += w.updates;
+        l.dropped += w.dropped;
+        l.suppressed += w.suppressed;
+        l.overflows += w.overflows;
     }
 
-    fn finish(self: Box<Self>, _sink: &mut dyn LineSink<A::Out>) -> RunStats {
+    fn finish(mut self: Box<Self>, _sink: &mut dyn LineSink<A::Out>) -> RunStats {
+        self.flush_work();
         let end = self.last_entry.map_or(0, |e| e + self.timeline.traversal());
         self.recorder.finish(self.line, end)
     }

@@ -147,6 +147,8 @@ fn flat_intensity(p: &scene::Polygon, channels: usize) -> [f64; MAX_CHANNELS] {
 pub struct ScanPlan<'s> {
     scene: &'s ScreenScene,
     trapezia: Vec<trapezoid::Trapezium>,
+    /// The trapezia's edge list, sorted (built once, shared by every band).
+    edges: Vec<scan::EdgeNode>,
     shades: Vec<Shade>,
 }
 
@@ -154,9 +156,11 @@ impl<'s> ScanPlan<'s> {
     /// The plan of `scene` under `options`.
     pub fn new(scene: &'s ScreenScene, options: &Options) -> ScanPlan<'s> {
         let channels = usize::from(scene.channels);
+        let trapezia = scene_trapezia(scene);
         ScanPlan {
             scene,
-            trapezia: scene_trapezia(scene),
+            edges: scan::edge_list(&trapezia, channels),
+            trapezia,
             shades: scene
                 .polygons
                 .iter()
@@ -226,7 +230,7 @@ pub fn emit_rows(
     let mut result = Ok(());
     let notes = sink.wants_comments();
     let mut fill = RowFill::default();
-    scan::scan_rows(trapezia, rows, channels, |visit| {
+    scan::scan_rows_of(trapezia, &plan.edges, rows, channels, |visit| {
         if result.is_err() {
             return;
         }

@@ -107,9 +107,21 @@ pub fn scan_rows(
     trapezia: &[Trapezium],
     rows: std::ops::Range<u32>,
     channels: usize,
-    mut visit: impl FnMut(Visit<'_>),
+    visit: impl FnMut(Visit<'_>),
 ) {
-    // The edge list, sorted on the top row (then Identifier, side).
+    scan_rows_of(
+        trapezia,
+        &edge_list(trapezia, channels),
+        rows,
+        channels,
+        visit,
+    );
+}
+
+/// The edge list of `trapezia`: both edges of every trapezium, sorted on the top row
+/// (then Identifier, side). Built once per scene and shared by the bands of
+/// [`scan_rows_of`].
+pub fn edge_list(trapezia: &[Trapezium], channels: usize) -> Vec<EdgeNode> {
     let mut edge_list: Vec<EdgeNode> = trapezia
         .iter()
         .enumerate()
@@ -126,6 +138,17 @@ pub fn scan_rows(
             .then(a.identifier.cmp(&b.identifier))
             .then(a.side.cmp(&b.side))
     });
+    edge_list
+}
+
+/// [`scan_rows`] with the scene's [`edge_list`] built already.
+pub fn scan_rows_of(
+    trapezia: &[Trapezium],
+    edge_list: &[EdgeNode],
+    rows: std::ops::Range<u32>,
+    channels: usize,
+    mut visit: impl FnMut(Visit<'_>),
+) {
     let mut next = 0;
     let mut aet: Vec<EdgeNode> = Vec::new();
     for row in rows {

@@ -12,7 +12,7 @@ use crate::progress::Progress;
 use crate::report::{timing_name, write_summary, StatsReport};
 use crate::summary::{write_render_summary, StageTimes};
 use clap::Args;
-use cwisim_isa::{Encoding, Instruction, Opcode, TraceWrite};
+use cwisim_isa::{Encoding, Instruction, Opcode, PackedStream, TraceWrite};
 use cwisim_xproc::{EngineWriter, ImageSink, LineSink, Machine, Numeric, RunStats, Timing};
 use cwisim_ypipe::scene::ScreenScene;
 use cwisim_ypipe::{emit, emit_rows, header, EmitStats, Options, ScanPlan};
@@ -75,8 +75,9 @@ pub struct RenderArgs {
     /// Print nothing (errors still go to standard error).
     #[arg(short, long)]
     pub quiet: bool,
-    /// Scan-convert bands of scanlines on this many threads (0: one per core). The
-    /// output, trace and statistics are identical to the serial run's, byte for byte.
+    /// Threads: with N > 1, N − 1 threads scan-convert bands of scanlines while one feeds
+    /// them, in order, to the array (0: one per core). The output, trace and statistics
+    /// are identical to the serial run's, byte for byte.
     #[arg(long, default_value_t = 1, value_name = "N")]
     pub threads: usize,
 }
@@ -175,19 +176,6 @@ pub fn render_scene<'a>(
 }
 
 /// Collects a band's instructions.
-struct Band(Vec<Instruction>);
-
-impl TraceWrite for Band {
-    fn write(&mut self, instr: &Instruction) -> io::Result<()> {
-        self.0.push(*instr);
-        Ok(())
-    }
-
-    fn finish(&mut self) -> io::Result<()> {
-        Ok(())
-    }
-}
-
 /// Bands per thread: enough that uneven bands balance out.
 const BANDS_PER_THREAD: u32 = 8;
 
@@ -241,6 +229,9 @@ pub fn render_scene_threads<'a>(
     })
 }
 
+/// The parallel render: `threads − 1` workers emit bands of scanlines (taking the next
+/// band as they finish one) while this thread feeds the finished bands to the array in
+/// order, so scan conversion and the array overlap.
 #[allow(clippy::too_many_arguments)]
 fn render_parallel<'a>(
     scene: &ScreenScene,
@@ -253,33 +244,18 @@ fn render_parallel<'a>(
     progress: Option<&'a mut Progress>,
     threads: usize,
 ) -> Result<Rendered, CliError> {
-    use rayon::prelude::*;
+    use std::collections::BTreeMap;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::sync::{mpsc, Mutex};
     let h = header(scene);
     let start = Instant::now();
     let plan = ScanPlan::new(scene, options);
     let n = (threads as u32 * BANDS_PER_THREAD).clamp(1, scene.height.max(1));
-    let bands: Vec<std::ops::Range<u32>> = (0..n)
-        .map(|k| {
-            let a = (u64::from(scene.height) * u64::from(k) / u64::from(n)) as u32;
-            let b = (u64::from(scene.height) * u64::from(k + 1) / u64::from(n)) as u32;
-            a..b
-        })
-        .collect();
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| CliError::Usage(format!("cannot start {threads} threads: {e}")))?;
-    let emitted: Vec<io::Result<(Vec<Instruction>, EmitStats)>> = pool.install(|| {
-        bands
-            .par_iter()
-            .map(|rows| {
-                let mut band = Band(Vec::new());
-                let stats = emit_rows(&plan, options, rows.clone(), &mut band)?;
-                Ok((band.0, stats))
-            })
-            .collect()
-    });
-    let ypipe_time = start.elapsed();
+    let band_rows = |k: u32| {
+        let a = (u64::from(scene.height) * u64::from(k) / u64::from(n)) as u32;
+        let b = (u64::from(scene.height) * u64::from(k + 1) / u64::from(n)) as u32;
+        a..b
+    };
     let array = EngineWriter::with_numeric(&h, machine, timing, numeric, sink)?;
     let mut feed = ScanlineFeed {
         array,
@@ -290,27 +266,69 @@ fn render_parallel<'a>(
         lines: 0,
     };
     let mut stats = plan.scene_stats();
-    let fed = Instant::now();
-    for band in emitted {
-        let (instructions, band_stats) = band.map_err(|e| {
-            CliError::Usage(format!(
-                "the Y-processor emitted an invalid instruction: {e}"
-            ))
-        })?;
-        stats.add_band(&band_stats);
-        for instr in &instructions {
-            feed.write(instr)
-                .map_err(|e| CliError::Usage(format!("the array failed: {e}")))?;
+    let next_band = AtomicUsize::new(0);
+    // buffers the feeder has emptied, for the workers to reuse: a fresh buffer per band
+    // would be mapped and faulted in page by page (most bands are over the allocator's
+    // mmap threshold), which costs more than the work overlapped
+    let spare: Mutex<Vec<PackedStream>> = Mutex::new(Vec::new());
+    // this thread feeds the array: it counts as one of the `threads`
+    let workers = threads.saturating_sub(1).max(1);
+    let failed: Result<(), CliError> = std::thread::scope(|scope| {
+        let (tx, rx) = mpsc::channel::<(usize, io::Result<(PackedStream, EmitStats)>)>();
+        for _ in 0..workers {
+            let tx = tx.clone();
+            let (plan, next_band, band_rows, spare) = (&plan, &next_band, &band_rows, &spare);
+            scope.spawn(move || loop {
+                let k = next_band.fetch_add(1, Ordering::Relaxed);
+                if k >= n as usize {
+                    break;
+                }
+                let reused = spare.lock().ok().and_then(|mut s| s.pop());
+                let mut band = reused.unwrap_or_default();
+                band.clear();
+                let r = emit_rows(plan, options, band_rows(k as u32), &mut band)
+                    .map(|stats| (band, stats));
+                if tx.send((k, r)).is_err() {
+                    break; // the feeder stopped on an error
+                }
+            });
         }
-    }
+        drop(tx);
+        // feed the bands in order as they arrive
+        let mut waiting = BTreeMap::new();
+        let mut want = 0usize;
+        for (k, band) in rx {
+            waiting.insert(k, band);
+            while let Some(band) = waiting.remove(&want) {
+                let (instructions, band_stats) = band.map_err(|e| {
+                    CliError::Usage(format!(
+                        "the Y-processor emitted an invalid instruction: {e}"
+                    ))
+                })?;
+                stats.add_band(&band_stats);
+                for instr in instructions.iter() {
+                    feed.write(&instr)
+                        .map_err(|e| CliError::Usage(format!("the array failed: {e}")))?;
+                }
+                if let Ok(mut s) = spare.lock() {
+                    s.push(instructions);
+                }
+                want += 1;
+            }
+        }
+        Ok(())
+    });
+    failed?;
     feed.finish()
         .map_err(|e| CliError::Usage(format!("the array failed: {e}")))?;
-    let array_time = fed.elapsed();
+    let total = start.elapsed();
+    let array_time = feed.array_time;
     let run = feed.array.into_stats().expect("finished");
     Ok(Rendered {
         emitted: stats,
         stats: run,
-        ypipe_time,
+        // the two overlap: the Y-processor's share is what the array did not take
+        ypipe_time: total.saturating_sub(array_time),
         array_time,
     })
 }
