@@ -16,6 +16,7 @@
 //! `h / (hi - lo) = 1 / |1/slope|` per pixel — not `1 / (2 · |1/slope|)` as the report's
 //! sequence procedure says (docs/ERRATA.md, E1).
 
+use crate::floor::{ceil_i64, floor_i64};
 use crate::trapezoid::Trapezium;
 
 /// An edge over one slice: its x extent.
@@ -30,12 +31,12 @@ pub struct SliceEdge {
 impl SliceEdge {
     /// First pixel column the edge cuts through.
     pub fn first_pixel(&self) -> i64 {
-        self.lo.floor() as i64
+        floor_i64(self.lo)
     }
 
     /// Last pixel column the edge cuts through (at least the first).
     pub fn last_pixel(&self) -> i64 {
-        (self.hi.ceil() as i64 - 1).max(self.first_pixel())
+        (ceil_i64(self.hi) - 1).max(self.first_pixel())
     }
 
     /// `D_E(i) / h`: the fraction of the band's height, integrated over pixel `i`, that

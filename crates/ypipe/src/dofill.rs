@@ -21,6 +21,7 @@
 //! flat, else a staircase of `Eval0`s ([`claim_chunk`], docs/ERRATA.md, D9).
 
 use crate::coverage::{Case, Slice};
+use crate::floor::ceil_i64;
 use crate::trapezoid::{vector, Trapezium, Vector};
 use crate::Claim;
 use cwisim_isa::{Instruction, Intensity};
@@ -393,8 +394,8 @@ pub fn sampled_row_into(
         return false;
     }
     let (xl, xr) = (t.left.x_at(y), t.right.x_at(y));
-    let first = ((xl - 0.5).ceil() as i64).max(0);
-    let end = ((xr - 0.5).ceil() as i64).min(i64::from(width));
+    let first = ceil_i64(xl - 0.5).max(0);
+    let end = ceil_i64(xr - 0.5).min(i64::from(width));
     if end <= first {
         return false;
     }

@@ -26,6 +26,7 @@ pub mod clip;
 pub mod coverage;
 pub mod dofill;
 pub mod exact;
+mod floor;
 pub mod scan;
 pub mod scene;
 pub mod trapezoid;

@@ -15,6 +15,7 @@
 //! subtraction accumulates over thousands of rows, and two polygons sharing an edge get
 //! bit-identical positions on it.
 
+use crate::floor::{ceil_i64, floor_i64};
 use crate::trapezoid::{Edge, Trapezium, Vector};
 
 /// Which side of its trapezium an edge node bounds.
@@ -69,12 +70,12 @@ impl EdgeNode {
 
     /// The first pixel row the node's trapezium touches.
     fn top_row(&self) -> i64 {
-        self.y_top.floor() as i64
+        floor_i64(self.y_top)
     }
 
     /// The last pixel row the node's trapezium touches.
     fn bottom_row(&self) -> i64 {
-        (self.y_min.ceil() as i64 - 1).max(self.top_row())
+        (ceil_i64(self.y_min) - 1).max(self.top_row())
     }
 
     /// Moves the node to the top of pixel row `row`.
