@@ -50,11 +50,12 @@ pub struct StatsReport<'a> {
 }
 
 impl StatsReport<'_> {
-    /// Pretty JSON with a trailing newline.
-    pub fn to_json(&self) -> serde_json::Result<String> {
-        let mut s = serde_json::to_string_pretty(self)?;
-        s.push('\n');
-        Ok(s)
+    /// Pretty JSON with a trailing newline, written to `out` as it is made (no copy of
+    /// the whole document in memory: a long trace's per-scanline records run to hundreds
+    /// of megabytes).
+    pub fn write_json(&self, out: &mut dyn std::io::Write) -> std::io::Result<()> {
+        serde_json::to_writer_pretty(&mut *out, self)?;
+        out.write_all(b"\n")
     }
 }
 
@@ -165,14 +166,16 @@ mod tests {
     fn json_report_has_the_four_parts() {
         let (h, stats) = sample();
         let m = Machine::default();
-        let json = StatsReport {
+        let mut written = Vec::new();
+        StatsReport {
             trace: (&h).into(),
             machine: &m,
             timing: timing_name(Timing::Stepped),
             stats: &stats,
         }
-        .to_json()
-        .expect("serializes");
+        .write_json(&mut written)
+        .expect("writes");
+        let json = String::from_utf8(written).expect("utf-8");
         assert!(json.ends_with("}\n"));
         let v: serde_json::Value = serde_json::from_str(&json).expect("json");
         assert_eq!(

@@ -137,17 +137,14 @@ pub fn run(
     }
     let stats = &replayed.stats;
     if let Some(path) = &args.stats_json {
-        let json = StatsReport {
+        let report = StatsReport {
             trace: (&header).into(),
             machine: &machine,
             timing: timing_name(timing),
             stats,
-        }
-        .to_json()
-        .map_err(|e| CliError::write(path, e.into()))?;
+        };
         write_atomic(path, |w| {
-            w.write_all(json.as_bytes())
-                .map_err(|e| CliError::write(path, e))
+            report.write_json(w).map_err(|e| CliError::write(path, e))
         })?;
     }
     if let Some(warning) = unrefreshed_warning(stats) {
