@@ -95,7 +95,44 @@ struct ScanlineFeed<'a, 's> {
     lines: u64,
 }
 
-impl ScanlineFeed<'_, '_> {
+impl<'a, 's> ScanlineFeed<'a, 's> {
+    /// The array for `scene`, fed scanline by scanline (and `also` the trace, if any).
+    fn open(
+        scene: &ScreenScene,
+        machine: &Machine,
+        numeric: &Numeric,
+        timing: Timing,
+        sink: &'s mut dyn LineSink<f64>,
+        also: Option<&'a mut dyn TraceWrite>,
+        progress: Option<&'a mut Progress>,
+    ) -> Result<Self, CliError> {
+        let h = header(scene);
+        Ok(ScanlineFeed {
+            array: EngineWriter::with_numeric(&h, machine, timing, numeric, sink)?,
+            also,
+            buffer: Vec::new(),
+            array_time: Duration::ZERO,
+            progress,
+            lines: 0,
+        })
+    }
+
+    /// Finishes the array and the trace; `total` is the wall time since emission began
+    /// (the Y-processor's share is what the array did not take: the two interleave, or
+    /// overlap on threads).
+    fn close(mut self, emitted: EmitStats, total: Duration) -> Result<Rendered, CliError> {
+        self.finish()
+            .map_err(|e| CliError::Usage(format!("the array failed: {e}")))?;
+        let array_time = self.array_time;
+        let stats = self.array.into_stats().expect("finished");
+        Ok(Rendered {
+            emitted,
+            stats,
+            ypipe_time: total.saturating_sub(array_time),
+            array_time,
+        })
+    }
+
     fn flush(&mut self) -> io::Result<()> {
         let start = Instant::now();
         for instr in self.buffer.drain(..) {
@@ -200,33 +237,14 @@ pub fn render_scene_threads<'a>(
             scene, options, machine, numeric, timing, sink, also, progress, threads,
         );
     }
-    let h = header(scene);
-    let array = EngineWriter::with_numeric(&h, machine, timing, numeric, sink)?;
-    let mut feed = ScanlineFeed {
-        array,
-        also,
-        buffer: Vec::new(),
-        array_time: Duration::ZERO,
-        progress,
-        lines: 0,
-    };
+    let mut feed = ScanlineFeed::open(scene, machine, numeric, timing, sink, also, progress)?;
     let start = Instant::now();
     let emitted = emit(scene, options, &mut feed).map_err(|e| {
         CliError::Usage(format!(
             "the Y-processor emitted an invalid instruction: {e}"
         ))
     })?;
-    feed.finish()
-        .map_err(|e| CliError::Usage(format!("the array failed: {e}")))?;
-    let total = start.elapsed();
-    let array_time = feed.array_time;
-    let stats = feed.array.into_stats().expect("finished");
-    Ok(Rendered {
-        emitted,
-        stats,
-        ypipe_time: total.saturating_sub(array_time),
-        array_time,
-    })
+    feed.close(emitted, start.elapsed())
 }
 
 /// The parallel render: `threads − 1` workers emit bands of scanlines (taking the next
@@ -247,7 +265,6 @@ fn render_parallel<'a>(
     use std::collections::BTreeMap;
     use std::sync::atomic::{AtomicUsize, Ordering};
     use std::sync::{mpsc, Mutex};
-    let h = header(scene);
     let start = Instant::now();
     let plan = ScanPlan::new(scene, options);
     let n = (threads as u32 * BANDS_PER_THREAD).clamp(1, scene.height.max(1));
@@ -256,15 +273,7 @@ fn render_parallel<'a>(
         let b = (u64::from(scene.height) * u64::from(k + 1) / u64::from(n)) as u32;
         a..b
     };
-    let array = EngineWriter::with_numeric(&h, machine, timing, numeric, sink)?;
-    let mut feed = ScanlineFeed {
-        array,
-        also,
-        buffer: Vec::new(),
-        array_time: Duration::ZERO,
-        progress,
-        lines: 0,
-    };
+    let mut feed = ScanlineFeed::open(scene, machine, numeric, timing, sink, also, progress)?;
     let mut stats = plan.scene_stats();
     let next_band = AtomicUsize::new(0);
     // buffers the feeder has emptied, for the workers to reuse: a fresh buffer per band
@@ -319,18 +328,7 @@ fn render_parallel<'a>(
         Ok(())
     });
     failed?;
-    feed.finish()
-        .map_err(|e| CliError::Usage(format!("the array failed: {e}")))?;
-    let total = start.elapsed();
-    let array_time = feed.array_time;
-    let run = feed.array.into_stats().expect("finished");
-    Ok(Rendered {
-        emitted: stats,
-        stats: run,
-        // the two overlap: the Y-processor's share is what the array did not take
-        ypipe_time: total.saturating_sub(array_time),
-        array_time,
-    })
+    feed.close(stats, start.elapsed())
 }
 
 /// The whole trace in one encoding, in memory (written only once complete).
