@@ -9,10 +9,10 @@
 //! quoted in docs/ACCURACY.md.
 
 use cwisim_isa::{Instruction, Intensity, Opcode, TraceHeader, TraceWrite};
+use cwisim_scene::{Polygon, ScreenScene};
 use cwisim_xproc::numeric::{error_bound, Numeric};
 use cwisim_xproc::{EngineWriter, ImageSink, Machine, RunStats, Timing};
 use cwisim_ypipe::exact::scene_box_filtered;
-use cwisim_ypipe::scene::{Polygon, ScreenScene};
 use cwisim_ypipe::{emit, header, Options};
 
 /// The formats of the suite: the reference, f32, and fixed point wide enough for every

@@ -18,10 +18,10 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use cwisim_host::commands::scene::render_scene_threads;
 use cwisim_isa::{io::read_all, Encoding, Instruction, TraceWrite};
+use cwisim_scene::ScreenScene;
 use cwisim_world::embedded::embedded;
 use cwisim_world::{parse_any, project::project, resolve, AnyScene, Visibility, WorldScene};
 use cwisim_xproc::{EngineWriter, ImageSink, Machine, NullSink, Numeric, Timing};
-use cwisim_ypipe::scene::ScreenScene;
 use cwisim_ypipe::{emit, header, Claim, Options, Shading};
 use std::hint::black_box;
 use std::time::Duration;

@@ -1,8 +1,8 @@
 //! Every way a `cwisim` command can fail, and the exit code each gives.
 
 use cwisim_isa::TraceError;
+use cwisim_scene::SceneError;
 use cwisim_xproc::{ImageLimit, MachineError, ReplayError};
-use cwisim_ypipe::scene::SceneError;
 use std::path::PathBuf;
 
 /// Exit code for bad input or usage: a malformed trace or machine file, bad arguments.

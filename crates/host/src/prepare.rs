@@ -4,9 +4,9 @@
 
 use crate::error::CliError;
 use clap::{Args, ValueEnum};
+use cwisim_scene::ScreenScene;
 use cwisim_world::embedded::{embedded, EMBEDDED};
 use cwisim_world::{AnyScene, ProjectStats, Visibility, VisibilityStats};
-use cwisim_ypipe::scene::ScreenScene;
 use cwisim_ypipe::{Antialias, Claim, Options, Shading};
 use std::path::{Path, PathBuf};
 use std::str::FromStr;

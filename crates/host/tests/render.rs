@@ -3,8 +3,8 @@
 mod common;
 
 use common::{cwisim, scratch};
+use cwisim_scene::{Polygon, ScreenScene};
 use cwisim_ypipe::exact::scene_coverage;
-use cwisim_ypipe::scene::{Polygon, ScreenScene};
 use proptest::prelude::*;
 use std::path::Path;
 
@@ -20,11 +20,7 @@ fn write_scene(dir: &Path, name: &str, s: &ScreenScene) {
 }
 
 fn ones(vertices: Vec<[f64; 2]>) -> Polygon {
-    let n = vertices.len();
-    Polygon {
-        vertices,
-        intensity: vec![vec![1.0]; n],
-    }
+    Polygon::uniform(vertices, &[1.0])
 }
 
 proptest! {

@@ -3,8 +3,8 @@
 mod common;
 
 use common::{cwisim, cwisim_ok, scratch};
+use cwisim_scene::{parse_scene, Scene};
 use cwisim_ypipe::exact::scene_box_filtered;
-use cwisim_ypipe::scene::{parse_scene, Scene};
 use std::path::Path;
 
 fn npy(path: &Path) -> Vec<f64> {

@@ -24,7 +24,7 @@
 mod peers;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use cwisim_ypipe::scene::ScreenScene;
+use cwisim_scene::ScreenScene;
 use cwisim_ypipe::Shading;
 use peers::{cwisim_image, fill, outlines, ypipe_only, Mode, Peer};
 use std::hint::black_box;

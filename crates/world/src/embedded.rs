@@ -52,7 +52,7 @@ mod tests {
                 crate::parse_any(e.text, None).unwrap_or_else(|err| panic!("{}: {err}", e.name));
             if let crate::AnyScene::World(w) = scene {
                 let (tris, _) =
-                    crate::project::project(&w, cwisim_ypipe::Shading::Gouraud).unwrap();
+                    crate::project::project(&w, cwisim_scene::Shading::Gouraud).unwrap();
                 assert!(!tris.is_empty(), "{}", e.name);
             }
         }

@@ -1,6 +1,6 @@
 //! Screen triangles: what projection and lighting hand to visibility.
 
-use cwisim_ypipe::trapezoid::Vector;
+use cwisim_scene::Vector;
 
 /// A triangle in screen space after projection and lighting.
 ///
@@ -58,7 +58,7 @@ impl ScreenTriangle {
     /// The intensity at screen point `p` (affine; extrapolated outside the triangle).
     pub fn intensity_at(&self, p: [f64; 2], channels: usize) -> Option<Vector> {
         let w = self.barycentric(p)?;
-        Some(cwisim_ypipe::trapezoid::vector(channels, |c| {
+        Some(cwisim_scene::vector(channels, |c| {
             w[0] * self.intensity[0][c] + w[1] * self.intensity[1][c] + w[2] * self.intensity[2][c]
         }))
     }

@@ -13,7 +13,7 @@
 //! 3. [`visibility`] — visible surfaces, two ways ([`Visibility`]): exact object-space
 //!    fragments (polygon booleans with `i_overlay`), or the triangles in front-to-back
 //!    order so that the array's `Eval0` claims hide farther ones.
-//! 4. [`to_screen`] — the result as a `cwisim_ypipe::scene::ScreenScene`.
+//! 4. [`to_screen`] — the result as a `cwisim_scene::ScreenScene`.
 //!
 //! [`parse_any`] / [`load_any`] read any scene file (screen or world); [`embedded`] holds
 //! the scenes built into the binary.
@@ -30,10 +30,10 @@ pub mod project;
 pub mod scene;
 pub mod visibility;
 
-use cwisim_ypipe::scene::{
+use cwisim_scene::Shading;
+use cwisim_scene::{
     parse_scene, read_kind, Polygon, Scene, SceneError, SceneErrorKind, ScreenScene,
 };
-use cwisim_ypipe::Shading;
 use std::path::Path;
 
 pub use project::ProjectStats;
@@ -132,6 +132,36 @@ pub enum Visibility {
     /// By the array: whole triangles front to back, each claiming its fully covered
     /// pixels with `Eval0` (set the Y-processor's `Claim::Eval0`).
     Eval0,
+}
+
+impl Visibility {
+    /// Every value, in order.
+    pub const ALL: [Visibility; 2] = [Visibility::Exact, Visibility::Eval0];
+
+    /// The name the command line, the summaries and `tradeoff` use.
+    pub fn name(self) -> &'static str {
+        match self {
+            Visibility::Exact => "exact",
+            Visibility::Eval0 => "eval0",
+        }
+    }
+}
+
+impl std::fmt::Display for Visibility {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for Visibility {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        Visibility::ALL
+            .into_iter()
+            .find(|v| v.name().eq_ignore_ascii_case(s))
+            .ok_or_else(|| format!("unknown visibility `{s}`; expected exact or eval0"))
+    }
 }
 
 /// A world scene made ready for the Y-processor.

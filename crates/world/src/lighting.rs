@@ -12,7 +12,7 @@
 //! are not clamped: a PNG clamps to `[0, 1]` on output, `.npy` keeps the values.
 
 use crate::scene::{LightSpec, Material, PerChannel};
-use cwisim_ypipe::trapezoid::{vector, Vector};
+use cwisim_scene::{vector, Vector};
 use glam::DVec3;
 
 /// The lights of a scene.

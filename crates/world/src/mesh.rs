@@ -14,7 +14,7 @@
 
 use crate::obj;
 use crate::scene::{MeshSpec, Revolution, Scale, Transform};
-use cwisim_ypipe::scene::{SceneError, SceneErrorKind};
+use cwisim_scene::{SceneError, SceneErrorKind};
 use glam::{DMat3, DMat4, DQuat, DVec3, EulerRot};
 use std::path::Path;
 

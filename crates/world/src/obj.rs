@@ -9,7 +9,7 @@
 //! lines it hands to `tobj`, so every error names the file and line.
 
 use crate::mesh::Raw;
-use cwisim_ypipe::scene::{SceneError, SceneErrorKind};
+use cwisim_scene::{SceneError, SceneErrorKind};
 use glam::DVec3;
 use std::io::{BufRead, Cursor, Read};
 use std::path::Path;

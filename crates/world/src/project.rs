@@ -16,8 +16,8 @@ use crate::face::ScreenTriangle;
 use crate::lighting::Lighting;
 use crate::mesh::Mesh;
 use crate::scene::WorldScene;
-use cwisim_ypipe::scene::{SceneError, SceneErrorKind, MAX_COORDINATE};
-use cwisim_ypipe::Shading;
+use cwisim_scene::Shading;
+use cwisim_scene::{SceneError, SceneErrorKind, MAX_COORDINATE};
 use glam::DVec3;
 
 /// What projection did.

@@ -32,7 +32,7 @@
 //! [`SceneError`], as for screen scenes.
 
 use crate::mesh::{self, Mesh};
-use cwisim_ypipe::scene::{
+use cwisim_scene::{
     json_error, locate_error, SceneError, SceneErrorKind, MAX_CHANNELS, MAX_SIDE, MAX_VALUES,
 };
 use serde::{Deserialize, Serialize};

@@ -74,8 +74,8 @@
 //! centroid, nearest first.
 
 use crate::face::ScreenTriangle;
-use cwisim_ypipe::scene::Polygon;
-use cwisim_ypipe::trapezoid::Vector;
+use cwisim_scene::Polygon;
+use cwisim_scene::Vector;
 use i_overlay::core::fill_rule::FillRule;
 use i_overlay::core::overlay::ShapeType;
 use i_overlay::core::overlay_rule::OverlayRule;

@@ -1,8 +1,8 @@
 //! Bad world scene files: every fault is a located error naming what was expected —
 //! never a panic.
 
+use cwisim_scene::SceneErrorKind;
 use cwisim_world::{load_any, parse_any};
-use cwisim_ypipe::scene::SceneErrorKind;
 
 const GOOD: &str = r#"{
   "kind": "world", "width": 32, "height": 24, "channels": 1,

@@ -3,11 +3,11 @@
 //! of the visible fragments.
 
 use cwisim_isa::TraceWrite;
+use cwisim_scene::ScreenScene;
 use cwisim_world::embedded::embedded;
 use cwisim_world::{parse_any, to_screen, AnyScene, Visibility};
 use cwisim_xproc::{EngineWriter, ImageSink, Machine, Timing};
 use cwisim_ypipe::exact::polygon_area;
-use cwisim_ypipe::scene::ScreenScene;
 use cwisim_ypipe::{emit, header, Claim, Options, Shading};
 
 /// The pot with ambient-only light of intensity 1 (`k_a` = 1): coverage, not shading.

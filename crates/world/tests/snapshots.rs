@@ -4,9 +4,9 @@
 
 use cwisim_isa::text::TextWriter;
 use cwisim_isa::TraceWrite;
+use cwisim_scene::ScreenScene;
 use cwisim_world::embedded::embedded;
 use cwisim_world::{parse_any, to_screen, AnyScene, Visibility};
-use cwisim_ypipe::scene::ScreenScene;
 use cwisim_ypipe::{emit, header, Options, Shading};
 
 fn text(scene: &ScreenScene, options: &Options) -> String {

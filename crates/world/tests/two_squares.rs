@@ -8,10 +8,10 @@
 //! polygon booleans.
 
 use cwisim_isa::TraceWrite;
+use cwisim_scene::{Polygon, ScreenScene};
 use cwisim_world::{parse_any, to_screen, AnyScene, Visibility};
 use cwisim_xproc::{EngineWriter, ImageSink, Machine, Timing};
 use cwisim_ypipe::exact::coverage;
-use cwisim_ypipe::scene::{Polygon, ScreenScene};
 use cwisim_ypipe::{emit, header, Claim, Options};
 
 const W: u32 = 48;

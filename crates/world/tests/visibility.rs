@@ -3,10 +3,10 @@
 //! inclusion–exclusion over convex intersections (clipped here), the scene validator's
 //! exact simplicity test, and brute-force depth tests at sample points.
 
+use cwisim_scene::{Polygon, ScreenScene};
 use cwisim_world::face::ScreenTriangle;
 use cwisim_world::visibility::{exact_fragments, Fragment, VisibilityStats};
 use cwisim_ypipe::exact::{coverage, polygon_area};
-use cwisim_ypipe::scene::{Polygon, ScreenScene};
 use proptest::prelude::*;
 
 type P = [f64; 2];

@@ -10,9 +10,9 @@
 //! ```
 
 use cwisim_isa::TraceWrite;
+use cwisim_scene::{Polygon, ScreenScene};
 use cwisim_xproc::{EngineWriter, ImageSink, Machine, Timing};
 use cwisim_ypipe::exact::{scene_box_filtered, scene_coverage};
-use cwisim_ypipe::scene::{Polygon, ScreenScene};
 use cwisim_ypipe::{emit, header, Options};
 
 fn scene(width: u32, height: u32, polygons: Vec<Polygon>) -> ScreenScene {
@@ -28,6 +28,7 @@ fn tri(v: [[f64; 2]; 3], i: [f64; 3]) -> Polygon {
     Polygon {
         vertices: v.to_vec(),
         intensity: i.iter().map(|x| vec![*x]).collect(),
+        depth: None,
     }
 }
 

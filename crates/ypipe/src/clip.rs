@@ -20,14 +20,14 @@
 //!
 //! ```
 //! use cwisim_ypipe::clip::clip_to_rect;
-//! use cwisim_ypipe::scene::Polygon;
+//! use cwisim_scene::Polygon;
 //! let p = Polygon::new(vec![[-2.0, 0.0], [2.0, 0.0], [2.0, 2.0]], vec![vec![0.0], vec![4.0], vec![8.0]]);
 //! let c = clip_to_rect(&p, 0.0, 0.0, 10.0, 10.0);
 //! assert_eq!(c.vertices, vec![[0.0, 1.0], [0.0, 0.0], [2.0, 0.0], [2.0, 2.0]]);
 //! assert_eq!(c.intensity, vec![vec![4.0], vec![2.0], vec![4.0], vec![8.0]]);
 //! ```
 
-use crate::scene::Polygon;
+use cwisim_scene::Polygon;
 
 /// The part of `p` inside the rectangle `[x0, x1] × [y0, y1]`, with intensities
 /// interpolated along the cut edges.

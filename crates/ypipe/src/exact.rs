@@ -18,7 +18,7 @@
 //!
 //! ```
 //! use cwisim_ypipe::exact::{box_filtered, coverage, polygon_area};
-//! use cwisim_ypipe::scene::Polygon;
+//! use cwisim_scene::Polygon;
 //! let p = Polygon::new(vec![[0.0, 0.0], [2.0, 0.0], [0.0, 2.0]], vec![vec![0.0], vec![2.0], vec![0.0]]);
 //! assert_eq!(polygon_area(&p), 2.0);
 //! assert_eq!(coverage(&p, 2, 2), vec![1.0, 0.5, 0.5, 0.0]);
@@ -27,10 +27,10 @@
 //! assert!((b[1] - 2.0 / 3.0).abs() < 1e-15);
 //! ```
 //!
-//! [`ScreenScene::validate`]: crate::scene::ScreenScene::validate
+//! [`ScreenScene::validate`]: cwisim_scene::ScreenScene::validate
 
 use crate::clip::clip_to_rect;
-use crate::scene::{Polygon, ScreenScene};
+use cwisim_scene::{Polygon, ScreenScene};
 
 /// The exact area of a polygon: the absolute value of its shoelace sum (taken relative to
 /// its first vertex). Zero for fewer than 3 vertices. Meaningful for simple polygons.

@@ -4,7 +4,7 @@
 //! of the X-processor array, as van Rij's report (CS-R9427, sections 2–3, appendix A)
 //! describes:
 //!
-//! 1. [`scene`] — screen-space scenes (JSON): polygons with per-vertex intensities.
+//! 1. `cwisim_scene` — screen-space scenes (JSON): polygons with per-vertex intensities.
 //! 2. [`clip`] — polygons are clipped exactly to the image.
 //! 3. [`trapezoid`] — each polygon becomes trapezia with horizontal top and bottom.
 //! 4. [`scan`] — an edge list and an active edge table grouped by Identifier visit the
@@ -28,33 +28,14 @@ pub mod dofill;
 pub mod exact;
 mod floor;
 pub mod scan;
-pub mod scene;
 pub mod trapezoid;
 
 use crate::dofill::{box_row_into, sampled_row_into, Procedure, RowFill, Shade};
-use crate::scene::ScreenScene;
 use cwisim_isa::{Instruction, TraceHeader, TraceWrite, MAX_CHANNELS};
+use cwisim_scene::ScreenScene;
 use std::io;
 
-/// Flat or Gouraud shading.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Shading {
-    /// One intensity per polygon: the mean of its vertex intensities.
-    Flat,
-    /// Intensities interpolated along the edges and across each scanline.
-    #[default]
-    Gouraud,
-}
-
-/// Anti-aliasing.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Antialias {
-    /// Point sampling at pixel centres.
-    None,
-    /// Box filter: exact covered area per pixel (DO_FILL).
-    #[default]
-    Box,
-}
+pub use cwisim_scene::{Antialias, Shading};
 
 /// What a polygon does to the pixels it fully covers.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -133,7 +114,7 @@ pub fn scene_trapezia(scene: &ScreenScene) -> Vec<trapezoid::Trapezium> {
     out
 }
 
-fn flat_intensity(p: &scene::Polygon, channels: usize) -> [f64; MAX_CHANNELS] {
+fn flat_intensity(p: &cwisim_scene::Polygon, channels: usize) -> [f64; MAX_CHANNELS] {
     let n = p.intensity.len().max(1) as f64;
     trapezoid::vector(channels, |c| {
         p.intensity.iter().map(|v| v[c]).sum::<f64>() / n

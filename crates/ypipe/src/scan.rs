@@ -188,8 +188,8 @@ pub fn scan_rows_of(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::Polygon;
     use crate::trapezoid::trapezia;
+    use cwisim_scene::Polygon;
 
     /// Why the AET is sorted on Identifier first (section 3.4.1): when trapezia share a
     /// row and their x ranges overlap (overlapping polygons, or the ties at a shared vertex
@@ -201,6 +201,7 @@ mod tests {
         let tri = |v: [[f64; 2]; 3]| Polygon {
             vertices: v.to_vec(),
             intensity: vec![vec![1.0]; 3],
+            depth: None,
         };
         let mut ts = trapezia(&tri([[2.0, 0.0], [10.0, 0.0], [6.0, 8.0]]), 0, 1, 1);
         ts.extend(trapezia(

@@ -6,16 +6,9 @@
 //! by the same two edges are merged. The trapezia of a polygon tile it with no gap and no
 //! overlap: each band's pieces are exactly the polygon's spans.
 
-use crate::scene::Polygon;
 use cwisim_isa::MAX_CHANNELS;
-
-/// A channel vector.
-pub type Vector = [f64; MAX_CHANNELS];
-
-/// The vector whose first `channels` entries are `f(c)` (the rest 0).
-pub fn vector(channels: usize, f: impl Fn(usize) -> f64) -> Vector {
-    std::array::from_fn(|c| if c < channels { f(c) } else { 0.0 })
-}
+use cwisim_scene::Polygon;
+pub use cwisim_scene::{vector, Vector};
 
 /// A polygon edge, oriented downward (y grows downward), with the intensities at its ends.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -158,6 +151,7 @@ mod tests {
         Polygon {
             vertices: v.to_vec(),
             intensity: vec![vec![1.0]; v.len()],
+            depth: None,
         }
     }
 

@@ -3,7 +3,7 @@
 
 use cwisim_isa::text::TextWriter;
 use cwisim_isa::TraceWrite;
-use cwisim_ypipe::scene::{Polygon, ScreenScene};
+use cwisim_scene::{Polygon, ScreenScene};
 use cwisim_ypipe::{
     emit, emit_rows, header, Antialias, Claim, EmitStats, Options, ScanPlan, Shading,
 };

@@ -6,9 +6,9 @@
 mod common;
 
 use cwisim_isa::{Instruction, Opcode, TraceWrite};
+use cwisim_scene::{Polygon, ScreenScene};
 use cwisim_xproc::{EngineWriter, ImageSink, Machine, RunStats, Timing};
 use cwisim_ypipe::exact::coverage;
-use cwisim_ypipe::scene::{Polygon, ScreenScene};
 use cwisim_ypipe::{emit, header, Antialias, Claim, EmitStats, Options, Shading};
 use proptest::prelude::*;
 
@@ -75,6 +75,7 @@ fn flat(vertices: Vec<[f64; 2]>, i: &[f64]) -> Polygon {
     Polygon {
         vertices,
         intensity: vec![i.to_vec(); n],
+        depth: None,
     }
 }
 
@@ -132,6 +133,7 @@ fn polygon() -> impl Strategy<Value = (Polygon, u8)> {
                 Polygon {
                     vertices,
                     intensity,
+                    depth: None,
                 },
                 channels,
             )
@@ -269,6 +271,7 @@ fn point_sampling_with_claims_shows_the_front_polygon() {
             vec![0.4, 0.9, 0.1],
             vec![0.2, 0.1, 0.8],
         ],
+        depth: None,
     };
     let overlap = check_point_sampled_visibility(&front, &back, 3);
     assert!(overlap > 20, "the polygons overlap ({overlap} samples)");
@@ -286,6 +289,7 @@ proptest! {
         let one = |p: &Polygon| Polygon {
             vertices: p.vertices.clone(),
             intensity: p.intensity.iter().map(|i| vec![i[0]]).collect(),
+            depth: None,
         };
         check_point_sampled_visibility(&one(&front), &one(&back), 1);
     }

@@ -4,8 +4,8 @@
 mod common;
 
 use common::render;
+use cwisim_scene::{Polygon, ScreenScene};
 use cwisim_ypipe::exact::{polygon_area, scene_coverage};
-use cwisim_ypipe::scene::{Polygon, ScreenScene};
 use cwisim_ypipe::{emit, header, Options};
 use proptest::prelude::*;
 
@@ -14,6 +14,7 @@ fn grey(vertices: Vec<[f64; 2]>) -> Polygon {
     Polygon {
         vertices,
         intensity: vec![vec![1.0]; n],
+        depth: None,
     }
 }
 
@@ -130,7 +131,7 @@ proptest! {
         let gx = ((i[1] - i[0]) * (verts[2][1] - verts[0][1]) - (i[2] - i[0]) * (verts[1][1] - verts[0][1])) / det;
         let gy = ((i[2] - i[0]) * (verts[1][0] - verts[0][0]) - (i[1] - i[0]) * (verts[2][0] - verts[0][0])) / det;
         let grad = gx.hypot(gy);
-        let p = Polygon { vertices: verts, intensity: i.iter().map(|x| vec![*x]).collect() };
+        let p = Polygon { vertices: verts, intensity: i.iter().map(|x| vec![*x]).collect(), depth: None };
         let s = scene(24, 16, vec![p]);
         let (img, _) = render(&s, &Options::default());
         let exact = cwisim_ypipe::exact::scene_box_filtered(&s);

@@ -5,9 +5,9 @@ mod common;
 
 use common::render;
 use cwisim_isa::{Instruction, Intensity, TraceHeader};
+use cwisim_scene::{Polygon, ScreenScene};
 use cwisim_xproc::{run, Machine, Timing};
 use cwisim_ypipe::exact::coverage;
-use cwisim_ypipe::scene::{Polygon, ScreenScene};
 use cwisim_ypipe::{Antialias, Options, Shading};
 
 fn grey(vertices: Vec<[f64; 2]>) -> Polygon {
@@ -15,6 +15,7 @@ fn grey(vertices: Vec<[f64; 2]>) -> Polygon {
     Polygon {
         vertices,
         intensity: vec![vec![1.0]; n],
+        depth: None,
     }
 }
 

@@ -2,12 +2,12 @@
 //! the box filter with intensity 1 is the coverage (two independent methods), linear
 //! intensities integrate to area × centroid value, clipping keeps exact areas.
 
+use cwisim_scene::{Polygon, ScreenScene};
 use cwisim_ypipe::clip::clip_to_rect;
 use cwisim_ypipe::exact::{
     box_filtered, box_filtered_subdivided, coverage, gouraud_at, polygon_area, scene_box_filtered,
     scene_coverage,
 };
-use cwisim_ypipe::scene::{Polygon, ScreenScene};
 use proptest::prelude::*;
 use std::time::Instant;
 

@@ -37,12 +37,12 @@
 #![allow(dead_code)] // each of the three targets uses a part
 
 use cwisim_isa::{Instruction, TraceWrite};
+use cwisim_scene::{Polygon, ScreenScene};
 use cwisim_world::embedded::embedded;
 use cwisim_world::{parse_any, to_screen, AnyScene, Visibility};
 use cwisim_xproc::{EngineWriter, ImageSink, Machine, Timing};
 use cwisim_ypipe::clip::clip_to_rect;
 use cwisim_ypipe::exact::coverage;
-use cwisim_ypipe::scene::{Polygon, ScreenScene};
 use cwisim_ypipe::{emit, header, Antialias, Claim, Options, Shading};
 use std::io;
 

@@ -5,8 +5,8 @@
 
 use cwisim_isa::text::TextWriter;
 use cwisim_isa::TraceWrite;
+use cwisim_scene::{parse_scene, Scene, ScreenScene};
 use cwisim_xproc::{EngineWriter, ImageSink, Machine, Timing};
-use cwisim_ypipe::scene::{parse_scene, Scene, ScreenScene};
 use cwisim_ypipe::{emit, header, EmitStats, Options};
 use std::path::PathBuf;
 

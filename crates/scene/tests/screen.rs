@@ -1,6 +1,6 @@
 //! Scene files: reading, writing back, and every refusal with its location.
 
-use cwisim_ypipe::scene::{
+use cwisim_scene::{
     load_scene, parse_scene, Polygon, Scene, SceneError, SceneErrorKind, ScreenScene,
 };
 use proptest::prelude::*;
@@ -164,12 +164,12 @@ fn schema_errors_are_located() {
     refused(
         &variant("{ \"vertices\"", "{ \"colour\": 1, \"vertices\""),
         Schema,
-        "5:14: unknown field `colour`, expected `vertices` or `intensity`",
+        "5:14: unknown field `colour`, expected one of `vertices`, `intensity`, `depth`",
     );
     refused(
         &variant("\"intensity\"", "\"intensities\""),
         Schema,
-        "6:19: unknown field `intensities`, expected `vertices` or `intensity`",
+        "6:19: unknown field `intensities`, expected one of `vertices`, `intensity`, `depth`",
     );
     refused(
         &variant("\"width\": 64, ", ""),
@@ -451,4 +451,51 @@ proptest! {
         prop_assert_eq!(s.validate(), Ok(()));
         prop_assert_eq!(parse_scene(&s.to_json()), Ok(Scene::Screen(s)));
     }
+}
+
+/// Depth: read, written back, refused where it does not fit, and evaluated on the plane.
+#[test]
+fn depth_is_optional_per_scene_and_checked() {
+    let with = |d0: &str, d1: &str| {
+        format!(
+            r#"{{"kind": "screen", "width": 8, "height": 8, "channels": 1, "polygons": [
+  {{"vertices": [[0, 0], [8, 0], [0, 8]], "intensity": [[1], [1], [1]], "depth": {d0}}},
+  {{"vertices": [[8, 8], [8, 0], [0, 8]], "intensity": [[0], [0], [0]]{d1}}}
+]}}"#
+        )
+    };
+    let s = screen(&with("[1, 2, 3]", r#", "depth": [0.5, 0.5, 0.5]"#));
+    assert_eq!(s.polygons[0].depth.as_deref(), Some(&[1.0, 2.0, 3.0][..]));
+    assert_eq!(screen(&s.to_json()), s, "depth is written back");
+    assert!(s.to_json().contains("\"depth\": [1.0, 2.0, 3.0]"));
+    // the plane through the vertices: depth 1 + x/8 + 2y/8
+    let d = s.polygons[0].depth_at([2.0, 3.0]).unwrap();
+    assert!(
+        (d - (1.0 + 2.0 / 8.0 + 2.0 * 3.0 / 8.0)).abs() < 1e-15,
+        "{d}"
+    );
+    assert_eq!(s.polygons[1].depth_at([4.0, 4.0]), Some(0.5));
+    // without depth: none, and nothing written
+    let plain = screen(EXAMPLE);
+    assert_eq!(plain.polygons[0].depth_at([1.0, 1.0]), None);
+    assert!(!plain.to_json().contains("depth"));
+
+    let e = err(&with("[1, 2, 3]", ""));
+    assert_eq!(e.kind, SceneErrorKind::Shape);
+    assert_eq!(e.field.as_deref(), Some("polygons[1]"));
+    assert!(e.to_string().contains("all carry depth or none do"), "{e}");
+    assert_eq!(e.line, Some(3), "{e}");
+    let e = err(&with("[1, 2]", r#", "depth": [0, 0, 0]"#));
+    assert_eq!(e.field.as_deref(), Some("polygons[0].depth"));
+    assert!(
+        e.to_string().contains("one depth per vertex (3), found 2"),
+        "{e}"
+    );
+    let e = err(&with("[1, 2, \"x\"]", r#", "depth": [0, 0, 0]"#));
+    assert_eq!(e.kind, SceneErrorKind::Schema, "{e}");
+    let mut bad = s.clone();
+    bad.polygons[1].depth = Some(vec![0.0, f64::NAN, 0.0]);
+    let e = bad.validate().unwrap_err();
+    assert_eq!(e.kind, SceneErrorKind::NonFinite);
+    assert_eq!(e.field.as_deref(), Some("polygons[1].depth[1]"));
 }

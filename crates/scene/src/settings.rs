@@ -1,0 +1,135 @@
+//! The drawing settings every renderer and every command names the same way. Each has
+//! one spelling, its [`Display`](std::fmt::Display) form, which [`FromStr`] reads back:
+//! the command line, the summaries, `--stats-json` and `tradeoff`'s table all use it.
+
+use std::fmt;
+use std::str::FromStr;
+
+/// How intensities vary over a polygon.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Shading {
+    /// One intensity per polygon (world scenes: lit once per face).
+    Flat,
+    /// Intensities interpolated along the edges and across each scanline (world scenes:
+    /// lit at every vertex).
+    #[default]
+    Gouraud,
+}
+
+/// How a pixel's value is sampled from what covers it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Antialias {
+    /// Point sampling at pixel centres.
+    None,
+    /// Box filter: the exact covered area of every pixel.
+    #[default]
+    Box,
+}
+
+/// The names of a setting's values, in order, and the value of each.
+trait Named: Sized + Copy + PartialEq + 'static {
+    const WHAT: &'static str;
+    const ALL: &'static [(Self, &'static str)];
+
+    fn name(self) -> &'static str {
+        Self::ALL
+            .iter()
+            .find(|(v, _)| *v == self)
+            .map(|(_, n)| *n)
+            .expect("every value is named")
+    }
+
+    fn parse(s: &str) -> Result<Self, String> {
+        Self::ALL
+            .iter()
+            .find(|(_, n)| n.eq_ignore_ascii_case(s))
+            .map(|(v, _)| *v)
+            .ok_or_else(|| {
+                let names: Vec<&str> = Self::ALL.iter().map(|(_, n)| *n).collect();
+                format!(
+                    "unknown {} `{s}`; expected {}",
+                    Self::WHAT,
+                    names.join(" or ")
+                )
+            })
+    }
+}
+
+impl Named for Shading {
+    const WHAT: &'static str = "shading";
+    const ALL: &'static [(Self, &'static str)] =
+        &[(Shading::Flat, "flat"), (Shading::Gouraud, "gouraud")];
+}
+
+impl Named for Antialias {
+    const WHAT: &'static str = "anti-aliasing";
+    const ALL: &'static [(Self, &'static str)] =
+        &[(Antialias::None, "none"), (Antialias::Box, "box")];
+}
+
+impl Shading {
+    /// Every value, in order.
+    pub const ALL: [Shading; 2] = [Shading::Flat, Shading::Gouraud];
+
+    /// How a summary says it: "flat" or "Gouraud".
+    pub fn title(self) -> &'static str {
+        match self {
+            Shading::Flat => "flat",
+            Shading::Gouraud => "Gouraud",
+        }
+    }
+}
+
+impl Antialias {
+    /// Every value, in order.
+    pub const ALL: [Antialias; 2] = [Antialias::None, Antialias::Box];
+
+    /// How a summary says it: "point sampling" or "box filter".
+    pub fn title(self) -> &'static str {
+        match self {
+            Antialias::None => "point sampling",
+            Antialias::Box => "box filter",
+        }
+    }
+}
+
+macro_rules! display_and_parse {
+    ($($t:ty),*) => {$(
+        impl fmt::Display for $t {
+            fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                f.write_str(Named::name(*self))
+            }
+        }
+
+        impl FromStr for $t {
+            type Err = String;
+
+            fn from_str(s: &str) -> Result<Self, String> {
+                <$t as Named>::parse(s)
+            }
+        }
+    )*};
+}
+
+display_and_parse!(Shading, Antialias);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_read_back() {
+        for s in Shading::ALL {
+            assert_eq!(s.to_string().parse::<Shading>(), Ok(s));
+        }
+        for a in Antialias::ALL {
+            assert_eq!(a.to_string().parse::<Antialias>(), Ok(a));
+        }
+        assert_eq!("GOURAUD".parse::<Shading>(), Ok(Shading::Gouraud));
+        assert_eq!(
+            "phong".parse::<Shading>().unwrap_err(),
+            "unknown shading `phong`; expected flat or gouraud"
+        );
+        assert_eq!(Antialias::Box.to_string(), "box");
+    }
+}
