@@ -8,7 +8,7 @@ use crate::commands::machine::MachineCmdArgs;
 use crate::commands::run::RunArgs;
 use crate::commands::scene::{EmitArgs, RenderArgs};
 use crate::commands::{
-    convert, diff, dump, fit, history, machine, run, scene, scenes, stats, tradeoff, vcd,
+    convert, diff, dump, fit, history, machine, renderers, run, scene, scenes, stats, tradeoff, vcd,
 };
 use crate::error::CliError;
 use clap::{Parser, Subcommand};
@@ -114,6 +114,17 @@ Example:\n  cwisim scenes\n  cwisim scenes pot > my-pot.json",
         after_help = AFTER_HELP
     )]
     Scenes(scenes::ScenesArgs),
+
+    /// List the renderers (`--renderer NAME`), one line each
+    #[command(
+        long_about = "List the renderers cwisim knows: the Y-processor programs that turn a scene into \
+scanline instructions for the X-processor array. Every command that draws a scene (render, \
+emit, stats, tradeoff, fit) takes one with --renderer NAME; each gets threads, traces, \
+statistics, cost images, tradeoff and fit through the same interface (docs/ARCHITECTURE.md).\n\n\
+Example:\n  cwisim renderers\n  cwisim render pot --renderer vanrij",
+        after_help = AFTER_HELP
+    )]
+    Renderers(renderers::RenderersArgs),
 
     /// Speed against accuracy: one scene over a grid of settings, measured
     #[command(
@@ -303,6 +314,7 @@ fn dispatch(
         Command::Machine(args) => machine::run(args, stdout, stderr).map(|()| 0),
         Command::Render(args) => scene::run_render(args, stdout, progress).map(|()| 0),
         Command::Scenes(args) => scenes::run(args, stdout).map(|()| 0),
+        Command::Renderers(args) => renderers::run(args, stdout).map(|()| 0),
         Command::Tradeoff(args) => tradeoff::run(args, stdout).map(|()| 0),
         Command::Fit(args) => fit::run(args, stdout).map(|()| 0),
         Command::Emit(args) => scene::run_emit(args).map(|()| 0),

@@ -1,13 +1,15 @@
 //! Every way a `cwisim` command can fail, and the exit code each gives.
 
 use cwisim_isa::TraceError;
+use cwisim_render::RenderError;
 use cwisim_scene::SceneError;
 use cwisim_xproc::{ImageLimit, MachineError, ReplayError};
 use std::path::PathBuf;
 
 /// Exit code for bad input or usage: a malformed trace or machine file, bad arguments.
 pub const EXIT_BAD_INPUT: u8 = 2;
-/// Exit code when the input was fine but an output could not be written.
+/// Exit code when the input was fine but an output could not be written, or cwisim
+/// itself failed (an internal fault: a bug, never the input's doing).
 pub const EXIT_OUTPUT_FAILED: u8 = 1;
 
 /// Why a command failed. Every message is one line and names the file involved.
@@ -40,6 +42,28 @@ pub enum CliError {
     /// Standard output could not be written (a closed pipe, a full disk).
     #[error("cannot write to standard output: {0}")]
     Stdout(std::io::Error),
+    /// cwisim itself failed — a renderer emitted an instruction the array refuses, or the
+    /// array failed: a bug, not bad input.
+    #[error(
+        "internal error (a bug in cwisim; please report it with the command that gave it): {0}"
+    )]
+    Internal(String),
+}
+
+impl From<RenderError> for CliError {
+    fn from(e: RenderError) -> Self {
+        match e {
+            RenderError::Scene(e) => CliError::Scene(e),
+            RenderError::Machine(e) => CliError::Machine(e),
+            RenderError::ImageLimit(e) => CliError::ImageLimit(e),
+            e @ (RenderError::Renderer { .. } | RenderError::Array(_)) => {
+                CliError::Internal(e.to_string())
+            }
+            e @ (RenderError::Usage(_) | RenderError::UnknownRenderer { .. }) => {
+                CliError::Usage(e.to_string())
+            }
+        }
+    }
 }
 
 impl From<ReplayError> for CliError {
@@ -53,7 +77,7 @@ impl From<ReplayError> for CliError {
 
 impl CliError {
     /// The process exit code: [`EXIT_BAD_INPUT`] (2) for bad input or usage,
-    /// [`EXIT_OUTPUT_FAILED`] (1) when writing an output failed.
+    /// [`EXIT_OUTPUT_FAILED`] (1) when writing an output failed or cwisim itself failed.
     pub fn exit_code(&self) -> u8 {
         match self {
             CliError::Trace(_)
@@ -61,7 +85,9 @@ impl CliError {
             | CliError::Scene(_)
             | CliError::ImageLimit(_)
             | CliError::Usage(_) => EXIT_BAD_INPUT,
-            CliError::Write { .. } | CliError::Stdout(_) => EXIT_OUTPUT_FAILED,
+            CliError::Write { .. } | CliError::Stdout(_) | CliError::Internal(_) => {
+                EXIT_OUTPUT_FAILED
+            }
         }
     }
 
@@ -115,5 +141,17 @@ mod tests {
         let e = CliError::write("out.png", std::io::Error::other("disk full"));
         assert_eq!(e.one_line(), "out.png: cannot write: disk full");
         assert_eq!(e.exit_code(), 1);
+        let e: CliError = RenderError::Array(std::io::Error::other("refused")).into();
+        assert_eq!(e.exit_code(), 1);
+        assert!(
+            e.one_line().starts_with("internal error"),
+            "{}",
+            e.one_line()
+        );
+        let e: CliError = cwisim_render::find("nope").unwrap_err().into();
+        assert_eq!(e.exit_code(), 2);
+        assert!(e
+            .one_line()
+            .starts_with("unknown renderer `nope`; known: vanrij"));
     }
 }

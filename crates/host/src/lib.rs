@@ -1,15 +1,15 @@
 //! # cwisim-host — the `cwisim` command-line tool
 //!
-//! The host side of the simulator: it renders scenes (`cwisim-world`, `cwisim-ypipe`),
+//! The host side of the simulator: it renders scenes (through `cwisim-render`'s renderers),
 //! reads trace files (`cwisim-isa`), replays them on the simulated X-processor array
 //! (`cwisim-xproc`), and writes what the array shifted out as a PNG picture or an exact
 //! NumPy array, with per-run statistics in text or JSON.
 //!
-//! * [`cli`] — the `cwisim` command line (`run`, `render`, `emit`, `scenes`, `tradeoff`,
+//! * [`cli`] — the `cwisim` command line (`run`, `render`, `emit`, `scenes`, `renderers`, `tradeoff`,
 //!   `fit`, `convert`, `machine`, and the study tools `stats`, `history`, `vcd`, `diff`, `dump`) and
 //!   [`cli::run_cli`], which runs it in-process on any output streams.
-//! * [`prepare`] — from a SCENE argument (a file or an embedded name) to the polygons the
-//!   Y-processor takes, through `cwisim-world` for 3D scenes.
+//! * [`draw`] — `--renderer`, `--shading`, `--aa`, `--visibility`, `--size`: the flattened
+//!   argument group that reads a SCENE and builds its renderer (`cwisim-render`).
 //! * [`summary`] — what `cwisim render` prints: every stage's figures and wall time.
 //! * [`tradeoff_plot`] — the error-against-cycles chart of `cwisim tradeoff`.
 //! * [`commands`] — one module per subcommand.
@@ -34,11 +34,11 @@ pub mod cli;
 pub mod commands;
 pub mod cost;
 pub mod demo;
+pub mod draw;
 pub mod error;
 pub mod files;
 pub mod output;
 pub mod plot;
-pub mod prepare;
 pub mod progress;
 pub mod range;
 pub mod report;

@@ -1,28 +1,20 @@
-//! The summary `cwisim render` prints: the scene, what the host side and the Y-processor
+//! The summary `cwisim render` prints: the scene, what the host side and the renderer
 //! did, the array's cycles against the display, and the wall time of every stage.
 
-use crate::prepare::{PreparedScene, VisibilityArg};
+use crate::draw::Drawn;
 use crate::report::TraceShape;
 use cwisim_isa::Opcode;
-use cwisim_xproc::{Numeric, RunStats};
-use cwisim_ypipe::{Antialias, EmitStats, Shading};
+use cwisim_render::Rendered;
+use cwisim_xproc::Numeric;
 use std::io::{self, Write};
 use std::path::Path;
 use std::time::Duration;
 
-/// Wall time of each stage of a render.
+/// Wall time of the stages the command runs around the renderer.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct StageTimes {
     /// Reading the scene, building meshes.
     pub load: Duration,
-    /// Transform, lighting, culling.
-    pub transform: Duration,
-    /// Hidden-surface removal.
-    pub visibility: Duration,
-    /// Scan conversion (the Y-processor).
-    pub ypipe: Duration,
-    /// The array simulator.
-    pub array: Duration,
     /// Writing the outputs.
     pub output: Duration,
 }
@@ -47,103 +39,86 @@ fn channels_name(c: u8) -> String {
 }
 
 /// The scene part of `--stats-json`: deterministic (no times, no paths).
-pub fn scene_json(p: &PreparedScene) -> serde_json::Value {
-    serde_json::json!({
-        "name": p.source.name(),
-        "kind": p.kind,
-        "polygons": p.screen.polygons.len(),
-        "visibility": p.visibility_mode.map(|v| match v {
-            VisibilityArg::Exact => "exact",
-            VisibilityArg::Eval0 => "eval0",
-        }),
-        "project": p.project,
-        "exact_visibility": p.visibility,
-    })
+pub fn scene_json(d: &Drawn) -> serde_json::Value {
+    let mut json = d.renderer.scene_json();
+    if !json.is_object() {
+        json = serde_json::json!({});
+    }
+    json["name"] = d.source.name().into();
+    json["kind"] = d.kind.into();
+    json["renderer"] = d.renderer.name().into();
+    json
+}
+
+/// A renderer's counters as text: `name value` for every non-zero counter, in the
+/// renderer's order, broken into lines of at most `width` characters (the first line
+/// starts after `first` characters of its own) and continued after `indent` spaces.
+pub fn counters_text(
+    counters: &cwisim_render::Counters,
+    first: usize,
+    indent: usize,
+    width: usize,
+) -> String {
+    let mut out = String::new();
+    let mut column = first;
+    for (name, v) in counters.iter().filter(|&(_, v)| v > 0) {
+        let part = format!("{} {v}", name.replace('_', " "));
+        if !out.is_empty() {
+            if column + 2 + part.len() > width {
+                out.push_str(",\n");
+                out.push_str(&" ".repeat(indent));
+                column = indent;
+            } else {
+                out.push_str(", ");
+                column += 2;
+            }
+        }
+        column += part.chars().count();
+        out.push_str(&part);
+    }
+    out
 }
 
 /// Writes the render summary.
 pub fn write_render_summary(
     out: &mut dyn Write,
-    p: &PreparedScene,
-    e: &EmitStats,
-    stats: &RunStats,
+    d: &Drawn,
+    rendered: &Rendered,
     numeric: &Numeric,
     t: &StageTimes,
     written: &[&Path],
 ) -> io::Result<()> {
     let row = |out: &mut dyn Write, label: &str, value: String| writeln!(out, "{label:<13}{value}");
-    let s = &p.screen;
+    let h = d.renderer.header();
     let shape = TraceShape {
-        width: s.width,
-        lines: s.height,
-        channels: s.channels,
+        width: h.width,
+        lines: h.lines,
+        channels: h.channels,
     };
-    let visibility = match p.visibility_mode {
-        Some(VisibilityArg::Exact) => ", exact visibility",
-        Some(VisibilityArg::Eval0) => ", eval0 visibility",
-        None => "",
-    };
+    let stats = &rendered.stats;
     row(
         out,
         "scene",
         format!(
-            "{} ({}, {}×{}, {}): {} shading, {}{visibility}, {numeric} registers",
-            p.source.name(),
-            p.kind,
+            "{} ({}, {}×{}, {}): {}, {numeric} registers",
+            d.source.name(),
+            d.kind,
             shape.width,
             shape.lines,
             channels_name(shape.channels),
-            match p.options.shading {
-                Shading::Flat => "flat",
-                Shading::Gouraud => "Gouraud",
-            },
-            match p.options.aa {
-                Antialias::Box => "box filter",
-                Antialias::None => "point sampling",
-            },
+            d.renderer.settings_phrase(),
         ),
     )?;
-    if let Some(g) = &p.project {
-        row(
-            out,
-            "geometry",
-            format!(
-                "{} mesh(es), {} faces → {} triangles: {} back faces culled, {} drawn ({} back faces of two-sided meshes, {} edge-on dropped)",
-                g.meshes,
-                g.faces,
-                g.triangles,
-                g.culled,
-                g.triangles - g.culled - g.edge_on,
-                g.back_faces_drawn,
-                g.edge_on
-            ),
-        )?;
+    for (label, text) in d.renderer.summary_rows(&rendered.counters, stats) {
+        row(out, label, text)?;
     }
-    match (&p.visibility_mode, &p.visibility) {
-        (Some(VisibilityArg::Exact), Some(v)) => row(
-            out,
-            "visibility",
-            format!(
-                "exact: {} visible fragments of {} triangles ({} wholly hidden; {} occluding pairs; {} hole cuts; {} slivers dropped, {:.1e} px² in all)",
-                v.fragments, v.triangles, v.hidden, v.occluding_pairs, v.hole_cuts, v.dropped_slivers, v.dropped_area
-            ),
-        )?,
-        (Some(VisibilityArg::Eval0), _) => row(
-            out,
-            "visibility",
-            format!(
-                "eval0: triangles front to back; {} Eval0 claims, {} contributions suppressed by them",
-                e.claims, stats.totals.suppressed
-            ),
-        )?,
-        _ => {}
-    }
+    let name = d.renderer.name();
     row(
         out,
         "Y-processor",
         format!(
-            "{} polygons → {} trapezia, {} trapezium rows",
-            e.polygons, e.trapezia, e.rows_filled
+            "{name}: {}",
+            counters_text(&rendered.counters, 13 + name.len() + 2, 13, 100)
         ),
     )?;
     let tot = &stats.totals;
@@ -196,24 +171,46 @@ pub fn write_render_summary(
             ),
         )?;
     }
-    let total = t.load + t.transform + t.visibility + t.ypipe + t.array + t.output;
-    row(
-        out,
-        "time",
-        format!(
-            "load {} · transform & lighting {} · visibility {} · Y-processor {} · array {} · output {} · total {}",
-            ms(t.load),
-            ms(t.transform),
-            ms(t.visibility),
-            ms(t.ypipe),
-            ms(t.array),
-            ms(t.output),
-            ms(total)
-        ),
-    )?;
+    let stages = d.renderer.stage_times();
+    let total = t.load
+        + stages.iter().map(|(_, d)| *d).sum::<Duration>()
+        + rendered.renderer_time
+        + rendered.array_time
+        + t.output;
+    let mut parts = vec![format!("load {}", ms(t.load))];
+    parts.extend(stages.iter().map(|(name, d)| format!("{name} {}", ms(*d))));
+    parts.push(format!("Y-processor {}", ms(rendered.renderer_time)));
+    parts.push(format!("array {}", ms(rendered.array_time)));
+    parts.push(format!("output {}", ms(t.output)));
+    parts.push(format!("total {}", ms(total)));
+    row(out, "time", parts.join(" · "))?;
     if !written.is_empty() {
         let names: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
         row(out, "wrote", names.join(", "))?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use cwisim_render::Counters;
+
+    #[test]
+    fn counters_wrap_and_skip_zeros() {
+        let c = Counters::default()
+            .with("polygons", 468)
+            .with("claims", 0)
+            .with("rows_filled", 9572)
+            .with("share_sequences", 51);
+        assert_eq!(
+            counters_text(&c, 0, 0, 100),
+            "polygons 468, rows filled 9572, share sequences 51"
+        );
+        assert_eq!(
+            counters_text(&c, 4, 2, 30),
+            "polygons 468,\n  rows filled 9572,\n  share sequences 51"
+        );
+        assert_eq!(counters_text(&Counters::default(), 0, 0, 10), "");
+    }
 }

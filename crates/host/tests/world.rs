@@ -189,7 +189,10 @@ fn the_stats_json_describes_the_scene() {
     assert_eq!(v["scene"]["name"], "pot");
     assert_eq!(v["scene"]["visibility"], "eval0");
     assert_eq!(v["scene"]["project"]["triangles"], 928);
-    assert!(v["emit"]["claims"].as_u64().unwrap() > 0);
+    assert_eq!(v["renderer"], "vanrij");
+    assert_eq!(v["scene"]["renderer"], "vanrij");
+    assert!(v["counters"]["claims"].as_u64().unwrap() > 0);
+    assert!(v["counters"]["trapezia"].as_u64().unwrap() > 0);
     assert!(v["stats"]["totals"]["suppressed"].as_u64().unwrap() > 0);
 }
 

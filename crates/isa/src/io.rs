@@ -48,6 +48,18 @@ pub trait TraceWrite {
     fn finish(&mut self) -> io::Result<()>;
 }
 
+/// Collects the stream in memory, one [`Instruction`] per write (comments dropped).
+impl TraceWrite for Vec<Instruction> {
+    fn write(&mut self, instr: &Instruction) -> io::Result<()> {
+        self.push(*instr);
+        Ok(())
+    }
+
+    fn finish(&mut self) -> io::Result<()> {
+        Ok(())
+    }
+}
+
 /// Reads `\n`-terminated UTF-8 lines with a length limit, counting lines and bytes.
 pub(crate) struct LineReader<R> {
     inner: R,

@@ -71,6 +71,11 @@ impl Shading {
     /// Every value, in order.
     pub const ALL: [Shading; 2] = [Shading::Flat, Shading::Gouraud];
 
+    /// Its one spelling: "flat", "gouraud" (the [`Display`](fmt::Display) form).
+    pub fn name(self) -> &'static str {
+        Named::name(self)
+    }
+
     /// How a summary says it: "flat" or "Gouraud".
     pub fn title(self) -> &'static str {
         match self {
@@ -83,6 +88,11 @@ impl Shading {
 impl Antialias {
     /// Every value, in order.
     pub const ALL: [Antialias; 2] = [Antialias::None, Antialias::Box];
+
+    /// Its one spelling: "none", "box" (the [`Display`](fmt::Display) form).
+    pub fn name(self) -> &'static str {
+        Named::name(self)
+    }
 
     /// How a summary says it: "point sampling" or "box filter".
     pub fn title(self) -> &'static str {

@@ -19,13 +19,12 @@
 
 use super::MachineArgs;
 use crate::commands::tradeoff::{errors, exact_image};
+use crate::draw::DrawArgs;
 use crate::error::CliError;
-use crate::prepare::{prepare, DrawArgs};
 use clap::Args;
 use cwisim_isa::{Instruction, TraceWrite};
 use cwisim_xproc::numeric::{FixedFormat, Numeric, Overflow, Q};
 use cwisim_xproc::{ImageSink, Machine, RunStats, Timing};
-use cwisim_ypipe::emit;
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -360,16 +359,11 @@ fn fit_format(bench: &mut Bench<'_>, budget: f64, overflow: Overflow) -> Result<
 /// Runs `cwisim fit`.
 pub fn run(args: &FitArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
     let machine = args.machine.load()?;
-    let prepared = prepare(args.scene.as_deref(), &args.draw)?;
+    let drawn = args.draw.draw(args.scene.as_deref())?;
     let exact = exact_image(args.scene.as_deref(), args.draw.size)?;
-    let header = cwisim_ypipe::header(&prepared.screen);
+    let header = drawn.renderer.header();
     let mut instructions: Vec<Instruction> = Vec::new();
-    emit(
-        &prepared.screen,
-        &prepared.options,
-        &mut Collect(&mut instructions),
-    )
-    .map_err(|e| CliError::Usage(format!("the Y-processor failed: {e}")))?;
+    cwisim_render::emit(&*drawn.renderer, &mut instructions)?;
     let mut bench = Bench {
         header,
         instructions: &instructions,
@@ -393,8 +387,8 @@ pub fn run(args: &FitArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
             "scene",
             format!(
                 "{} ({}, {}×{}, {} channel(s)), {} instructions",
-                prepared.source.name(),
-                prepared.kind,
+                drawn.source.name(),
+                drawn.kind,
                 header.width,
                 header.lines,
                 header.channels,
@@ -443,20 +437,6 @@ pub fn run(args: &FitArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
         out.flush()
     })()
     .map_err(CliError::Stdout)
-}
-
-/// Collects an instruction stream.
-struct Collect<'a>(&'a mut Vec<Instruction>);
-
-impl TraceWrite for Collect<'_> {
-    fn write(&mut self, instr: &Instruction) -> std::io::Result<()> {
-        self.0.push(*instr);
-        Ok(())
-    }
-
-    fn finish(&mut self) -> std::io::Result<()> {
-        Ok(())
-    }
 }
 
 #[cfg(test)]

@@ -6,6 +6,7 @@ pub mod dump;
 pub mod fit;
 pub mod history;
 pub mod machine;
+pub mod renderers;
 pub mod run;
 pub mod scene;
 pub mod scenes;

@@ -1,24 +1,23 @@
 //! `cwisim render` and `cwisim emit`: a scene (screen or world, a file or an embedded
-//! name) through the host side and the Y-processor (`cwisim-world`, `cwisim-ypipe`), into
-//! the array simulator or a trace file.
+//! name) through a renderer (`cwisim-render`'s registry), into the array simulator or a
+//! trace file.
 
 use super::{ImageArgs, MachineArgs};
 use crate::commands::run::TimingArg;
 use crate::cost::{display_name, CostArgs, CostMap};
+use crate::draw::{DrawArgs, Drawn};
 use crate::error::CliError;
 use crate::files::{check_outputs, same_file, write_atomic};
-use crate::prepare::{prepare, DrawArgs, PreparedScene};
 use crate::progress::Progress;
 use crate::report::{timing_name, write_summary, StatsReport};
 use crate::summary::{write_render_summary, StageTimes};
 use clap::Args;
-use cwisim_isa::{Encoding, Instruction, Opcode, PackedStream, TraceWrite};
-use cwisim_scene::ScreenScene;
-use cwisim_xproc::{EngineWriter, ImageSink, LineSink, Machine, Numeric, RunStats, Timing};
-use cwisim_ypipe::{emit, emit_rows, header, EmitStats, Options, ScanPlan};
-use std::io::{self, Write};
+use cwisim_isa::{Encoding, TraceWrite};
+use cwisim_render::{render, ArrayConfig, Renderer, Taps};
+use cwisim_xproc::{ImageSink, Numeric, Timing};
+use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 /// The arguments of `cwisim emit`.
 #[derive(Args, Clone, Debug, PartialEq)]
@@ -75,272 +74,22 @@ pub struct RenderArgs {
     /// Print nothing (errors still go to standard error).
     #[arg(short, long)]
     pub quiet: bool,
-    /// Threads: with N > 1, N − 1 threads scan-convert bands of scanlines while one feeds
-    /// them, in order, to the array (0: one per core). The output, trace and statistics
+    /// Threads: with N > 1, N − 1 threads emit bands of scanlines while one feeds them,
+    /// in order, to the array (0: one per core). The output, trace and statistics
     /// are identical to the serial run's, byte for byte.
     #[arg(long, default_value_t = 1, value_name = "N")]
     pub threads: usize,
 }
 
-/// The array as a [`TraceWrite`] fed one scanline at a time: instructions are buffered
-/// until their `Refresh` and then handed to the array, so that the array's share of the
-/// wall time is measured per scanline rather than per instruction. Every instruction also
-/// goes to `also` (a cost map, say) as it comes.
-struct ScanlineFeed<'a, 's> {
-    array: EngineWriter<'s, f64>,
-    also: Option<&'a mut dyn TraceWrite>,
-    buffer: Vec<Instruction>,
-    array_time: Duration,
-    progress: Option<&'a mut Progress>,
-    lines: u64,
-}
-
-impl<'a, 's> ScanlineFeed<'a, 's> {
-    /// The array for `scene`, fed scanline by scanline (and `also` the trace, if any).
-    fn open(
-        scene: &ScreenScene,
-        machine: &Machine,
-        numeric: &Numeric,
-        timing: Timing,
-        sink: &'s mut dyn LineSink<f64>,
-        also: Option<&'a mut dyn TraceWrite>,
-        progress: Option<&'a mut Progress>,
-    ) -> Result<Self, CliError> {
-        let h = header(scene);
-        Ok(ScanlineFeed {
-            array: EngineWriter::with_numeric(&h, machine, timing, numeric, sink)?,
-            also,
-            buffer: Vec::new(),
-            array_time: Duration::ZERO,
-            progress,
-            lines: 0,
-        })
-    }
-
-    /// Finishes the array and the trace; `total` is the wall time since emission began
-    /// (the Y-processor's share is what the array did not take: the two interleave, or
-    /// overlap on threads).
-    fn close(mut self, emitted: EmitStats, total: Duration) -> Result<Rendered, CliError> {
-        self.finish()
-            .map_err(|e| CliError::Usage(format!("the array failed: {e}")))?;
-        let array_time = self.array_time;
-        let stats = self.array.into_stats().expect("finished");
-        Ok(Rendered {
-            emitted,
-            stats,
-            ypipe_time: total.saturating_sub(array_time),
-            array_time,
-        })
-    }
-
-    fn flush(&mut self) -> io::Result<()> {
-        let start = Instant::now();
-        for instr in self.buffer.drain(..) {
-            self.array.write(&instr)?;
-        }
-        self.array_time += start.elapsed();
-        Ok(())
-    }
-}
-
-impl TraceWrite for ScanlineFeed<'_, '_> {
-    fn write(&mut self, instr: &Instruction) -> io::Result<()> {
-        if let Some(also) = self.also.as_deref_mut() {
-            also.write(instr)?;
-        }
-        self.buffer.push(*instr);
-        if instr.op == Opcode::Refresh {
-            self.flush()?;
-            self.lines += 1;
-            if let Some(p) = self.progress.as_deref_mut() {
-                p.update(self.lines);
-            }
-        }
-        Ok(())
-    }
-
-    fn comment(&mut self, text: &str) -> io::Result<()> {
-        match self.also.as_deref_mut() {
-            Some(also) => also.comment(text),
-            None => Ok(()),
-        }
-    }
-
-    fn wants_comments(&self) -> bool {
-        self.also.as_deref().is_some_and(|a| a.wants_comments())
-    }
-
-    fn finish(&mut self) -> io::Result<()> {
-        self.flush()?;
-        let start = Instant::now();
-        self.array.finish()?;
-        self.array_time += start.elapsed();
-        if let Some(also) = self.also.as_deref_mut() {
-            also.finish()?;
-        }
-        Ok(())
-    }
-}
-
-/// What rendering a screen scene gives besides the scanlines.
-pub struct Rendered {
-    /// The scan conversion's statistics.
-    pub emitted: EmitStats,
-    /// The array's statistics.
-    pub stats: RunStats,
-    /// Wall time in the Y-processor (scan conversion).
-    pub ypipe_time: Duration,
-    /// Wall time in the array simulator.
-    pub array_time: Duration,
-}
-
-/// Scan-converts `scene` straight into the array on `machine`, handing its scanlines to
-/// `sink`, and every instruction also to `also` when given.
-#[allow(clippy::too_many_arguments)]
-pub fn render_scene<'a>(
-    scene: &ScreenScene,
-    options: &Options,
-    machine: &Machine,
-    numeric: &Numeric,
-    timing: Timing,
-    sink: &mut dyn LineSink<f64>,
-    also: Option<&'a mut dyn TraceWrite>,
-    progress: Option<&'a mut Progress>,
-) -> Result<Rendered, CliError> {
-    render_scene_threads(
-        scene, options, machine, numeric, timing, sink, also, progress, 1,
-    )
-}
-
-/// Collects a band's instructions.
-/// Bands per thread: enough that uneven bands balance out.
-const BANDS_PER_THREAD: u32 = 8;
-
-/// [`render_scene`] with the Y-processor's work split into bands of scanlines emitted on
-/// `threads` threads (1: serially, as the scene streams into the array). The bands'
-/// streams are fed to the array in order, so the output, the trace and every statistic
-/// are identical to the serial run, byte for byte.
-#[allow(clippy::too_many_arguments)]
-pub fn render_scene_threads<'a>(
-    scene: &ScreenScene,
-    options: &Options,
-    machine: &Machine,
-    numeric: &Numeric,
-    timing: Timing,
-    sink: &mut dyn LineSink<f64>,
-    also: Option<&'a mut dyn TraceWrite>,
-    progress: Option<&'a mut Progress>,
-    threads: usize,
-) -> Result<Rendered, CliError> {
-    if threads > 1 {
-        return render_parallel(
-            scene, options, machine, numeric, timing, sink, also, progress, threads,
-        );
-    }
-    let mut feed = ScanlineFeed::open(scene, machine, numeric, timing, sink, also, progress)?;
-    let start = Instant::now();
-    let emitted = emit(scene, options, &mut feed).map_err(|e| {
-        CliError::Usage(format!(
-            "the Y-processor emitted an invalid instruction: {e}"
-        ))
-    })?;
-    feed.close(emitted, start.elapsed())
-}
-
-/// The parallel render: `threads − 1` workers emit bands of scanlines (taking the next
-/// band as they finish one) while this thread feeds the finished bands to the array in
-/// order, so scan conversion and the array overlap.
-#[allow(clippy::too_many_arguments)]
-fn render_parallel<'a>(
-    scene: &ScreenScene,
-    options: &Options,
-    machine: &Machine,
-    numeric: &Numeric,
-    timing: Timing,
-    sink: &mut dyn LineSink<f64>,
-    also: Option<&'a mut dyn TraceWrite>,
-    progress: Option<&'a mut Progress>,
-    threads: usize,
-) -> Result<Rendered, CliError> {
-    use std::collections::BTreeMap;
-    use std::sync::atomic::{AtomicUsize, Ordering};
-    use std::sync::{mpsc, Mutex};
-    let start = Instant::now();
-    let plan = ScanPlan::new(scene, options);
-    let n = (threads as u32 * BANDS_PER_THREAD).clamp(1, scene.height.max(1));
-    let band_rows = |k: u32| {
-        let a = (u64::from(scene.height) * u64::from(k) / u64::from(n)) as u32;
-        let b = (u64::from(scene.height) * u64::from(k + 1) / u64::from(n)) as u32;
-        a..b
-    };
-    let mut feed = ScanlineFeed::open(scene, machine, numeric, timing, sink, also, progress)?;
-    let mut stats = plan.scene_stats();
-    let next_band = AtomicUsize::new(0);
-    // buffers the feeder has emptied, for the workers to reuse: a fresh buffer per band
-    // would be mapped and faulted in page by page (most bands are over the allocator's
-    // mmap threshold), which costs more than the work overlapped
-    let spare: Mutex<Vec<PackedStream>> = Mutex::new(Vec::new());
-    // this thread feeds the array: it counts as one of the `threads`
-    let workers = threads.saturating_sub(1).max(1);
-    let failed: Result<(), CliError> = std::thread::scope(|scope| {
-        let (tx, rx) = mpsc::channel::<(usize, io::Result<(PackedStream, EmitStats)>)>();
-        for _ in 0..workers {
-            let tx = tx.clone();
-            let (plan, next_band, band_rows, spare) = (&plan, &next_band, &band_rows, &spare);
-            scope.spawn(move || loop {
-                let k = next_band.fetch_add(1, Ordering::Relaxed);
-                if k >= n as usize {
-                    break;
-                }
-                let reused = spare.lock().ok().and_then(|mut s| s.pop());
-                let mut band = reused.unwrap_or_default();
-                band.clear();
-                let r = emit_rows(plan, options, band_rows(k as u32), &mut band)
-                    .map(|stats| (band, stats));
-                if tx.send((k, r)).is_err() {
-                    break; // the feeder stopped on an error
-                }
-            });
-        }
-        drop(tx);
-        // feed the bands in order as they arrive
-        let mut waiting = BTreeMap::new();
-        let mut want = 0usize;
-        for (k, band) in rx {
-            waiting.insert(k, band);
-            while let Some(band) = waiting.remove(&want) {
-                let (instructions, band_stats) = band.map_err(|e| {
-                    CliError::Usage(format!(
-                        "the Y-processor emitted an invalid instruction: {e}"
-                    ))
-                })?;
-                stats.add_band(&band_stats);
-                for instr in instructions.iter() {
-                    feed.write(&instr)
-                        .map_err(|e| CliError::Usage(format!("the array failed: {e}")))?;
-                }
-                if let Ok(mut s) = spare.lock() {
-                    s.push(instructions);
-                }
-                want += 1;
-            }
-        }
-        Ok(())
-    });
-    failed?;
-    feed.close(stats, start.elapsed())
-}
-
-/// The whole trace in one encoding, in memory (written only once complete).
-fn encode(scene: &ScreenScene, options: &Options, path: &Path) -> Result<Vec<u8>, CliError> {
+/// The renderer's whole stream in one encoding, in memory (written only once complete).
+fn encode(renderer: &dyn Renderer, path: &Path) -> Result<Vec<u8>, CliError> {
     let encoding = Encoding::from_path(path)?;
     let mut bytes = Vec::new();
     {
         let mut w = encoding
-            .writer(&mut bytes, &header(scene))
+            .writer(&mut bytes, &renderer.header())
             .map_err(|e| CliError::write(path, e))?;
-        emit(scene, options, &mut *w).map_err(|e| CliError::write(path, e))?;
-        w.finish().map_err(|e| CliError::write(path, e))?;
+        cwisim_render::emit(renderer, &mut *w)?;
     }
     Ok(bytes)
 }
@@ -352,8 +101,8 @@ pub fn run_emit(args: &EmitArgs) -> Result<(), CliError> {
             "the output would overwrite the scene".into(),
         ));
     }
-    let prepared = prepare(Some(&args.scene), &args.draw)?;
-    let bytes = encode(&prepared.screen, &prepared.options, &args.output)?;
+    let drawn = args.draw.draw(Some(&args.scene))?;
+    let bytes = encode(&*drawn.renderer, &args.output)?;
     write_atomic(&args.output, |w| {
         w.write_all(&bytes)
             .map_err(|e| CliError::write(&args.output, e))
@@ -361,12 +110,12 @@ pub fn run_emit(args: &EmitArgs) -> Result<(), CliError> {
 }
 
 /// The PNG path `render` writes when given no output at all.
-fn default_png(args: &RenderArgs, prepared: &PreparedScene) -> Option<PathBuf> {
+fn default_png(args: &RenderArgs, drawn: &Drawn) -> Option<PathBuf> {
     let any = args.image.wanted()
         || args.trace.is_some()
         || args.cost.wanted()
         || args.stats_json.is_some();
-    (!any).then(|| PathBuf::from(format!("{}.png", prepared.source.name())))
+    (!any).then(|| PathBuf::from(format!("{}.png", drawn.source.name())))
 }
 
 /// Runs `cwisim render`.
@@ -393,18 +142,21 @@ pub fn run_render(
         ],
     )?;
     args.cost.check()?;
-    let prepared = prepare(args.scene.as_deref(), &args.draw)?;
+    let drawn = args.draw.draw(args.scene.as_deref())?;
     let mut image_args = args.image.clone();
-    if let Some(png) = default_png(args, &prepared) {
+    if let Some(png) = default_png(args, &drawn) {
         image_args.output = Some(png);
     }
-    let scene = &prepared.screen;
-    let machine = args.machine.load()?;
-    let timing = Timing::from(args.timing);
-    let h = header(scene);
+    let renderer = &*drawn.renderer;
+    let array = ArrayConfig {
+        machine: args.machine.load()?,
+        numeric: args.numeric,
+        timing: Timing::from(args.timing),
+    };
+    let h = renderer.header();
     image_args.check(h.channel_count())?;
     let trace_bytes = match &args.trace {
-        Some(path) => Some(encode(scene, &prepared.options, path)?),
+        Some(path) => Some(encode(renderer, path)?),
         None => None,
     };
     let mut sink = ImageSink::new(
@@ -413,30 +165,28 @@ pub fn run_render(
         ImageSink::DEFAULT_LIMIT_BYTES,
     );
     let mut cost = args.cost.wanted().then(|| CostMap::new(h.width as usize));
-    let mut progress = Progress::scanlines(u64::from(h.lines), progress && !args.quiet);
-    let threads = match args.threads {
-        0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
-        n => n,
-    };
-    let rendered = render_scene_threads(
-        scene,
-        &prepared.options,
-        &machine,
-        &args.numeric,
-        timing,
+    let mut progress = Progress::scanlines(
+        u64::from(h.lines) * u64::from(renderer.frames()),
+        progress && !args.quiet,
+    );
+    let rendered = render(
+        renderer,
+        &array,
+        args.threads,
         &mut sink,
-        cost.as_mut().map(|c| c as &mut dyn TraceWrite),
-        Some(&mut progress),
-        threads,
+        Taps {
+            also: cost.as_mut().map(|c| c as &mut dyn TraceWrite),
+            progress: Some(&mut |lines| progress.update(lines)),
+        },
     )?;
     drop(progress);
     let start = Instant::now();
     let image = sink.finish()?;
     image_args.write(&image)?;
     if let Some(cost) = &cost {
-        let name = match prepared.source.path() {
+        let name = match drawn.source.path() {
             Some(p) => display_name(p),
-            None => prepared.source.name(),
+            None => drawn.source.name(),
         };
         args.cost.write(cost, &name)?;
     }
@@ -448,15 +198,16 @@ pub fn run_render(
     if let Some(path) = &args.stats_json {
         let report = StatsReport {
             trace: (&h).into(),
-            machine: &machine,
-            timing: timing_name(timing),
+            machine: &array.machine,
+            timing: timing_name(array.timing),
             stats: &rendered.stats,
         };
         let mut json =
             serde_json::to_value(&report).map_err(|e| CliError::write(path, e.into()))?;
-        json["emit"] =
-            serde_json::to_value(&rendered.emitted).map_err(|e| CliError::write(path, e.into()))?;
-        json["scene"] = crate::summary::scene_json(&prepared);
+        json["renderer"] = serde_json::Value::from(renderer.name());
+        json["counters"] = serde_json::to_value(&rendered.counters)
+            .map_err(|e| CliError::write(path, e.into()))?;
+        json["scene"] = crate::summary::scene_json(&drawn);
         json["numeric"] = serde_json::Value::from(args.numeric.to_string());
         let text = serde_json::to_string_pretty(&json)
             .map_err(|e| CliError::write(path, e.into()))?
@@ -469,11 +220,7 @@ pub fn run_render(
     let output_time = start.elapsed();
     if !args.quiet {
         let times = StageTimes {
-            load: prepared.times.load,
-            transform: prepared.times.transform,
-            visibility: prepared.times.visibility,
-            ypipe: rendered.ypipe_time,
-            array: rendered.array_time,
+            load: drawn.load_time,
             output: output_time,
         };
         let written: Vec<&Path> = [
@@ -487,19 +234,11 @@ pub fn run_render(
         .into_iter()
         .flatten()
         .collect();
-        write_render_summary(
-            stdout,
-            &prepared,
-            &rendered.emitted,
-            &rendered.stats,
-            &args.numeric,
-            &times,
-            &written,
-        )
-        .map_err(CliError::Stdout)?;
+        write_render_summary(stdout, &drawn, &rendered, &args.numeric, &times, &written)
+            .map_err(CliError::Stdout)?;
         if args.stats {
             writeln!(stdout).map_err(CliError::Stdout)?;
-            write_summary(stdout, &h, timing, &rendered.stats).map_err(CliError::Stdout)?;
+            write_summary(stdout, &h, array.timing, &rendered.stats).map_err(CliError::Stdout)?;
         }
         stdout.flush().map_err(CliError::Stdout)?;
     }

@@ -7,12 +7,11 @@
 
 use super::MachineArgs;
 use crate::commands::run::{open_trace, replay_file, TimingArg};
-use crate::commands::scene::render_scene;
 use crate::cost::{check_extension, display_name};
+use crate::draw::DrawArgs;
 use crate::error::CliError;
 use crate::files::{self, write_atomic};
 use crate::plot::{issue_costs, render_stats_plot, StatsPlot};
-use crate::prepare::{prepare, DrawArgs};
 use crate::range::{parse_range, Range};
 use crate::report::{timing_name, unrefreshed_warning, TraceShape};
 use clap::Args;
@@ -25,8 +24,8 @@ use std::path::{Path, PathBuf};
 /// The arguments of `cwisim stats`.
 #[derive(Args, Clone, Debug, PartialEq)]
 pub struct StatsArgs {
-    /// A trace (.cwt, .jsonl, .cwb), replayed; or a screen-space scene (.json), rendered
-    /// first through the Y-processor (Gouraud shading, box filter).
+    /// A trace (.cwt, .jsonl, .cwb), replayed; or a scene (.json), rendered first
+    /// through the renderer and settings the drawing options give.
     #[arg(value_name = "TRACE|SCENE")]
     pub input: PathBuf,
 
@@ -59,6 +58,10 @@ pub struct StatsArgs {
     /// Timing model. Both give identical cycle counts.
     #[arg(long, value_enum, default_value_t = TimingArg::Fast)]
     pub timing: TimingArg,
+
+    /// How to draw a scene (ignored for a trace).
+    #[command(flatten)]
+    pub draw: DrawArgs,
 }
 
 /// What the input is, by its extension.
@@ -195,18 +198,20 @@ pub fn run(
             (header, replayed.stats)
         }
         Input::Scene => {
-            let prepared = prepare(Some(&args.input), &DrawArgs::default())?;
-            let rendered = render_scene(
-                &prepared.screen,
-                &prepared.options,
-                &machine,
-                &cwisim_xproc::Numeric::F64,
+            let drawn = args.draw.draw(Some(&args.input))?;
+            let array = cwisim_render::ArrayConfig {
+                machine: machine.clone(),
+                numeric: cwisim_xproc::Numeric::F64,
                 timing,
+            };
+            let rendered = cwisim_render::render(
+                &*drawn.renderer,
+                &array,
+                1,
                 &mut NullSink,
-                None,
-                None,
+                cwisim_render::Taps::default(),
             )?;
-            (cwisim_ypipe::header(&prepared.screen), rendered.stats)
+            (drawn.renderer.header(), rendered.stats)
         }
     };
     let timeline = machine.timeline(&header)?;

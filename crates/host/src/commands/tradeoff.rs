@@ -10,12 +10,14 @@
 //! and of the array.
 
 use super::MachineArgs;
-use crate::commands::scene::render_scene;
+use crate::draw::build;
 use crate::error::CliError;
 use crate::files::{check_outputs, write_atomic};
-use crate::prepare::{prepare, AaArg, DrawArgs, ShadingArg, Size, VisibilityArg};
 use crate::tradeoff_plot::render_tradeoff_plot;
 use clap::Args;
+use cwisim_render::{registry, render, ArrayConfig, PolygonScene, Settings, Size, Source, Taps};
+use cwisim_scene::{Antialias, Shading};
+use cwisim_world::Visibility;
 use cwisim_xproc::{ImageSink, Machine, Numeric, Timing};
 use cwisim_ypipe::exact::scene_box_filtered;
 use serde::Serialize;
@@ -41,6 +43,10 @@ pub struct TradeoffArgs {
     /// Draw at this size, WIDTHxHEIGHT (default: the scene's).
     #[arg(long, value_name = "WxH")]
     pub size: Option<Size>,
+    /// The renderers to try, comma-separated (default: every registered renderer;
+    /// `cwisim renderers` lists them).
+    #[arg(long, value_name = "LIST", value_delimiter = ',')]
+    pub renderers: Vec<String>,
     /// The numeric formats of the array to try, comma-separated or repeated (f64, f32,
     /// fixed:I=M.N,dI=M.N,ddI=M.N[,acc=M.N][,overflow=wrap|saturate]).
     #[arg(long = "numeric", value_name = "FORMAT", value_delimiter = ';')]
@@ -92,32 +98,55 @@ pub struct Row {
     pub psnr_db: f64,
     /// Register overflows (wraps or saturations) in the array.
     pub overflows: u64,
+    /// The renderer's own counters.
+    pub counters: cwisim_render::Counters,
     /// Pareto-optimal: no other setting is at least as good in bus cycles, register bits
     /// and RMS error and better in one of them.
     pub pareto: bool,
 }
 
-/// The settings of the grid, in order.
-fn grid(world: bool, formats: &[Numeric]) -> Vec<(DrawArgs, Numeric)> {
+/// One setting of the grid.
+#[derive(Clone, Copy, Debug)]
+pub struct Setting {
+    /// The renderer.
+    pub renderer: &'static registry::Entry,
+    /// How it draws.
+    pub settings: Settings,
+    /// The array's registers.
+    pub numeric: Numeric,
+}
+
+/// The settings of the grid, in order: renderer, then visibility (world scenes only),
+/// shading, anti-aliasing and numeric format.
+pub fn grid(
+    renderers: &[&'static registry::Entry],
+    world: bool,
+    size: Option<Size>,
+    formats: &[Numeric],
+) -> Vec<Setting> {
     let mut out = Vec::new();
-    let visibilities: &[VisibilityArg] = if world {
-        &[VisibilityArg::Exact, VisibilityArg::Eval0]
+    let visibilities: &[Visibility] = if world {
+        &[Visibility::Exact, Visibility::Eval0]
     } else {
-        &[VisibilityArg::Exact]
+        &[Visibility::Exact]
     };
-    for &visibility in visibilities {
-        for shading in [ShadingArg::Gouraud, ShadingArg::Flat] {
-            for aa in [AaArg::Box, AaArg::None] {
-                for numeric in formats {
-                    out.push((
-                        DrawArgs {
-                            shading,
-                            aa,
-                            visibility,
-                            ..DrawArgs::default()
-                        },
-                        *numeric,
-                    ));
+    for &renderer in renderers {
+        for &visibility in visibilities {
+            for shading in [Shading::Gouraud, Shading::Flat] {
+                for aa in [Antialias::Box, Antialias::None] {
+                    for numeric in formats {
+                        out.push(Setting {
+                            renderer,
+                            settings: Settings {
+                                shading,
+                                aa,
+                                visibility,
+                                size,
+                                ..Settings::default()
+                            },
+                            numeric: *numeric,
+                        });
+                    }
                 }
             }
         }
@@ -184,112 +213,103 @@ pub fn mark_pareto(rows: &mut [Row]) {
     }
 }
 
-/// The exact image of the scene SCENE names, at `size`.
+/// The exact image of the scene SCENE names, at `size`: the box-filtered Gouraud image of
+/// its exact visible surfaces, computed by the independent reference.
 pub fn exact_image(scene: Option<&Path>, size: Option<Size>) -> Result<Vec<f64>, CliError> {
-    let draw = DrawArgs {
+    let settings = Settings {
         size,
-        ..DrawArgs::default()
+        ..Settings::default()
     };
-    let p = prepare(scene, &draw)?;
+    let loaded = Source::resolve(scene)?.load(size)?;
+    let p = PolygonScene::new(loaded, &settings)?;
     Ok(scene_box_filtered(&p.screen))
 }
 
-/// Renders one setting; the image, its statistics and the wall time.
+/// What measuring one setting gives.
+pub struct Measured {
+    /// The image, `(lines, width, channels)`.
+    pub image: Vec<f64>,
+    /// The renderer's counters.
+    pub counters: cwisim_render::Counters,
+    /// The array's statistics.
+    pub stats: cwisim_xproc::RunStats,
+    /// Wall time of reading, preparing, rendering and executing.
+    pub time: Duration,
+}
+
+/// Renders one setting.
 pub fn measure(
     scene: Option<&Path>,
-    draw: &DrawArgs,
-    numeric: &Numeric,
+    setting: &Setting,
     machine: &Machine,
-) -> Result<
-    (
-        Vec<f64>,
-        cwisim_ypipe::EmitStats,
-        cwisim_xproc::RunStats,
-        Duration,
-    ),
-    CliError,
-> {
+) -> Result<Measured, CliError> {
     let start = Instant::now();
-    let p = prepare(scene, draw)?;
-    let h = cwisim_ypipe::header(&p.screen);
+    let loaded = Source::resolve(scene)?.load(setting.settings.size)?;
+    let drawn = build(setting.renderer, loaded, &setting.settings)?;
+    let h = drawn.renderer.header();
     let mut sink = ImageSink::new(
         h.width as usize,
         h.channel_count(),
         ImageSink::DEFAULT_LIMIT_BYTES,
     );
-    let rendered = render_scene(
-        &p.screen,
-        &p.options,
-        machine,
-        numeric,
-        Timing::Fast,
-        &mut sink,
-        None,
-        None,
-    )?;
-    let elapsed = start.elapsed();
+    let array = ArrayConfig {
+        machine: machine.clone(),
+        numeric: setting.numeric,
+        timing: Timing::Fast,
+    };
+    let rendered = render(&*drawn.renderer, &array, 1, &mut sink, Taps::default())?;
+    let time = start.elapsed();
     let image = sink.finish()?;
-    Ok((image.data, rendered.emitted, rendered.stats, elapsed))
+    Ok(Measured {
+        image: image.data,
+        counters: rendered.counters,
+        stats: rendered.stats,
+        time,
+    })
 }
 
-fn shading_name(s: ShadingArg) -> &'static str {
-    match s {
-        ShadingArg::Flat => "flat",
-        ShadingArg::Gouraud => "gouraud",
-    }
-}
-
-fn aa_name(a: AaArg) -> &'static str {
-    match a {
-        AaArg::None => "none",
-        AaArg::Box => "box",
-    }
-}
-
-fn visibility_name(v: VisibilityArg) -> &'static str {
-    match v {
-        VisibilityArg::Exact => "exact",
-        VisibilityArg::Eval0 => "eval0",
-    }
-}
-
-/// Measures every setting of the grid.
+/// Measures every setting of the grid: `renderers` by name (empty: every registered one).
+#[allow(clippy::too_many_arguments)]
 pub fn tradeoff_rows(
     scene: Option<&Path>,
     size: Option<Size>,
+    renderers: &[String],
     formats: &[Numeric],
     machine: &Machine,
     repeat: u32,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<Vec<Row>, CliError> {
-    let probe = prepare(scene, &DrawArgs::default())?;
-    let world = probe.kind == "world";
+    let entries: Vec<&'static registry::Entry> = if renderers.is_empty() {
+        registry::REGISTRY.iter().collect()
+    } else {
+        renderers
+            .iter()
+            .map(|n| registry::find(n))
+            .collect::<Result<_, _>>()?
+    };
+    let world = Source::resolve(scene)?.load(size)?.scene.kind() == "world";
     let reference = exact_image(scene, size)?;
-    let settings = grid(world, formats);
+    let settings = grid(&entries, world, size, formats);
     let mut rows = Vec::with_capacity(settings.len());
-    for (k, (mut draw, numeric)) in settings.into_iter().enumerate() {
-        progress(k, rows.capacity());
-        draw.size = size;
-        let mut times = Vec::new();
-        let (image, _, stats, t) = measure(scene, &draw, &numeric, machine)?;
-        times.push(t);
+    for (k, setting) in settings.iter().enumerate() {
+        progress(k, settings.len());
+        let measured = measure(scene, setting, machine)?;
+        let mut times = vec![measured.time];
         for _ in 1..repeat.max(1) {
-            times.push(measure(scene, &draw, &numeric, machine)?.3);
+            times.push(measure(scene, setting, machine)?.time);
         }
         times.sort();
-        let (max_error, rms_error, psnr_db) = errors(&image, &reference);
+        let stats = &measured.stats;
+        let (max_error, rms_error, psnr_db) = errors(&measured.image, &reference);
         let worst = stats.lines.iter().map(|l| l.busy_cycles).max().unwrap_or(0);
+        let s = &setting.settings;
         rows.push(Row {
-            renderer: "van Rij DO_FILL",
-            shading: shading_name(draw.shading),
-            aa: aa_name(draw.aa),
-            visibility: if world {
-                visibility_name(draw.visibility)
-            } else {
-                "-"
-            },
-            numeric: short_numeric(&numeric),
-            register_bits: register_bits(&numeric),
+            renderer: setting.renderer.name,
+            shading: s.shading.name(),
+            aa: s.aa.name(),
+            visibility: if world { s.visibility.name() } else { "-" },
+            numeric: short_numeric(&setting.numeric),
+            register_bits: register_bits(&setting.numeric),
             instructions: stats.totals.instructions,
             busy_cycles: stats.lines.iter().map(|l| l.busy_cycles).sum(),
             worst_line_share: if stats.line_period > 0 {
@@ -303,6 +323,7 @@ pub fn tradeoff_rows(
             rms_error,
             psnr_db,
             overflows: stats.totals.overflows,
+            counters: measured.counters,
             pareto: false,
         });
     }
@@ -314,13 +335,14 @@ pub fn tradeoff_rows(
 pub fn write_table(out: &mut dyn Write, rows: &[Row]) -> std::io::Result<()> {
     writeln!(
         out,
-        "{:<8} {:<4} {:<5} {:<34} {:>4} {:>8} {:>9} {:>6} {:>4} {:>8} {:>9} {:>9} {:>6} {:>5}  pareto",
-        "shading", "aa", "vis", "numeric", "bits", "instr", "busy cyc", "worst", "late", "host ms", "max err", "RMS err", "PSNR", "ovfl"
+        "{:<8} {:<8} {:<4} {:<5} {:<34} {:>4} {:>8} {:>9} {:>6} {:>4} {:>8} {:>9} {:>9} {:>6} {:>5}  pareto",
+        "renderer", "shading", "aa", "vis", "numeric", "bits", "instr", "busy cyc", "worst", "late", "host ms", "max err", "RMS err", "PSNR", "ovfl"
     )?;
     for r in rows {
         writeln!(
             out,
-            "{:<8} {:<4} {:<5} {:<34} {:>4} {:>8} {:>9} {:>5.1}% {:>4} {:>8.2} {:>9.2e} {:>9.2e} {:>6} {:>5}  {}",
+            "{:<8} {:<8} {:<4} {:<5} {:<34} {:>4} {:>8} {:>9} {:>5.1}% {:>4} {:>8.2} {:>9.2e} {:>9.2e} {:>6} {:>5}  {}",
+            r.renderer,
             r.shading,
             r.aa,
             r.visibility,
@@ -345,14 +367,29 @@ pub fn write_table(out: &mut dyn Write, rows: &[Row]) -> std::io::Result<()> {
     Ok(())
 }
 
-/// The table as CSV (one header line, one line per setting).
+/// The table as CSV (one header line, one line per setting). After the fixed columns
+/// come the renderers' own counters, one column per name (the union over the rows, in the
+/// order first met), empty where a row's renderer does not count it.
 pub fn csv(rows: &[Row]) -> String {
+    let mut names: Vec<&'static str> = Vec::new();
+    for r in rows {
+        for (name, _) in r.counters.iter() {
+            if !names.contains(&name) {
+                names.push(name);
+            }
+        }
+    }
     let mut s = String::from(
-        "renderer,shading,aa,visibility,numeric,register_bits,instructions,busy_cycles,worst_line_share,late_lines,host_ms,max_error,rms_error,psnr_db,overflows,pareto\n",
+        "renderer,shading,aa,visibility,numeric,register_bits,instructions,busy_cycles,worst_line_share,late_lines,host_ms,max_error,rms_error,psnr_db,overflows,pareto",
     );
+    for name in &names {
+        s.push(',');
+        s.push_str(name);
+    }
+    s.push('\n');
     for r in rows {
         s.push_str(&format!(
-            "{},{},{},{},\"{}\",{},{},{},{},{},{},{:e},{:e},{},{},{}\n",
+            "{},{},{},{},\"{}\",{},{},{},{},{},{},{:e},{:e},{},{},{}",
             r.renderer,
             r.shading,
             r.aa,
@@ -370,6 +407,13 @@ pub fn csv(rows: &[Row]) -> String {
             r.overflows,
             r.pareto
         ));
+        for name in &names {
+            s.push(',');
+            if let Some(v) = r.counters.get(name) {
+                s.push_str(&v.to_string());
+            }
+        }
+        s.push('\n');
     }
     s
 }
@@ -395,6 +439,7 @@ pub fn run(args: &TradeoffArgs, stdout: &mut dyn Write) -> Result<(), CliError> 
     let rows = tradeoff_rows(
         args.scene.as_deref(),
         args.size,
+        &args.renderers,
         &formats,
         &machine,
         args.repeat,
@@ -409,7 +454,7 @@ pub fn run(args: &TradeoffArgs, stdout: &mut dyn Write) -> Result<(), CliError> 
         })?;
     }
     if let Some(path) = &args.plot {
-        let name = crate::prepare::Source::resolve(args.scene.as_deref())?.name();
+        let name = Source::resolve(args.scene.as_deref())?.name();
         let img = render_tradeoff_plot(&rows, &name).map_err(CliError::Usage)?;
         img.write_png(path)?;
     }
@@ -437,6 +482,7 @@ mod tests {
             rms_error: rms,
             psnr_db: 0.0,
             overflows: 0,
+            counters: Default::default(),
             pareto: false,
         }
     }

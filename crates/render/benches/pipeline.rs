@@ -1,4 +1,4 @@
-//! The whole pipeline, measured: `cargo bench -p cwisim-host --bench pipeline`.
+//! The whole pipeline, measured: `cargo bench -p cwisim-render --bench pipeline`.
 //!
 //! * `pot_1024` — the embedded pot at 1024×1024, end to end from the parsed scene:
 //!   transform and lighting, visibility, the Y-processor, and the array with its timing
@@ -16,12 +16,15 @@
 //! The figures are in docs/PERFORMANCE.md.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use cwisim_host::commands::scene::render_scene_threads;
 use cwisim_isa::{io::read_all, Encoding, Instruction, TraceWrite};
+use cwisim_render::vanrij::VanRij;
+use cwisim_render::{
+    render as run_pipeline, ArrayConfig, LoadedScene, PolygonScene, Settings, Taps,
+};
 use cwisim_scene::ScreenScene;
 use cwisim_world::embedded::embedded;
 use cwisim_world::{parse_any, project::project, resolve, AnyScene, Visibility, WorldScene};
-use cwisim_xproc::{EngineWriter, ImageSink, Machine, NullSink, Numeric, Timing};
+use cwisim_xproc::{EngineWriter, ImageSink, Machine, NullSink, Timing};
 use cwisim_ypipe::{emit, header, Claim, Options, Shading};
 use std::hint::black_box;
 use std::time::Duration;
@@ -61,37 +64,31 @@ fn prepare(w: &WorldScene, visibility: Visibility) -> ScreenScene {
     }
 }
 
-/// The array and its timing on a screen scene, into an image (or nowhere).
-fn render(screen: &ScreenScene, options: &Options, threads: usize, image: bool) -> u64 {
-    let h = header(screen);
+/// The array and its timing on a screen scene, into an image (or nowhere), through the
+/// renderer interface and the pipeline as `cwisim render` runs them.
+fn render(screen: ScreenScene, visibility: Visibility, threads: usize, image: bool) -> u64 {
+    let h = header(&screen);
     let mut img = ImageSink::new(h.width as usize, h.channel_count(), 1 << 34);
     let mut null = NullSink;
     let sink: &mut dyn cwisim_xproc::LineSink<f64> = if image { &mut img } else { &mut null };
-    let r = render_scene_threads(
-        screen,
-        options,
-        &Machine::default(),
-        &Numeric::F64,
-        Timing::Fast,
-        sink,
-        None,
-        None,
+    let settings = Settings {
+        visibility,
+        ..Settings::default()
+    };
+    let loaded = LoadedScene::built("bench", AnyScene::Screen(screen));
+    let mut polygons = PolygonScene::new(loaded, &settings).expect("prepares");
+    // the screen scene stands for a world scene's visible surfaces: claim as eval0 does
+    polygons.visibility_mode = Some(visibility);
+    let renderer = VanRij::from_polygons(polygons, &settings);
+    let r = run_pipeline(
+        &renderer,
+        &ArrayConfig::default(),
         threads,
+        sink,
+        Taps::default(),
     )
     .expect("renders");
     r.stats.totals.cycles
-}
-
-struct Collect(Vec<Instruction>);
-
-impl TraceWrite for Collect {
-    fn write(&mut self, i: &Instruction) -> std::io::Result<()> {
-        self.0.push(*i);
-        Ok(())
-    }
-    fn finish(&mut self) -> std::io::Result<()> {
-        Ok(())
-    }
 }
 
 struct Count(u64);
@@ -115,7 +112,7 @@ fn pot_1024(c: &mut Criterion) {
             g.bench_function(BenchmarkId::new(name, format!("{threads}thread")), |b| {
                 b.iter(|| {
                     let screen = prepare(black_box(&w), vis);
-                    black_box(render(&screen, &options(vis), threads, true))
+                    black_box(render(screen, vis, threads, true))
                 })
             });
         }
@@ -138,17 +135,17 @@ fn stages_1024(c: &mut Criterion) {
         g.bench_function(BenchmarkId::new("ypipe_rows", name), |b| {
             b.iter(|| black_box(emit(&screen, &opts, &mut Count(0)).expect("emit")))
         });
-        let mut stream = Collect(Vec::new());
+        let mut stream: Vec<Instruction> = Vec::new();
         emit(&screen, &opts, &mut stream).expect("emit");
         let h = header(&screen);
-        g.throughput(Throughput::Elements(stream.0.len() as u64));
+        g.throughput(Throughput::Elements(stream.len() as u64));
         g.bench_function(BenchmarkId::new("array_instructions", name), |b| {
             b.iter(|| {
                 let mut sink = NullSink;
                 let mut a =
                     EngineWriter::<f64>::new(&h, &Machine::default(), Timing::Fast, &mut sink)
                         .expect("machine");
-                for i in &stream.0 {
+                for i in &stream {
                     a.write(i).expect("valid");
                 }
                 a.finish().expect("finish");
@@ -179,7 +176,7 @@ fn scaling(c: &mut Criterion) {
             ..fixed.clone()
         };
         g.bench_with_input(BenchmarkId::from_parameter(side), &screen, |b, s| {
-            b.iter(|| black_box(render(s, &Options::default(), 1, false)))
+            b.iter(|| black_box(render(s.clone(), Visibility::Exact, 1, false)))
         });
     }
     g.finish();

@@ -1,0 +1,163 @@
+//! How a scene is drawn, as the command line says it: `--renderer`, `--shading`, `--aa`,
+//! `--visibility`, `--eval0-tolerance`, `--size` — one flattened group shared by
+//! `render`, `emit`, `stats` and `fit`, converted into `cwisim-render`'s plain
+//! [`Settings`].
+
+use crate::error::CliError;
+use clap::{Args, ValueEnum};
+use cwisim_render::{registry, LoadedScene, Renderer, Settings, Size, Source};
+use cwisim_scene::{Antialias, Shading};
+use cwisim_world::Visibility;
+use std::path::Path;
+use std::time::Duration;
+
+/// `--shading`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum ShadingArg {
+    /// One intensity per polygon (world scenes: lit once per face): Eval1 spans.
+    Flat,
+    /// Interpolated along the edges and across each scanline (world scenes: lit at every
+    /// vertex): Eval2 spans.
+    #[default]
+    Gouraud,
+}
+
+/// `--aa`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum AaArg {
+    /// Point sampling at pixel centres.
+    None,
+    /// Box filter: the exact covered area of every pixel (DO_FILL's twelve cases).
+    #[default]
+    Box,
+}
+
+/// `--visibility`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum VisibilityArg {
+    /// Object space: every triangle minus what hides it (polygon booleans), then exact
+    /// coverage of the visible fragments.
+    #[default]
+    Exact,
+    /// The array's own way: whole triangles front to back, each claiming the pixels it
+    /// fully covers with Eval0; edge pixels are approximate.
+    Eval0,
+}
+
+impl From<ShadingArg> for Shading {
+    fn from(s: ShadingArg) -> Shading {
+        match s {
+            ShadingArg::Flat => Shading::Flat,
+            ShadingArg::Gouraud => Shading::Gouraud,
+        }
+    }
+}
+
+impl From<AaArg> for Antialias {
+    fn from(a: AaArg) -> Antialias {
+        match a {
+            AaArg::None => Antialias::None,
+            AaArg::Box => Antialias::Box,
+        }
+    }
+}
+
+impl From<VisibilityArg> for Visibility {
+    fn from(v: VisibilityArg) -> Visibility {
+        match v {
+            VisibilityArg::Exact => Visibility::Exact,
+            VisibilityArg::Eval0 => Visibility::Eval0,
+        }
+    }
+}
+
+/// How a scene is drawn: shared by `render`, `emit`, `stats` and `fit`.
+#[derive(Args, Clone, Debug, PartialEq)]
+pub struct DrawArgs {
+    /// The renderer: the Y-processor program that turns the scene into instructions
+    /// (`cwisim renderers` lists them).
+    #[arg(long, value_name = "NAME", default_value = registry::DEFAULT_RENDERER)]
+    pub renderer: String,
+    /// Shading.
+    #[arg(long, value_enum, default_value_t = ShadingArg::Gouraud)]
+    pub shading: ShadingArg,
+    /// Anti-aliasing.
+    #[arg(long, value_enum, default_value_t = AaArg::Box)]
+    pub aa: AaArg,
+    /// Hidden-surface removal for world scenes (screen scenes are drawn as they are:
+    /// their polygons add up).
+    #[arg(long, value_enum, default_value_t = VisibilityArg::Exact)]
+    pub visibility: VisibilityArg,
+    /// With --visibility eval0 and Gouraud shading: how far (in intensity) the staircase
+    /// of Eval0s that claims a shaded interior may stray from the Gouraud value at a pixel
+    /// centre. Smaller is more exact and costs more Eval0s; 0 is one Eval0 per pixel.
+    #[arg(long, value_name = "TOL", default_value_t = 1.0 / 512.0)]
+    pub eval0_tolerance: f64,
+    /// Draw at another size, WIDTHxHEIGHT (a world scene's camera keeps its vertical field
+    /// of view; a screen scene is scaled).
+    #[arg(long, value_name = "WxH")]
+    pub size: Option<Size>,
+}
+
+impl Default for DrawArgs {
+    fn default() -> Self {
+        DrawArgs {
+            renderer: registry::DEFAULT_RENDERER.into(),
+            shading: ShadingArg::Gouraud,
+            aa: AaArg::Box,
+            visibility: VisibilityArg::Exact,
+            eval0_tolerance: 1.0 / 512.0,
+            size: None,
+        }
+    }
+}
+
+/// A scene read and made ready by a renderer.
+pub struct Drawn {
+    /// Where the scene came from.
+    pub source: Source,
+    /// `"screen"` or `"world"`.
+    pub kind: &'static str,
+    /// Wall time of reading it.
+    pub load_time: Duration,
+    /// The renderer, built for it.
+    pub renderer: Box<dyn Renderer>,
+}
+
+impl DrawArgs {
+    /// The library's settings.
+    pub fn settings(&self) -> Settings {
+        Settings {
+            shading: self.shading.into(),
+            aa: self.aa.into(),
+            visibility: self.visibility.into(),
+            eval0_tolerance: self.eval0_tolerance,
+            size: self.size,
+        }
+    }
+
+    /// Reads the scene SCENE names (a file, an embedded name, or none: the default) and
+    /// builds the renderer for it.
+    pub fn draw(&self, scene: Option<&Path>) -> Result<Drawn, CliError> {
+        let entry = registry::find(&self.renderer)?;
+        let settings = self.settings();
+        settings.check().map_err(CliError::Usage)?;
+        let loaded = Source::resolve(scene)?.load(self.size)?;
+        Ok(build(entry, loaded, &settings)?)
+    }
+}
+
+/// Builds `entry`'s renderer for a loaded scene.
+pub fn build(
+    entry: &registry::Entry,
+    loaded: LoadedScene,
+    settings: &Settings,
+) -> Result<Drawn, cwisim_render::RenderError> {
+    let (source, kind, load_time) = (loaded.source.clone(), loaded.scene.kind(), loaded.load_time);
+    Ok(Drawn {
+        source,
+        kind,
+        load_time,
+        renderer: (entry.build)(loaded, settings)?,
+    })
+}

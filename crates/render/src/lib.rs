@@ -1,0 +1,53 @@
+//! # cwisim-render — one interface for every renderer
+//!
+//! In the CWI architecture a Y-processor program turns a scene into scanline
+//! instructions for the X-processor array. This crate is where such programs plug in:
+//!
+//! * [`renderer`] — the [`Renderer`] trait (name, header, frames, a [`FramePlan`] per
+//!   frame from which any band of rows is emitted into any `TraceWrite`) and
+//!   [`Counters`], a renderer's own figures by name.
+//! * [`registry`] — the renderers by name ([`REGISTRY`]); adding one is its module plus
+//!   one line there.
+//! * [`pipeline`] — [`render`]: a renderer's frames, in bands on threads, fed to the
+//!   simulated array ([`ArrayConfig`]) scanline by scanline, byte-identical at any thread
+//!   count, with the renderer's and the array's wall time; [`emit`](fn@emit): the stream
+//!   alone, into a trace.
+//! * [`source`] — which scene ([`Source`]: a file or an embedded name) and reading it.
+//! * [`settings`] — how to draw ([`Settings`]), in plain types.
+//! * [`prepare`] — screen-space polygons from any scene ([`PolygonScene`]), what polygon
+//!   renderers start from.
+//! * [`vanrij`] — van Rij's DO_FILL (`cwisim-ypipe`), the first renderer and the default.
+//!
+//! ```
+//! use cwisim_render::{registry, render, ArrayConfig, Settings, Source, Taps};
+//! use cwisim_xproc::ImageSink;
+//!
+//! let source = Source::resolve(Some("fig25".as_ref())).unwrap();
+//! let settings = Settings::default();
+//! let loaded = source.load(settings.size).unwrap();
+//! let renderer = (registry::find("vanrij").unwrap().build)(loaded, &settings).unwrap();
+//! let h = renderer.header();
+//! let mut image = ImageSink::new(h.width as usize, h.channel_count(), ImageSink::DEFAULT_LIMIT_BYTES);
+//! let done = render(&*renderer, &ArrayConfig::default(), 1, &mut image, Taps::default()).unwrap();
+//! assert_eq!(done.stats.totals.frames, 1);
+//! assert!(done.counters.get("trapezia").unwrap() > 0);
+//! ```
+
+#![warn(missing_docs)]
+
+pub mod error;
+pub mod pipeline;
+pub mod prepare;
+pub mod registry;
+pub mod renderer;
+pub mod settings;
+pub mod source;
+pub mod vanrij;
+
+pub use error::RenderError;
+pub use pipeline::{emit, render, ArrayConfig, Rendered, Taps};
+pub use prepare::PolygonScene;
+pub use registry::{find, Entry, DEFAULT_RENDERER, REGISTRY};
+pub use renderer::{Counters, FramePlan, Renderer};
+pub use settings::{Settings, Size};
+pub use source::{LoadedScene, Source, DEFAULT_SCENE};

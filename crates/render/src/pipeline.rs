@@ -1,0 +1,353 @@
+//! The pipeline: a renderer's frames, emitted (in bands, on threads when asked) and fed
+//! to the simulated X-processor array scanline by scanline, with the wall time of each
+//! side measured.
+//!
+//! With `threads > 1`, `threads − 1` workers each take the next band of rows of the frame
+//! and emit it into a [`PackedStream`]; the calling thread feeds the finished bands to the
+//! array in band order and hands their buffers back for reuse. The renderer and the array
+//! overlap, and the array sees exactly the serial stream: output, trace and statistics
+//! are byte-identical at any thread count.
+
+use crate::error::RenderError;
+use crate::renderer::{Counters, FramePlan, Renderer};
+use cwisim_isa::{Instruction, Opcode, PackedStream, TraceHeader, TraceWrite};
+use cwisim_xproc::{EngineWriter, Image, LineOut, LineSink, Machine, Numeric, RunStats, Timing};
+use std::cell::RefCell;
+use std::io;
+use std::rc::Rc;
+use std::time::{Duration, Instant};
+
+/// The simulated array: its machine model, register format and timing engine.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ArrayConfig {
+    /// The machine model (timing parameters).
+    pub machine: Machine,
+    /// The registers' numeric format.
+    pub numeric: Numeric,
+    /// The timing engine (fast, or cycle-stepped).
+    pub timing: Timing,
+}
+
+/// What watches the stream besides the array.
+#[derive(Default)]
+pub struct Taps<'a> {
+    /// Gets every instruction (and comment) as the array does: a trace file, a cost map.
+    pub also: Option<&'a mut dyn TraceWrite>,
+    /// Told the number of scanlines done after each one.
+    pub progress: Option<&'a mut dyn FnMut(u64)>,
+}
+
+/// What a render gives besides the scanlines.
+#[derive(Clone, Debug)]
+pub struct Rendered {
+    /// The renderer's counters, summed over bands and frames.
+    pub counters: Counters,
+    /// The array's statistics.
+    pub stats: RunStats,
+    /// Wall time in the renderer (emitting instructions).
+    pub renderer_time: Duration,
+    /// Wall time in the array simulator.
+    pub array_time: Duration,
+}
+
+/// Bands per thread: enough that uneven bands balance out.
+const BANDS_PER_THREAD: u32 = 8;
+
+/// Renders every frame of `renderer` into the array `array`, handing its scanlines to
+/// `lines`, on `threads` threads (0: as many as the machine has; 1: serially, as the
+/// stream comes).
+pub fn render(
+    renderer: &dyn Renderer,
+    array: &ArrayConfig,
+    threads: usize,
+    lines: &mut dyn LineSink<f64>,
+    taps: Taps<'_>,
+) -> Result<Rendered, RenderError> {
+    let threads = match threads {
+        0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
+        n => n,
+    };
+    let header = renderer.header();
+    let keep = renderer.needs_previous_frame() && renderer.frames() > 1;
+    let frame_image = keep.then(|| Rc::new(RefCell::new(empty_image(&header))));
+    let mut keeper;
+    let sink: &mut dyn LineSink<f64> = match &frame_image {
+        Some(frame) => {
+            keeper = FrameKeeper {
+                inner: lines,
+                frame: Rc::clone(frame),
+            };
+            &mut keeper
+        }
+        None => lines,
+    };
+    let mut feed = ScanlineFeed::open(&header, array, sink, taps)?;
+    let start = Instant::now();
+    let mut counters = Counters::default();
+    let mut previous: Option<Image> = None;
+    for index in 0..renderer.frames() {
+        let plan = renderer.frame(index, previous.as_ref())?;
+        counters.merge(&plan.counters());
+        let fault = |source| RenderError::Renderer {
+            renderer: renderer.name(),
+            source,
+        };
+        let band = if threads > 1 {
+            feed_parallel(&*plan, header.lines, threads, &mut feed, fault)?
+        } else {
+            plan.emit_rows(0..header.lines, &mut feed).map_err(|e| {
+                feed.fault
+                    .take()
+                    .map_or_else(|| fault(e), RenderError::Array)
+            })?
+        };
+        counters.merge(&band);
+        drop(plan);
+        if let Some(frame) = &frame_image {
+            previous = Some(frame.replace(empty_image(&header)));
+        }
+    }
+    feed.close(counters, start.elapsed())
+}
+
+/// Emits the whole stream of `renderer`, every frame, into `sink` (a trace file, a
+/// collector), serially; its counters. Frames that need the previous frame's output
+/// cannot be emitted without the array: they are refused.
+pub fn emit(renderer: &dyn Renderer, sink: &mut dyn TraceWrite) -> Result<Counters, RenderError> {
+    if renderer.needs_previous_frame() && renderer.frames() > 1 {
+        return Err(RenderError::Usage(format!(
+            "the renderer `{}` draws each frame from the previous frame's output: render it through the array (`cwisim render --trace`)",
+            renderer.name()
+        )));
+    }
+    let header = renderer.header();
+    let fault = |source| RenderError::Renderer {
+        renderer: renderer.name(),
+        source,
+    };
+    let mut counters = Counters::default();
+    for index in 0..renderer.frames() {
+        let plan = renderer.frame(index, None)?;
+        counters.merge(&plan.counters());
+        counters.merge(&plan.emit_rows(0..header.lines, sink).map_err(fault)?);
+    }
+    sink.finish().map_err(fault)?;
+    Ok(counters)
+}
+
+fn empty_image(header: &TraceHeader) -> Image {
+    Image {
+        width: header.width as usize,
+        channels: header.channel_count(),
+        lines: 0,
+        data: Vec::new(),
+    }
+}
+
+/// Passes scanlines on, and keeps the current frame's as an [`Image`] for the next frame.
+struct FrameKeeper<'s> {
+    inner: &'s mut dyn LineSink<f64>,
+    frame: Rc<RefCell<Image>>,
+}
+
+impl LineSink<f64> for FrameKeeper<'_> {
+    fn line(&mut self, line: LineOut<'_, f64>) {
+        {
+            let mut image = self.frame.borrow_mut();
+            let (width, channels) = (image.width, image.channels);
+            let start = image.data.len();
+            image.data.resize(start + width * channels, 0.0);
+            let row = &mut image.data[start..];
+            row[line.span.0 * channels..line.span.1 * channels].copy_from_slice(line.values);
+            image.lines += 1;
+        }
+        self.inner.line(line);
+    }
+}
+
+/// The array, fed one scanline at a time: instructions are buffered up to each
+/// `Refresh`, so that the array's share of the wall time is measured per scanline rather
+/// than per instruction. Every instruction also goes to the taps as it comes.
+struct ScanlineFeed<'a, 's> {
+    array: EngineWriter<'s, f64>,
+    taps: Taps<'a>,
+    buffer: Vec<Instruction>,
+    array_time: Duration,
+    lines: u64,
+    /// The array's (or a tap's) own failure, told apart from the renderer's.
+    fault: Option<io::Error>,
+}
+
+impl<'a, 's> ScanlineFeed<'a, 's> {
+    fn open(
+        header: &TraceHeader,
+        array: &ArrayConfig,
+        sink: &'s mut dyn LineSink<f64>,
+        taps: Taps<'a>,
+    ) -> Result<Self, RenderError> {
+        Ok(ScanlineFeed {
+            array: EngineWriter::with_numeric(
+                header,
+                &array.machine,
+                array.timing,
+                &array.numeric,
+                sink,
+            )?,
+            taps,
+            buffer: Vec::new(),
+            array_time: Duration::ZERO,
+            lines: 0,
+            fault: None,
+        })
+    }
+
+    /// Finishes the array and the taps; `total` is the wall time since emission began
+    /// (the renderer's share is what the array did not take: the two interleave, or
+    /// overlap on threads).
+    fn close(mut self, counters: Counters, total: Duration) -> Result<Rendered, RenderError> {
+        self.finish().map_err(RenderError::Array)?;
+        let array_time = self.array_time;
+        let stats = self.array.into_stats().expect("finished");
+        Ok(Rendered {
+            counters,
+            stats,
+            renderer_time: total.saturating_sub(array_time),
+            array_time,
+        })
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        let start = Instant::now();
+        for instr in self.buffer.drain(..) {
+            self.array.write(&instr)?;
+        }
+        self.array_time += start.elapsed();
+        Ok(())
+    }
+
+    /// Notes an error of the array's or a tap's own, so that it is not blamed on the
+    /// renderer.
+    fn own(&mut self, r: io::Result<()>) -> io::Result<()> {
+        r.map_err(|e| {
+            let again = io::Error::new(e.kind(), e.to_string());
+            self.fault = Some(e);
+            again
+        })
+    }
+}
+
+impl TraceWrite for ScanlineFeed<'_, '_> {
+    fn write(&mut self, instr: &Instruction) -> io::Result<()> {
+        if let Some(also) = self.taps.also.as_deref_mut() {
+            let r = also.write(instr);
+            self.own(r)?;
+        }
+        self.buffer.push(*instr);
+        if instr.op == Opcode::Refresh {
+            let r = self.flush();
+            self.own(r)?;
+            self.lines += 1;
+            if let Some(p) = self.taps.progress.as_deref_mut() {
+                p(self.lines);
+            }
+        }
+        Ok(())
+    }
+
+    fn comment(&mut self, text: &str) -> io::Result<()> {
+        match self.taps.also.as_deref_mut() {
+            Some(also) => {
+                let r = also.comment(text);
+                self.own(r)
+            }
+            None => Ok(()),
+        }
+    }
+
+    fn wants_comments(&self) -> bool {
+        self.taps
+            .also
+            .as_deref()
+            .is_some_and(|a| a.wants_comments())
+    }
+
+    fn finish(&mut self) -> io::Result<()> {
+        self.flush()?;
+        let start = Instant::now();
+        self.array.finish()?;
+        self.array_time += start.elapsed();
+        if let Some(also) = self.taps.also.as_deref_mut() {
+            also.finish()?;
+        }
+        Ok(())
+    }
+}
+
+/// One frame in bands: `threads − 1` workers emit bands of rows (taking the next band as
+/// they finish one) while this thread feeds the finished bands to the array in order.
+fn feed_parallel(
+    plan: &dyn FramePlan,
+    rows: u32,
+    threads: usize,
+    feed: &mut ScanlineFeed<'_, '_>,
+    fault: impl Fn(io::Error) -> RenderError,
+) -> Result<Counters, RenderError> {
+    use std::collections::BTreeMap;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::sync::{mpsc, Mutex};
+    let n = (threads as u32 * BANDS_PER_THREAD).clamp(1, rows.max(1));
+    let band_rows = |k: u32| {
+        let a = (u64::from(rows) * u64::from(k) / u64::from(n)) as u32;
+        let b = (u64::from(rows) * u64::from(k + 1) / u64::from(n)) as u32;
+        a..b
+    };
+    let next_band = AtomicUsize::new(0);
+    // buffers the feeder has emptied, for the workers to reuse: a fresh buffer per band
+    // would be mapped and faulted in page by page (most bands are over the allocator's
+    // mmap threshold), which costs more than the work overlapped
+    let spare: Mutex<Vec<PackedStream>> = Mutex::new(Vec::new());
+    // this thread feeds the array: it counts as one of the `threads`
+    let workers = threads.saturating_sub(1).max(1);
+    std::thread::scope(|scope| {
+        let (tx, rx) = mpsc::channel::<(usize, io::Result<(PackedStream, Counters)>)>();
+        for _ in 0..workers {
+            let tx = tx.clone();
+            let (next_band, band_rows, spare) = (&next_band, &band_rows, &spare);
+            scope.spawn(move || loop {
+                let k = next_band.fetch_add(1, Ordering::Relaxed);
+                if k >= n as usize {
+                    break;
+                }
+                let reused = spare.lock().ok().and_then(|mut s| s.pop());
+                let mut band = reused.unwrap_or_default();
+                band.clear();
+                let r = plan
+                    .emit_rows(band_rows(k as u32), &mut band)
+                    .map(|counters| (band, counters));
+                if tx.send((k, r)).is_err() {
+                    break; // the feeder stopped on an error
+                }
+            });
+        }
+        drop(tx);
+        // feed the bands in order as they arrive
+        let mut counters = Counters::default();
+        let mut waiting = BTreeMap::new();
+        let mut want = 0usize;
+        for (k, band) in rx {
+            waiting.insert(k, band);
+            while let Some(band) = waiting.remove(&want) {
+                let (instructions, band_counters) = band.map_err(&fault)?;
+                counters.merge(&band_counters);
+                for instr in instructions.iter() {
+                    feed.write(&instr).map_err(RenderError::Array)?;
+                }
+                if let Ok(mut s) = spare.lock() {
+                    s.push(instructions);
+                }
+                want += 1;
+            }
+        }
+        Ok(counters)
+    })
+}

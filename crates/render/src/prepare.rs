@@ -1,0 +1,131 @@
+//! From a loaded scene to screen-space polygons: what every polygon renderer starts from.
+//! A screen scene is taken as it is; a world scene is projected, lit (per vertex for
+//! Gouraud shading, per face for flat) with back faces culled, and its hidden surfaces
+//! removed (exact fragments, or whole triangles front to back for `Eval0` claims).
+
+use crate::error::RenderError;
+use crate::settings::Settings;
+use crate::source::{LoadedScene, Source};
+use cwisim_scene::ScreenScene;
+use cwisim_world::{AnyScene, ProjectStats, Visibility, VisibilityStats};
+use std::time::{Duration, Instant};
+
+/// Screen-space polygons, ready to scan-convert, and what making them did.
+#[derive(Clone, Debug)]
+pub struct PolygonScene {
+    /// Where the scene came from.
+    pub source: Source,
+    /// `"screen"` or `"world"`.
+    pub kind: &'static str,
+    /// The polygons, in the order they are sent.
+    pub screen: ScreenScene,
+    /// What projection did (world scenes).
+    pub project: Option<ProjectStats>,
+    /// What exact visibility did (world scenes, exact visibility).
+    pub visibility: Option<VisibilityStats>,
+    /// The visibility used (world scenes; screen scenes are drawn as they are).
+    pub visibility_mode: Option<Visibility>,
+    /// Wall time of reading the scene.
+    pub load_time: Duration,
+    /// Wall time of transform, lighting and culling (world scenes).
+    pub transform_time: Duration,
+    /// Wall time of hidden-surface removal (world scenes).
+    pub visibility_time: Duration,
+}
+
+impl PolygonScene {
+    /// Makes `loaded` ready as `settings` say.
+    pub fn new(loaded: LoadedScene, settings: &Settings) -> Result<PolygonScene, RenderError> {
+        settings.check().map_err(RenderError::Usage)?;
+        let kind = loaded.scene.kind();
+        let mut prepared = PolygonScene {
+            source: loaded.source,
+            kind,
+            screen: ScreenScene {
+                width: 1,
+                height: 1,
+                channels: 1,
+                polygons: Vec::new(),
+            },
+            project: None,
+            visibility: None,
+            visibility_mode: None,
+            load_time: loaded.load_time,
+            transform_time: Duration::ZERO,
+            visibility_time: Duration::ZERO,
+        };
+        match loaded.scene {
+            AnyScene::Screen(s) => prepared.screen = s,
+            AnyScene::World(w) => {
+                let start = Instant::now();
+                let (tris, project) = cwisim_world::project::project(&w, settings.shading)?;
+                prepared.transform_time = start.elapsed();
+                let start = Instant::now();
+                let (polygons, vis) =
+                    cwisim_world::resolve(&tris, w.channels(), settings.visibility);
+                prepared.visibility_time = start.elapsed();
+                prepared.screen = ScreenScene {
+                    width: w.width(),
+                    height: w.height(),
+                    channels: w.channels() as u8,
+                    polygons,
+                };
+                prepared.project = Some(project);
+                prepared.visibility = vis;
+                prepared.visibility_mode = Some(settings.visibility);
+            }
+        }
+        Ok(prepared)
+    }
+
+    /// The host-side figures every polygon renderer's summary shows: the geometry, and
+    /// exact visibility's fragments.
+    pub fn summary_rows(&self) -> Vec<(&'static str, String)> {
+        let mut rows = Vec::new();
+        if let Some(g) = &self.project {
+            rows.push((
+                "geometry",
+                format!(
+                    "{} mesh(es), {} faces → {} triangles: {} back faces culled, {} drawn ({} back faces of two-sided meshes, {} edge-on dropped)",
+                    g.meshes,
+                    g.faces,
+                    g.triangles,
+                    g.culled,
+                    g.triangles - g.culled - g.edge_on,
+                    g.back_faces_drawn,
+                    g.edge_on
+                ),
+            ));
+        }
+        if let (Some(Visibility::Exact), Some(v)) = (&self.visibility_mode, &self.visibility) {
+            rows.push((
+                "visibility",
+                format!(
+                    "exact: {} visible fragments of {} triangles ({} wholly hidden; {} occluding pairs; {} hole cuts; {} slivers dropped, {:.1e} px² in all)",
+                    v.fragments, v.triangles, v.hidden, v.occluding_pairs, v.hole_cuts, v.dropped_slivers, v.dropped_area
+                ),
+            ));
+        }
+        rows
+    }
+
+    /// The host-side stage times: transform & lighting, visibility.
+    pub fn stage_times(&self) -> Vec<(&'static str, Duration)> {
+        vec![
+            ("transform & lighting", self.transform_time),
+            ("visibility", self.visibility_time),
+        ]
+    }
+
+    /// The scene part of `--stats-json`: deterministic (no times, no paths).
+    pub fn scene_json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "name": self.source.name(),
+            "kind": self.kind,
+            "polygons": self.screen.polygons.len(),
+            "visibility": self.visibility_mode.map(Visibility::name),
+            "project": self.project,
+            "exact_visibility": self.visibility,
+        })
+    }
+}

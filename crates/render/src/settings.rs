@@ -1,0 +1,115 @@
+//! How to draw: the settings every renderer reads, in plain types (the command line's
+//! argument groups convert into them; nothing here knows about clap).
+
+use cwisim_scene::{Antialias, Shading};
+use cwisim_world::Visibility;
+use std::fmt;
+use std::str::FromStr;
+
+/// An image size, `WIDTHxHEIGHT`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Size {
+    /// Width, pixels.
+    pub width: u32,
+    /// Height, pixels.
+    pub height: u32,
+}
+
+impl FromStr for Size {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let bad = || format!("expected WIDTHxHEIGHT in pixels, such as 640x480; found `{s}`");
+        let (w, h) = s.split_once(['x', 'X', '×']).ok_or_else(bad)?;
+        let (width, height) = (
+            w.trim().parse::<u32>().map_err(|_| bad())?,
+            h.trim().parse::<u32>().map_err(|_| bad())?,
+        );
+        if width == 0 || height == 0 {
+            return Err(format!("an image needs at least 1x1 pixels; found `{s}`"));
+        }
+        Ok(Size { width, height })
+    }
+}
+
+impl fmt::Display for Size {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}x{}", self.width, self.height)
+    }
+}
+
+/// How a scene is drawn, whatever the renderer. A renderer reads the settings that apply
+/// to it and says in its description which ones it used.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Settings {
+    /// Shading.
+    pub shading: Shading,
+    /// Anti-aliasing.
+    pub aa: Antialias,
+    /// Hidden-surface removal for world scenes.
+    pub visibility: Visibility,
+    /// With eval0 visibility and Gouraud shading: how far the staircase of `Eval0`s that
+    /// claims a shaded interior may stray from the Gouraud value at a pixel centre.
+    pub eval0_tolerance: f64,
+    /// Draw at another size (a world scene's camera keeps its vertical field of view; a
+    /// screen scene is scaled).
+    pub size: Option<Size>,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings {
+            shading: Shading::Gouraud,
+            aa: Antialias::Box,
+            visibility: Visibility::Exact,
+            eval0_tolerance: 1.0 / 512.0,
+            size: None,
+        }
+    }
+}
+
+impl Settings {
+    /// Refuses settings no renderer could use, saying which and why.
+    pub fn check(&self) -> Result<(), String> {
+        if !(self.eval0_tolerance >= 0.0 && self.eval0_tolerance.is_finite()) {
+            return Err(format!(
+                "--eval0-tolerance must be a finite number ≥ 0, found {}",
+                self.eval0_tolerance
+            ));
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_parse_print_and_refuse() {
+        let s: Size = "640x480".parse().unwrap();
+        assert_eq!(
+            s,
+            Size {
+                width: 640,
+                height: 480
+            }
+        );
+        assert_eq!(s.to_string().parse::<Size>(), Ok(s));
+        assert!("640".parse::<Size>().unwrap_err().contains("WIDTHxHEIGHT"));
+        assert!("0x4".parse::<Size>().unwrap_err().contains("at least"));
+        assert!("-3x4".parse::<Size>().is_err());
+    }
+
+    #[test]
+    fn tolerances_are_checked() {
+        assert_eq!(Settings::default().check(), Ok(()));
+        for bad in [-1.0, f64::NAN, f64::INFINITY] {
+            let s = Settings {
+                eval0_tolerance: bad,
+                ..Settings::default()
+            };
+            assert!(s.check().unwrap_err().contains("--eval0-tolerance"));
+        }
+    }
+}
