@@ -1,0 +1,194 @@
+//! The pipeline's contract with renderers: frames in order, the previous frame's output
+//! handed to renderers that need it, bands on threads byte-identical to one thread, and
+//! a renderer's fault reported as cwisim's, not the user's.
+
+use cwisim_isa::{Instruction, Intensity, TraceHeader, TraceWrite};
+use cwisim_render::{emit, render, ArrayConfig, Counters, FramePlan, RenderError, Renderer, Taps};
+use cwisim_xproc::{Image, ImageSink};
+use std::io;
+use std::ops::Range;
+
+const W: u32 = 7;
+const H: u32 = 5;
+
+/// Frame 0: a ramp per row; frame k > 0: every pixel `0.5 × previous + 0.125`, one
+/// `Eval1` per pixel — it can only be drawn from the previous frame's output.
+struct Refine {
+    frames: u32,
+}
+
+enum Plan<'a> {
+    Ramp,
+    From(&'a Image),
+}
+
+impl FramePlan for Plan<'_> {
+    fn counters(&self) -> Counters {
+        Counters::default().with("frames", 1)
+    }
+
+    fn emit_rows(&self, rows: Range<u32>, sink: &mut dyn TraceWrite) -> io::Result<Counters> {
+        let mut pixels = 0;
+        for y in rows {
+            match self {
+                Plan::Ramp => sink.write(&Instruction::eval2(
+                    0,
+                    W,
+                    Intensity::grey(f64::from(y) / 8.0),
+                    Intensity::grey(1.0 / 16.0),
+                ))?,
+                Plan::From(previous) => {
+                    for x in 0..W {
+                        let v = previous.data[(y * W + x) as usize];
+                        sink.write(&Instruction::eval1(x, 1, Intensity::grey(0.5 * v + 0.125)))?;
+                        pixels += 1;
+                    }
+                }
+            }
+            sink.write(&Instruction::refresh())?;
+        }
+        Ok(Counters::default().with("pixels", pixels))
+    }
+}
+
+impl Renderer for Refine {
+    fn name(&self) -> &'static str {
+        "refine-test"
+    }
+
+    fn header(&self) -> TraceHeader {
+        TraceHeader::new(W, H, 1).unwrap()
+    }
+
+    fn frames(&self) -> u32 {
+        self.frames
+    }
+
+    fn needs_previous_frame(&self) -> bool {
+        true
+    }
+
+    fn frame<'a>(
+        &'a self,
+        index: u32,
+        previous: Option<&'a Image>,
+    ) -> Result<Box<dyn FramePlan + 'a>, RenderError> {
+        match (index, previous) {
+            (0, None) => Ok(Box::new(Plan::Ramp)),
+            (_, Some(p)) => {
+                assert_eq!((p.width, p.lines), (W as usize, H as usize), "one frame");
+                Ok(Box::new(Plan::From(p)))
+            }
+            (k, None) => Err(RenderError::Usage(format!(
+                "frame {k} without the previous"
+            ))),
+        }
+    }
+
+    fn settings_phrase(&self) -> String {
+        "test".into()
+    }
+}
+
+fn run(r: &dyn Renderer, threads: usize) -> Result<(Image, cwisim_render::Rendered), RenderError> {
+    let h = r.header();
+    let mut sink = ImageSink::new(h.width as usize, 1, 1 << 20);
+    let done = render(
+        r,
+        &ArrayConfig::default(),
+        threads,
+        &mut sink,
+        Taps::default(),
+    )?;
+    Ok((sink.finish()?, done))
+}
+
+#[test]
+fn each_frame_is_drawn_from_the_previous_frames_output() {
+    let r = Refine { frames: 3 };
+    let (image, done) = run(&r, 1).unwrap();
+    assert_eq!(image.lines, 3 * H as usize);
+    let frame = (W * H) as usize;
+    for x in 0..W as usize {
+        for y in 0..H as usize {
+            let first = image.data[y * W as usize + x];
+            assert_eq!(first, y as f64 / 8.0 + x as f64 / 16.0);
+            for k in 1..3 {
+                let prev = image.data[(k - 1) * frame + y * W as usize + x];
+                assert_eq!(
+                    image.data[k * frame + y * W as usize + x],
+                    0.5 * prev + 0.125
+                );
+            }
+        }
+    }
+    assert_eq!(done.counters.get("frames"), Some(3));
+    assert_eq!(done.counters.get("pixels"), Some(2 * u64::from(W * H)));
+    assert_eq!(done.stats.totals.frames, 3);
+    for threads in [2, 3] {
+        let (again, d) = run(&r, threads).unwrap();
+        assert_eq!(again.data, image.data, "{threads} threads");
+        assert_eq!(d.counters, done.counters);
+        assert_eq!(
+            format!("{:?}", d.stats.totals),
+            format!("{:?}", done.stats.totals)
+        );
+    }
+}
+
+#[test]
+fn a_stream_alone_cannot_draw_from_the_previous_frame() {
+    let mut sink: Vec<Instruction> = Vec::new();
+    let e = emit(&Refine { frames: 2 }, &mut sink).unwrap_err();
+    assert!(e.to_string().contains("previous frame's output"), "{e}");
+    assert!(!e.is_internal());
+    // one frame needs nothing before it
+    emit(&Refine { frames: 1 }, &mut sink).unwrap();
+    assert_eq!(sink.len(), 2 * H as usize);
+}
+
+/// A renderer that emits an instruction outside the array.
+struct Broken;
+
+struct BrokenPlan;
+
+impl FramePlan for BrokenPlan {
+    fn emit_rows(&self, rows: Range<u32>, sink: &mut dyn TraceWrite) -> io::Result<Counters> {
+        for _ in rows {
+            sink.write(&Instruction::eval1(W - 1, 2, Intensity::grey(1.0)))?;
+            sink.write(&Instruction::refresh())?;
+        }
+        Ok(Counters::default())
+    }
+}
+
+impl Renderer for Broken {
+    fn name(&self) -> &'static str {
+        "broken"
+    }
+
+    fn header(&self) -> TraceHeader {
+        TraceHeader::new(W, H, 1).unwrap()
+    }
+
+    fn frame<'a>(
+        &'a self,
+        _: u32,
+        _: Option<&'a Image>,
+    ) -> Result<Box<dyn FramePlan + 'a>, RenderError> {
+        Ok(Box::new(BrokenPlan))
+    }
+
+    fn settings_phrase(&self) -> String {
+        "broken".into()
+    }
+}
+
+#[test]
+fn a_renderers_bad_instruction_is_an_internal_fault() {
+    for threads in [1, 2] {
+        let e = run(&Broken, threads).expect_err("refused");
+        assert!(e.is_internal(), "{e}");
+        assert!(e.to_string().contains("the array failed"), "{e}");
+    }
+}
