@@ -3,6 +3,7 @@
 use cwisim_isa::TraceError;
 use cwisim_render::RenderError;
 use cwisim_scene::SceneError;
+use cwisim_study::StudyError;
 use cwisim_xproc::{ImageLimit, MachineError, ReplayError};
 use std::path::PathBuf;
 
@@ -48,6 +49,18 @@ pub enum CliError {
         "internal error (a bug in cwisim; please report it with the command that gave it): {0}"
     )]
     Internal(String),
+}
+
+impl From<StudyError> for CliError {
+    fn from(e: StudyError) -> Self {
+        match e {
+            StudyError::Render(e) => e.into(),
+            StudyError::Machine(e) => CliError::Machine(e),
+            StudyError::ImageLimit(e) => CliError::ImageLimit(e),
+            e @ StudyError::Array(_) => CliError::Internal(e.to_string()),
+            e @ (StudyError::Usage(_) | StudyError::Plot(_)) => CliError::Usage(e.to_string()),
+        }
+    }
 }
 
 impl From<RenderError> for CliError {

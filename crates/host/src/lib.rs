@@ -11,7 +11,8 @@
 //! * [`draw`] — `--renderer`, `--shading`, `--aa`, `--visibility`, `--size`: the flattened
 //!   argument group that reads a SCENE and builds its renderer (`cwisim-render`).
 //! * [`summary`] — what `cwisim render` prints: every stage's figures and wall time.
-//! * [`tradeoff_plot`] — the error-against-cycles chart of `cwisim tradeoff`.
+//! * [`cost_args`] — `--cost-image` and `--cost-npy`, the cost outputs of `run` and
+//!   `render` (the counting and drawing are `cwisim-study`'s).
 //! * [`commands`] — one module per subcommand.
 //! * [`demo`] — the embedded demo trace `cwisim run` replays when given no file.
 //! * [`output`] — NumPy `.npy` and PNG encoding of an [`Image`](cwisim_xproc::Image).
@@ -32,17 +33,15 @@
 
 pub mod cli;
 pub mod commands;
-pub mod cost;
+pub mod cost_args;
 pub mod demo;
 pub mod draw;
 pub mod error;
 pub mod files;
 pub mod output;
-pub mod plot;
 pub mod progress;
 pub mod range;
 pub mod report;
 pub mod summary;
-pub mod tradeoff_plot;
 
 pub use error::CliError;

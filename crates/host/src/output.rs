@@ -113,6 +113,13 @@ pub fn encode_png<W: Write>(out: W, image: &Image) -> io::Result<()> {
         })
 }
 
+/// Writes a drawn plot (an RGB bitmap from `cwisim-study`) as a PNG, all or nothing.
+pub fn write_rgb_png(path: &Path, rgb: &cwisim_study::plot::Rgb) -> Result<(), CliError> {
+    crate::files::write_atomic(path, |w| {
+        rgb.encode_png(w).map_err(|e| CliError::write(path, e))
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

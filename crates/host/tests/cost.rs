@@ -4,7 +4,7 @@
 mod common;
 
 use common::{cwisim, cwisim_ok, fig25, read, scratch, text, trace};
-use cwisim_host::cost::{cost_layout, count_color};
+use cwisim_study::cost::{cost_layout, count_color};
 use serde_json::Value;
 use std::path::Path;
 

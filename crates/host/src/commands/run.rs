@@ -1,7 +1,7 @@
 //! `cwisim run`: replay a trace, write the image and the statistics.
 
 use super::{ImageArgs, MachineArgs};
-use crate::cost::{display_name, CostArgs, CostMap, CostReader};
+use crate::cost_args::{display_name, CostArgs};
 use crate::demo;
 use crate::error::CliError;
 use crate::files::{check_outputs, write_atomic};
@@ -9,6 +9,7 @@ use crate::progress::Progress;
 use crate::report::{timing_name, unrefreshed_warning, write_summary, StatsReport};
 use clap::{Args, ValueEnum};
 use cwisim_isa::{Encoding, FileReader, TraceRead};
+use cwisim_study::cost::{CostMap, CostReader};
 use cwisim_xproc::{replay_streaming, Image, ImageSink, NullSink, Numeric, RunStats, Timing};
 use std::io::Write;
 use std::path::{Path, PathBuf};

@@ -4,7 +4,7 @@
 
 use super::{ImageArgs, MachineArgs};
 use crate::commands::run::TimingArg;
-use crate::cost::{display_name, CostArgs, CostMap};
+use crate::cost_args::{display_name, CostArgs};
 use crate::draw::{DrawArgs, Drawn};
 use crate::error::CliError;
 use crate::files::{check_outputs, same_file, write_atomic};
@@ -14,6 +14,7 @@ use crate::summary::{write_render_summary, StageTimes};
 use clap::Args;
 use cwisim_isa::{Encoding, TraceWrite};
 use cwisim_render::{render, ArrayConfig, Renderer, Taps};
+use cwisim_study::cost::CostMap;
 use cwisim_xproc::{ImageSink, Numeric, Timing};
 use std::io::Write;
 use std::path::{Path, PathBuf};

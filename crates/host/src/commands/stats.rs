@@ -7,15 +7,15 @@
 
 use super::MachineArgs;
 use crate::commands::run::{open_trace, replay_file, TimingArg};
-use crate::cost::{check_extension, display_name};
+use crate::cost_args::{check_extension, display_name};
 use crate::draw::DrawArgs;
 use crate::error::CliError;
 use crate::files::{self, write_atomic};
-use crate::plot::{issue_costs, render_stats_plot, StatsPlot};
 use crate::range::{parse_range, Range};
 use crate::report::{timing_name, unrefreshed_warning, TraceShape};
 use clap::Args;
 use cwisim_isa::{Encoding, Opcode, TraceHeader};
+use cwisim_study::plot::{issue_costs, render_stats_plot, StatsPlot};
 use cwisim_xproc::{LineStats, Machine, NullSink, OpcodeCounts, RunStats, Timing, Totals};
 use serde::Serialize;
 use std::io::Write;
@@ -248,7 +248,7 @@ pub fn run(
             cost: issue_costs(&timeline),
         })
         .map_err(CliError::Usage)?;
-        plot.write_png(path)?;
+        crate::output::write_rgb_png(path, &plot)?;
     }
     if let Some(path) = &args.csv {
         let text = csv(&lines);

@@ -15,10 +15,8 @@
 //! array pixel an integer number of image pixels square, a colour bar with the counts) and
 //! a NumPy array ([`encode_cost_npy`]: `uint32`, shape `(scanlines, width)`).
 
-use crate::error::CliError;
-use crate::files::write_atomic;
+use crate::error::StudyError;
 use crate::plot::{draw_on, err, nice_step, Align, Label, Rgb};
-use clap::Args;
 use cwisim_isa::{
     Instruction, Location, Opcode, OperandKind, TraceError, TraceHeader, TraceRead, TraceWrite,
 };
@@ -26,7 +24,9 @@ use npyz::WriterBuilder;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::io::{self, Write};
-use std::path::{Path, PathBuf};
+
+/// What a cost image says of a stream that output no scanline.
+pub const NO_SCANLINE: &str = "the trace output no scanline (no Refresh); nothing to write";
 
 /// The largest cost map kept: 1 GiB of counts.
 pub const COST_LIMIT_BYTES: u64 = 1 << 30;
@@ -142,10 +142,10 @@ impl CostMap {
     }
 
     /// The map, or why it could not be kept whole.
-    pub fn check(&self) -> Result<(), CliError> {
+    pub fn check(&self) -> Result<(), StudyError> {
         match self.overflow {
             None => Ok(()),
-            Some(line) => Err(CliError::Usage(format!(
+            Some(line) => Err(StudyError::Usage(format!(
                 "the cost map would exceed {} bytes at scanline {line} ({} counts per scanline)",
                 self.limit_bytes, self.width
             ))),
@@ -192,33 +192,6 @@ impl TraceRead for CostReader<'_> {
     }
     fn bytes_read(&self) -> u64 {
         self.inner.bytes_read()
-    }
-}
-
-/// Sends every instruction (and comment) to two writers, `first` first.
-pub struct Tee<'a> {
-    /// Gets each instruction first; its error stops the second from seeing it.
-    pub first: &'a mut dyn TraceWrite,
-    /// Gets each instruction second.
-    pub second: &'a mut dyn TraceWrite,
-}
-
-impl TraceWrite for Tee<'_> {
-    fn write(&mut self, instr: &Instruction) -> io::Result<()> {
-        self.first.write(instr)?;
-        self.second.write(instr)
-    }
-    fn comment(&mut self, text: &str) -> io::Result<()> {
-        self.first.comment(text)?;
-        self.second.comment(text)
-    }
-
-    fn wants_comments(&self) -> bool {
-        self.first.wants_comments() || self.second.wants_comments()
-    }
-    fn finish(&mut self) -> io::Result<()> {
-        self.first.finish()?;
-        self.second.finish()
     }
 }
 
@@ -307,9 +280,9 @@ pub const MAX_SIDE: u32 = 4096;
 pub const MAX_PIXELS: u64 = 1 << 26;
 
 /// The layout of a cost image of `width × lines` array pixels.
-pub fn cost_layout(width: usize, lines: usize) -> Result<CostLayout, CliError> {
+pub fn cost_layout(width: usize, lines: usize) -> Result<CostLayout, StudyError> {
     if width == 0 || lines == 0 {
-        return Err(CliError::Usage(crate::output::NO_SCANLINE.into()));
+        return Err(StudyError::Usage(NO_SCANLINE.into()));
     }
     let big = u64::from(MAX_SIDE);
     let (w, l) = (width as u64, lines as u64);
@@ -321,7 +294,7 @@ pub fn cost_layout(width: usize, lines: usize) -> Result<CostLayout, CliError> {
     let iw = u64::from(LEFT) + mw + u64::from(BAR_GAP + BAR_W + RIGHT);
     let ih = u64::from(TOP) + mh.max(u64::from(MIN_BAR_H)) + u64::from(BOTTOM);
     if iw * ih > MAX_PIXELS || iw > u64::from(i32::MAX as u32) || ih > u64::from(i32::MAX as u32) {
-        return Err(CliError::Usage(format!(
+        return Err(StudyError::Usage(format!(
             "a cost image of {width} × {lines} pixels would be too large ({iw} × {ih}); use --cost-npy"
         )));
     }
@@ -334,7 +307,7 @@ pub fn cost_layout(width: usize, lines: usize) -> Result<CostLayout, CliError> {
 
 /// Draws the cost image: the title (`name`, the largest count), the heat map with pixel
 /// column and scanline ticks, and a colour bar with the counts.
-pub fn render_cost_image(map: &CostMap, name: &str) -> Result<Rgb, CliError> {
+pub fn render_cost_image(map: &CostMap, name: &str) -> Result<Rgb, StudyError> {
     let layout = cost_layout(map.width(), map.lines())?;
     let (iw, ih) = layout.size;
     let s = layout.scale;
@@ -488,7 +461,7 @@ pub fn render_cost_image(map: &CostMap, name: &str) -> Result<Rgb, CliError> {
         );
         Ok(())
     })
-    .map_err(CliError::Usage)?;
+    .map_err(StudyError::Plot)?;
     // The heat map itself, pixel by pixel: exactly `s × s` image pixels per array pixel.
     for line in 0..map.lines() {
         for (x, &c) in map.row(line).iter().enumerate() {
@@ -520,84 +493,6 @@ fn frame_bar(
 
 fn color(c: [u8; 3]) -> RGBColor {
     RGBColor(c[0], c[1], c[2])
-}
-
-/// `--cost-image OUT.png` and `--cost-npy OUT.npy` (`run` and `render`).
-#[derive(Args, Clone, Debug, Default, PartialEq)]
-pub struct CostArgs {
-    /// Write a cost image: per pixel, how many instructions addressed it on its scanline
-    /// (a viridis heat map, black for none, with a colour bar; small arrays scaled up).
-    #[arg(long, value_name = "OUT.png")]
-    pub cost_image: Option<PathBuf>,
-
-    /// Write the cost counts as a NumPy array: uint32, shape (scanlines, width).
-    #[arg(long, value_name = "OUT.npy")]
-    pub cost_npy: Option<PathBuf>,
-}
-
-/// Refuses an output whose extension is not `ext` (case-insensitive).
-pub fn check_extension(flag: &str, path: &Path, ext: &str) -> Result<(), CliError> {
-    let got = path.extension().and_then(|e| e.to_str()).unwrap_or("");
-    if got.eq_ignore_ascii_case(ext) {
-        Ok(())
-    } else {
-        Err(CliError::Usage(format!(
-            "{flag} writes a .{ext} file, but `{}` does not end in .{ext}",
-            path.display()
-        )))
-    }
-}
-
-impl CostArgs {
-    /// Whether any cost output was asked for.
-    pub fn wanted(&self) -> bool {
-        self.cost_image.is_some() || self.cost_npy.is_some()
-    }
-
-    /// The outputs with their flags, for path checks.
-    pub fn outputs(&self) -> [(&'static str, Option<&PathBuf>); 2] {
-        [
-            ("--cost-image", self.cost_image.as_ref()),
-            ("--cost-npy", self.cost_npy.as_ref()),
-        ]
-    }
-
-    /// Refuses, before any work, outputs with the wrong extension.
-    pub fn check(&self) -> Result<(), CliError> {
-        if let Some(p) = &self.cost_image {
-            check_extension("--cost-image", p, "png")?;
-        }
-        if let Some(p) = &self.cost_npy {
-            check_extension("--cost-npy", p, "npy")?;
-        }
-        Ok(())
-    }
-
-    /// Writes the outputs asked for (the image drawn first, so that a map that cannot be
-    /// drawn writes neither). `name` titles the image.
-    pub fn write(&self, map: &CostMap, name: &str) -> Result<(), CliError> {
-        map.check()?;
-        let image = match &self.cost_image {
-            Some(_) => Some(render_cost_image(map, name)?),
-            None => None,
-        };
-        if let (Some(path), Some(image)) = (&self.cost_image, &image) {
-            image.write_png(path)?;
-        }
-        if let Some(path) = &self.cost_npy {
-            write_atomic(path, |w| {
-                encode_cost_npy(w, map).map_err(|e| CliError::write(path, e))
-            })?;
-        }
-        Ok(())
-    }
-}
-
-/// The file name of `path` for titles (never a directory).
-pub fn display_name(path: &Path) -> String {
-    path.file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| path.display().to_string())
 }
 
 #[cfg(test)]

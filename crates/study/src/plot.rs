@@ -11,8 +11,6 @@
 //! [`render_stats_plot`] is the `cwisim stats --plot` chart: one stacked bar of bus
 //! cycles per scanline, split by opcode group, against the line period.
 
-use crate::error::CliError;
-use crate::files::write_atomic;
 use ab_glyph::{point, Font, FontRef, PxScale, ScaleFont};
 use cwisim_isa::{Instruction, Opcode};
 use cwisim_xproc::{LineStats, Timeline};
@@ -21,7 +19,6 @@ use image::{ExtendedColorType, ImageEncoder};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::io::{self, Write};
-use std::path::Path;
 use std::sync::{Once, OnceLock};
 
 /// The font family name under which [`register_fonts`] gives plotters the embedded font.
@@ -210,13 +207,6 @@ impl Rgb {
                 image::ImageError::IoError(e) => e,
                 other => io::Error::other(other.to_string()),
             })
-    }
-
-    /// Writes the PNG to `path`, all or nothing.
-    pub fn write_png(&self, path: &Path) -> Result<(), CliError> {
-        write_atomic(path, |w| {
-            self.encode_png(w).map_err(|e| CliError::write(path, e))
-        })
     }
 }
 

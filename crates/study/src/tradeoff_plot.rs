@@ -7,8 +7,8 @@
 //! sampling; a circle is exact visibility, a square eval0 (or a screen scene). Errors
 //! below [`ERROR_FLOOR`] (an exact image) are drawn on the floor.
 
-use crate::commands::tradeoff::Row;
 use crate::plot::{draw_on, err, Align, Label, Rgb};
+use crate::tradeoff::Row;
 use plotters::prelude::*;
 
 /// The smallest error the chart shows; smaller ones sit on this line.

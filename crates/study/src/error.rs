@@ -1,0 +1,41 @@
+//! How a study fails: bad input or settings (nothing to draw, too large an image, a
+//! renderer's refusal), or a drawing that could not be made.
+
+use cwisim_render::RenderError;
+use cwisim_xproc::{ImageLimit, MachineError};
+
+/// Why a study could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum StudyError {
+    /// Rendering the scene failed (its own error says whether the input or cwisim is at
+    /// fault).
+    #[error(transparent)]
+    Render(#[from] RenderError),
+    /// The machine model or the numeric format is unusable.
+    #[error(transparent)]
+    Machine(#[from] MachineError),
+    /// The image would be larger than the collector allows.
+    #[error(transparent)]
+    ImageLimit(#[from] ImageLimit),
+    /// The input cannot be studied so (nothing to draw, a map too large, a search that
+    /// found nothing).
+    #[error("{0}")]
+    Usage(String),
+    /// The array refused a stream it had already run: a fault of cwisim's own.
+    #[error("the array failed: {0}")]
+    Array(std::io::Error),
+    /// A plot could not be drawn (the message says so).
+    #[error("{0}")]
+    Plot(String),
+}
+
+impl StudyError {
+    /// Whether the fault is cwisim's own, not the input's.
+    pub fn is_internal(&self) -> bool {
+        match self {
+            StudyError::Render(e) => e.is_internal(),
+            StudyError::Array(_) => true,
+            _ => false,
+        }
+    }
+}

@@ -1,0 +1,24 @@
+//! # cwisim-study — studying what the array does, without a command line
+//!
+//! The measuring and drawing behind `cwisim`'s study commands, as a library (no clap, no
+//! files: callers choose where results go):
+//!
+//! * [`cost`] — cost maps: per pixel, how many instructions addressed it on its scanline,
+//!   counted from the stream alone; their heat maps and `.npy` form.
+//! * [`plot`] — PNG plots with an embedded font (the same bytes on every machine), and the
+//!   stats chart: bus cycles per scanline by opcode group against the line period.
+//! * [`tradeoff`] — one scene over a grid of renderers and settings, each measured
+//!   against the exact image, with the Pareto front; [`tradeoff_plot`] draws it.
+//! * [`fit`] — the narrowest fixed-point registers within an error budget.
+//! * [`error`] — [`StudyError`].
+
+#![warn(missing_docs)]
+
+pub mod cost;
+pub mod error;
+pub mod fit;
+pub mod plot;
+pub mod tradeoff;
+pub mod tradeoff_plot;
+
+pub use error::StudyError;

@@ -1,0 +1,460 @@
+//! Speed against accuracy: one scene rendered over a grid of settings (renderer,
+//! visibility, shading, anti-aliasing, the array's numeric format), each measured — what
+//! it costs (instructions, bus cycles, the worst scanline, host time, the renderer's own
+//! counters) against how far it is from the exact image (max, RMS, PSNR) — with the
+//! Pareto front of error against cycles and register bits marked.
+//!
+//! The exact image is the same for every setting: the box filter (exact area-weighted
+//! mean per pixel) of the Gouraud-shaded visible surfaces, computed by
+//! `cwisim_ypipe::exact::scene_box_filtered` — for a world scene on the exact visible
+//! fragments, for a screen scene on its polygons — independently of the renderers and of
+//! the array.
+
+use crate::error::StudyError;
+use cwisim_render::{registry, render, ArrayConfig, PolygonScene, Settings, Size, Source, Taps};
+use cwisim_scene::{Antialias, Shading};
+use cwisim_world::Visibility;
+use cwisim_xproc::{ImageSink, Machine, Numeric, Timing};
+use cwisim_ypipe::exact::scene_box_filtered;
+use serde::Serialize;
+use std::io::Write;
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+/// The numeric formats `tradeoff` tries unless told otherwise.
+pub const DEFAULT_FORMATS: &[&str] = &[
+    "f64",
+    "f32",
+    "fixed:I=10.22,dI=4.28,ddI=1.35",
+    "fixed:I=10.14,dI=4.20,ddI=1.27",
+    "fixed:I=10.10,dI=4.14,ddI=1.20",
+];
+
+/// One setting of the grid, measured.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Row {
+    /// The renderer feeding the array.
+    pub renderer: &'static str,
+    /// `flat` or `gouraud`.
+    pub shading: &'static str,
+    /// `none` or `box`.
+    pub aa: &'static str,
+    /// `exact`, `eval0`, or `-` (screen scenes).
+    pub visibility: &'static str,
+    /// The array's numeric format.
+    pub numeric: String,
+    /// Register bits per processor and channel (I, dI, ddI and the accumulator).
+    pub register_bits: u32,
+    /// Instructions sent, `Refresh` included.
+    pub instructions: u64,
+    /// Bus-busy cycles over the frame: the array's work.
+    pub busy_cycles: u64,
+    /// The busiest scanline's bus cycles as a share of the line period.
+    pub worst_line_share: f64,
+    /// Scanlines not ready by their deadline.
+    pub late_lines: u64,
+    /// Wall time of preparing, scan-converting and executing (median), milliseconds.
+    pub host_ms: f64,
+    /// Largest absolute error of any value against the exact image.
+    pub max_error: f64,
+    /// Root-mean-square error over all values.
+    pub rms_error: f64,
+    /// Peak signal-to-noise ratio for a peak of 1, dB (infinite for an exact image).
+    pub psnr_db: f64,
+    /// Register overflows (wraps or saturations) in the array.
+    pub overflows: u64,
+    /// The renderer's own counters.
+    pub counters: cwisim_render::Counters,
+    /// Pareto-optimal: no other setting is at least as good in bus cycles, register bits
+    /// and RMS error and better in one of them.
+    pub pareto: bool,
+}
+
+/// One setting of the grid.
+#[derive(Clone, Copy, Debug)]
+pub struct Setting {
+    /// The renderer.
+    pub renderer: &'static registry::Entry,
+    /// How it draws.
+    pub settings: Settings,
+    /// The array's registers.
+    pub numeric: Numeric,
+}
+
+/// The settings of the grid, in order: renderer, then visibility (world scenes only),
+/// shading, anti-aliasing and numeric format.
+pub fn grid(
+    renderers: &[&'static registry::Entry],
+    world: bool,
+    size: Option<Size>,
+    formats: &[Numeric],
+) -> Vec<Setting> {
+    let mut out = Vec::new();
+    let visibilities: &[Visibility] = if world {
+        &[Visibility::Exact, Visibility::Eval0]
+    } else {
+        &[Visibility::Exact]
+    };
+    for &renderer in renderers {
+        for &visibility in visibilities {
+            for shading in [Shading::Gouraud, Shading::Flat] {
+                for aa in [Antialias::Box, Antialias::None] {
+                    for numeric in formats {
+                        out.push(Setting {
+                            renderer,
+                            settings: Settings {
+                                shading,
+                                aa,
+                                visibility,
+                                size,
+                                ..Settings::default()
+                            },
+                            numeric: *numeric,
+                        });
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+/// A format as the table shows it: the canonical form without the defaults (an
+/// accumulator like I, saturation).
+pub fn short_numeric(numeric: &Numeric) -> String {
+    let mut s = numeric.to_string();
+    if let Numeric::Fixed(f) = numeric {
+        if f.acc == f.i {
+            s = s.replace(&format!(",acc={}.{}", f.acc.int_bits, f.acc.frac_bits), "");
+        }
+        s = s.replace(",overflow=saturate", "");
+    }
+    s
+}
+
+/// Errors of `image` against `reference`: max, RMS, PSNR (peak 1).
+pub fn errors(image: &[f64], reference: &[f64]) -> (f64, f64, f64) {
+    let mut max = 0.0f64;
+    let mut sum_sq = 0.0;
+    for (a, b) in image.iter().zip(reference) {
+        let e = (a - b).abs();
+        max = max.max(e);
+        sum_sq += e * e;
+    }
+    let mse = sum_sq / reference.len().max(1) as f64;
+    let psnr = if mse == 0.0 {
+        f64::INFINITY
+    } else {
+        -10.0 * mse.log10()
+    };
+    (max, mse.sqrt(), psnr)
+}
+
+/// Register bits per processor and channel: I, dI, ddI and the accumulator.
+pub fn register_bits(numeric: &Numeric) -> u32 {
+    match numeric {
+        Numeric::F64 => 4 * 64,
+        Numeric::F32 => 4 * 32,
+        Numeric::Fixed(f) => [f.i, f.di, f.ddi, f.acc]
+            .iter()
+            .map(|q| q.int_bits + q.frac_bits)
+            .sum(),
+    }
+}
+
+/// Marks the Pareto-optimal rows: no other row has fewer or equal bus cycles, register
+/// bits and RMS error, and fewer of one. (The numeric format changes bits and error but
+/// not cycles; cycles alone would hide the format's trade.)
+pub fn mark_pareto(rows: &mut [Row]) {
+    let points: Vec<(u64, u32, f64)> = rows
+        .iter()
+        .map(|r| (r.busy_cycles, r.register_bits, r.rms_error))
+        .collect();
+    for (k, row) in rows.iter_mut().enumerate() {
+        let (c, b, e) = points[k];
+        row.pareto = !points
+            .iter()
+            .any(|&(c2, b2, e2)| c2 <= c && b2 <= b && e2 <= e && (c2 < c || b2 < b || e2 < e));
+    }
+}
+
+/// The exact image of the scene SCENE names, at `size`: the box-filtered Gouraud image of
+/// its exact visible surfaces, computed by the independent reference.
+pub fn exact_image(scene: Option<&Path>, size: Option<Size>) -> Result<Vec<f64>, StudyError> {
+    let settings = Settings {
+        size,
+        ..Settings::default()
+    };
+    let loaded = Source::resolve(scene)?.load(size)?;
+    let p = PolygonScene::new(loaded, &settings)?;
+    Ok(scene_box_filtered(&p.screen))
+}
+
+/// What measuring one setting gives.
+pub struct Measured {
+    /// The image, `(lines, width, channels)`.
+    pub image: Vec<f64>,
+    /// The renderer's counters.
+    pub counters: cwisim_render::Counters,
+    /// The array's statistics.
+    pub stats: cwisim_xproc::RunStats,
+    /// Wall time of reading, preparing, rendering and executing.
+    pub time: Duration,
+}
+
+/// Renders one setting.
+pub fn measure(
+    scene: Option<&Path>,
+    setting: &Setting,
+    machine: &Machine,
+) -> Result<Measured, StudyError> {
+    let start = Instant::now();
+    let loaded = Source::resolve(scene)?.load(setting.settings.size)?;
+    let renderer = (setting.renderer.build)(loaded, &setting.settings)?;
+    let h = renderer.header();
+    let mut sink = ImageSink::new(
+        h.width as usize,
+        h.channel_count(),
+        ImageSink::DEFAULT_LIMIT_BYTES,
+    );
+    let array = ArrayConfig {
+        machine: machine.clone(),
+        numeric: setting.numeric,
+        timing: Timing::Fast,
+    };
+    let rendered = render(&*renderer, &array, 1, &mut sink, Taps::default())?;
+    let time = start.elapsed();
+    let image = sink.finish()?;
+    Ok(Measured {
+        image: image.data,
+        counters: rendered.counters,
+        stats: rendered.stats,
+        time,
+    })
+}
+
+/// Measures every setting of the grid: `renderers` by name (empty: every registered one).
+#[allow(clippy::too_many_arguments)]
+pub fn tradeoff_rows(
+    scene: Option<&Path>,
+    size: Option<Size>,
+    renderers: &[String],
+    formats: &[Numeric],
+    machine: &Machine,
+    repeat: u32,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<Vec<Row>, StudyError> {
+    let entries: Vec<&'static registry::Entry> = if renderers.is_empty() {
+        registry::REGISTRY.iter().collect()
+    } else {
+        renderers
+            .iter()
+            .map(|n| registry::find(n))
+            .collect::<Result<_, _>>()?
+    };
+    let world = Source::resolve(scene)?.load(size)?.scene.kind() == "world";
+    let reference = exact_image(scene, size)?;
+    let settings = grid(&entries, world, size, formats);
+    let mut rows = Vec::with_capacity(settings.len());
+    for (k, setting) in settings.iter().enumerate() {
+        progress(k, settings.len());
+        let measured = measure(scene, setting, machine)?;
+        let mut times = vec![measured.time];
+        for _ in 1..repeat.max(1) {
+            times.push(measure(scene, setting, machine)?.time);
+        }
+        times.sort();
+        let stats = &measured.stats;
+        let (max_error, rms_error, psnr_db) = errors(&measured.image, &reference);
+        let worst = stats.lines.iter().map(|l| l.busy_cycles).max().unwrap_or(0);
+        let s = &setting.settings;
+        rows.push(Row {
+            renderer: setting.renderer.name,
+            shading: s.shading.name(),
+            aa: s.aa.name(),
+            visibility: if world { s.visibility.name() } else { "-" },
+            numeric: short_numeric(&setting.numeric),
+            register_bits: register_bits(&setting.numeric),
+            instructions: stats.totals.instructions,
+            busy_cycles: stats.lines.iter().map(|l| l.busy_cycles).sum(),
+            worst_line_share: if stats.line_period > 0 {
+                worst as f64 / stats.line_period as f64
+            } else {
+                0.0
+            },
+            late_lines: stats.totals.late_lines,
+            host_ms: times[times.len() / 2].as_secs_f64() * 1e3,
+            max_error,
+            rms_error,
+            psnr_db,
+            overflows: stats.totals.overflows,
+            counters: measured.counters,
+            pareto: false,
+        });
+    }
+    mark_pareto(&mut rows);
+    Ok(rows)
+}
+
+/// The table, as `tradeoff` prints it.
+pub fn write_table(out: &mut dyn Write, rows: &[Row]) -> std::io::Result<()> {
+    writeln!(
+        out,
+        "{:<8} {:<8} {:<4} {:<5} {:<34} {:>4} {:>8} {:>9} {:>6} {:>4} {:>8} {:>9} {:>9} {:>6} {:>5}  pareto",
+        "renderer", "shading", "aa", "vis", "numeric", "bits", "instr", "busy cyc", "worst", "late", "host ms", "max err", "RMS err", "PSNR", "ovfl"
+    )?;
+    for r in rows {
+        writeln!(
+            out,
+            "{:<8} {:<8} {:<4} {:<5} {:<34} {:>4} {:>8} {:>9} {:>5.1}% {:>4} {:>8.2} {:>9.2e} {:>9.2e} {:>6} {:>5}  {}",
+            r.renderer,
+            r.shading,
+            r.aa,
+            r.visibility,
+            r.numeric,
+            r.register_bits,
+            r.instructions,
+            r.busy_cycles,
+            100.0 * r.worst_line_share,
+            r.late_lines,
+            r.host_ms,
+            r.max_error,
+            r.rms_error,
+            if r.psnr_db.is_finite() {
+                format!("{:.1}", r.psnr_db)
+            } else {
+                "inf".into()
+            },
+            r.overflows,
+            if r.pareto { "*" } else { "" }
+        )?;
+    }
+    Ok(())
+}
+
+/// The table as CSV (one header line, one line per setting). After the fixed columns
+/// come the renderers' own counters, one column per name (the union over the rows, in the
+/// order first met), empty where a row's renderer does not count it.
+pub fn csv(rows: &[Row]) -> String {
+    let mut names: Vec<&'static str> = Vec::new();
+    for r in rows {
+        for (name, _) in r.counters.iter() {
+            if !names.contains(&name) {
+                names.push(name);
+            }
+        }
+    }
+    let mut s = String::from(
+        "renderer,shading,aa,visibility,numeric,register_bits,instructions,busy_cycles,worst_line_share,late_lines,host_ms,max_error,rms_error,psnr_db,overflows,pareto",
+    );
+    for name in &names {
+        s.push(',');
+        s.push_str(name);
+    }
+    s.push('\n');
+    for r in rows {
+        s.push_str(&format!(
+            "{},{},{},{},\"{}\",{},{},{},{},{},{},{:e},{:e},{},{},{}",
+            r.renderer,
+            r.shading,
+            r.aa,
+            r.visibility,
+            r.numeric,
+            r.register_bits,
+            r.instructions,
+            r.busy_cycles,
+            r.worst_line_share,
+            r.late_lines,
+            r.host_ms,
+            r.max_error,
+            r.rms_error,
+            r.psnr_db,
+            r.overflows,
+            r.pareto
+        ));
+        for name in &names {
+            s.push(',');
+            if let Some(v) = r.counters.get(name) {
+                s.push_str(&v.to_string());
+            }
+        }
+        s.push('\n');
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(busy: u64, rms: f64) -> Row {
+        Row {
+            renderer: "r",
+            shading: "gouraud",
+            aa: "box",
+            visibility: "exact",
+            numeric: "f64".into(),
+            register_bits: 256,
+            instructions: 0,
+            busy_cycles: busy,
+            worst_line_share: 0.0,
+            late_lines: 0,
+            host_ms: 0.0,
+            max_error: 0.0,
+            rms_error: rms,
+            psnr_db: 0.0,
+            overflows: 0,
+            counters: Default::default(),
+            pareto: false,
+        }
+    }
+
+    #[test]
+    fn the_pareto_front_keeps_only_undominated_points() {
+        let mut rows = vec![
+            row(100, 0.5),
+            row(200, 0.1),
+            row(150, 0.6), // dominated by (100, 0.5)
+            row(300, 0.1), // dominated by (200, 0.1)
+            row(400, 0.0),
+        ];
+        mark_pareto(&mut rows);
+        let front: Vec<bool> = rows.iter().map(|r| r.pareto).collect();
+        assert_eq!(front, [true, true, false, false, true]);
+        // fewer register bits at the same cycles and error dominates; more bits with a
+        // smaller error does not
+        let mut rows = vec![row(100, 0.5), row(100, 0.5), row(100, 0.4)];
+        rows[1].register_bits = 80;
+        rows[2].register_bits = 128;
+        mark_pareto(&mut rows);
+        let front: Vec<bool> = rows.iter().map(|r| r.pareto).collect();
+        assert_eq!(front, [false, true, true]);
+    }
+
+    #[test]
+    fn short_formats_parse_back() {
+        for f in [
+            "f64",
+            "f32",
+            "fixed:I=10.22,dI=4.28,ddI=1.35,acc=10.22,overflow=saturate",
+            "fixed:I=3.4,dI=2.8,ddI=1.9,acc=6.4,overflow=wrap",
+        ] {
+            let n: Numeric = f.parse().unwrap();
+            let back: Numeric = short_numeric(&n).parse().unwrap();
+            assert_eq!(back, n, "{f}");
+        }
+        assert_eq!(
+            short_numeric(&"fixed:I=10.22,dI=4.28,ddI=1.35".parse().unwrap()),
+            "fixed:I=10.22,dI=4.28,ddI=1.35"
+        );
+    }
+
+    #[test]
+    fn errors_and_psnr() {
+        let (max, rms, psnr) = errors(&[0.0, 0.5, 1.0, 1.0], &[0.0, 0.5, 1.0, 0.9]);
+        assert!((max - 0.1).abs() < 1e-12);
+        assert!((rms - 0.05).abs() < 1e-12);
+        assert!((psnr - 26.0206).abs() < 1e-3, "{psnr}");
+        assert_eq!(errors(&[1.0], &[1.0]).2, f64::INFINITY);
+    }
+}
