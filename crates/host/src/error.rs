@@ -55,6 +55,7 @@ impl From<StudyError> for CliError {
     fn from(e: StudyError) -> Self {
         match e {
             StudyError::Render(e) => e.into(),
+            StudyError::Trace(e) => CliError::Trace(e),
             StudyError::Machine(e) => CliError::Machine(e),
             StudyError::ImageLimit(e) => CliError::ImageLimit(e),
             e @ StudyError::Array(_) => CliError::Internal(e.to_string()),

@@ -1,8 +1,9 @@
 //! How a study fails: bad input or settings (nothing to draw, too large an image, a
 //! renderer's refusal), or a drawing that could not be made.
 
+use cwisim_isa::TraceError;
 use cwisim_render::RenderError;
-use cwisim_xproc::{ImageLimit, MachineError};
+use cwisim_xproc::{ImageLimit, MachineError, ReplayError};
 
 /// Why a study could not be made.
 #[derive(Debug, thiserror::Error)]
@@ -11,6 +12,9 @@ pub enum StudyError {
     /// fault).
     #[error(transparent)]
     Render(#[from] RenderError),
+    /// The trace cannot be read (its message is located).
+    #[error(transparent)]
+    Trace(#[from] TraceError),
     /// The machine model or the numeric format is unusable.
     #[error(transparent)]
     Machine(#[from] MachineError),
@@ -27,6 +31,15 @@ pub enum StudyError {
     /// A plot could not be drawn (the message says so).
     #[error("{0}")]
     Plot(String),
+}
+
+impl From<ReplayError> for StudyError {
+    fn from(e: ReplayError) -> Self {
+        match e {
+            ReplayError::Trace(e) => StudyError::Trace(e),
+            ReplayError::Machine(e) => StudyError::Machine(e),
+        }
+    }
 }
 
 impl StudyError {

@@ -10,6 +10,10 @@
 //! * [`tradeoff`] — one scene over a grid of renderers and settings, each measured
 //!   against the exact image, with the Pareto front; [`tradeoff_plot`] draws it.
 //! * [`fit`] — the narrowest fixed-point registers within an error budget.
+//! * [`history`] — one pixel's history: every instruction that reached it on a scanline,
+//!   registers before and after; [`vcd`] — a scanline's per-cycle waveform as a Value
+//!   Change Dump; both from the cycle-stepped engine's probe. [`until`] ends a trace
+//!   after a given scanline.
 //! * [`error`] — [`StudyError`].
 
 #![warn(missing_docs)]
@@ -17,8 +21,11 @@
 pub mod cost;
 pub mod error;
 pub mod fit;
+pub mod history;
 pub mod plot;
 pub mod tradeoff;
 pub mod tradeoff_plot;
+pub mod until;
+pub mod vcd;
 
 pub use error::StudyError;

@@ -4,13 +4,13 @@
 //! The output is itself a valid `.cwt` trace (annotations are comments), so
 //! `cwisim dump t.cwb > t.cwt` disassembles.
 
-use super::until::UntilLine;
 use super::MachineArgs;
 use crate::error::CliError;
 use crate::range::{parse_range, Range};
 use clap::Args;
 use cwisim_isa::text::{format_header, format_instruction};
 use cwisim_isa::{FileReader, Instruction, TraceRead};
+use cwisim_study::until::UntilLine;
 use cwisim_xproc::{replay_probed, NullSink, Probe};
 use std::collections::VecDeque;
 use std::io::Write;

@@ -5,13 +5,12 @@
 //! It replays the trace on the cycle-stepped engine (the reference model) up to the
 //! scanline asked for, watching one processor.
 
-use super::until::UntilLine;
 use super::MachineArgs;
 use crate::error::CliError;
 use clap::Args;
-use cwisim_isa::text::{format_instruction, format_value};
-use cwisim_isa::{FileReader, Instruction, Opcode, TraceRead};
-use cwisim_xproc::{replay_probed, NullSink, Probe, ProcessorState};
+use cwisim_isa::text::format_instruction;
+use cwisim_isa::{FileReader, Opcode, TraceRead};
+use cwisim_study::history::{pixel_history, state, values};
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -35,92 +34,6 @@ pub struct HistoryArgs {
     pub machine: MachineArgs,
 }
 
-/// One visit of a token to the watched processor.
-struct Visit {
-    cycle: u64,
-    index: u64,
-    instr: Instruction,
-    addressed: bool,
-    before: ProcessorState,
-    after: ProcessorState,
-}
-
-struct Watch {
-    x: usize,
-    y: u64,
-    visits: Vec<Visit>,
-}
-
-impl Probe for Watch {
-    fn watches(&self, p: usize) -> bool {
-        p == self.x
-    }
-
-    fn visit(
-        &mut self,
-        cycle: u64,
-        _p: usize,
-        index: u64,
-        line: u64,
-        instr: &Instruction,
-        addressed: bool,
-        before: &ProcessorState,
-        after: &ProcessorState,
-    ) {
-        if line == self.y {
-            self.visits.push(Visit {
-                cycle,
-                index,
-                instr: *instr,
-                addressed,
-                before: before.clone(),
-                after: after.clone(),
-            });
-        }
-    }
-}
-
-fn values(v: &[f64]) -> String {
-    v.iter()
-        .map(|x| format_value(*x))
-        .collect::<Vec<_>>()
-        .join(",")
-}
-
-/// The registers and flags, one line: `acc=… I=… dI=… ddI=… [locked masked neg]`;
-/// a preload register shows `-` when it holds no unconsumed value.
-fn state(s: &ProcessorState) -> String {
-    let reg = |k: usize| {
-        if s.has[k] {
-            values(&s.reg[k])
-        } else {
-            "-".to_string()
-        }
-    };
-    let mut flags = Vec::new();
-    if s.locked {
-        flags.push("locked");
-    }
-    if s.masked {
-        flags.push("masked");
-    }
-    if s.negative_enabled {
-        flags.push("neg");
-    }
-    format!(
-        "acc={} I={} dI={} ddI={} flags={}",
-        values(&s.acc),
-        reg(0),
-        reg(1),
-        reg(2),
-        if flags.is_empty() {
-            "-".to_string()
-        } else {
-            flags.join(",")
-        }
-    )
-}
-
 /// Runs `cwisim history`.
 pub fn run(args: &HistoryArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
     let machine = args.machine.load()?;
@@ -134,22 +47,17 @@ pub fn run(args: &HistoryArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
             header.width - 1
         )));
     }
-    let mut watch = Watch {
-        x: args.x as usize,
-        y: args.y,
-        visits: Vec::new(),
+    let visits = match pixel_history(&mut file, &machine, args.x as usize, args.y)? {
+        Ok(visits) => visits,
+        Err(lines) => {
+            return Err(CliError::Usage(format!(
+                "--y {}: {} outputs only {lines} scanline(s) (0..={})",
+                args.y,
+                args.trace.display(),
+                lines.saturating_sub(1)
+            )))
+        }
     };
-    let mut reader = UntilLine::new(&mut file, Some(args.y));
-    replay_probed::<f64>(&mut reader, &machine, &mut watch, &mut NullSink)?;
-    let lines = reader.lines_read();
-    if lines <= args.y {
-        return Err(CliError::Usage(format!(
-            "--y {}: {} outputs only {lines} scanline(s) (0..={})",
-            args.y,
-            args.trace.display(),
-            lines.saturating_sub(1)
-        )));
-    }
     let w = |out: &mut dyn Write, s: String| writeln!(out, "{s}").map_err(CliError::Stdout);
     w(
         stdout,
@@ -162,27 +70,12 @@ arrived, and the registers before → after it acted",
         ),
     )?;
     let mut shown = 0;
-    for v in &watch.visits {
-        let changed = v.before != v.after;
-        if !(args.all || v.addressed || changed) {
+    for v in &visits {
+        if !(args.all || v.addressed || v.changed()) {
             continue;
         }
         shown += 1;
-        let how = if !v.addressed {
-            "  (passes through)"
-        } else if !changed
-            && v.before.locked
-            && matches!(
-                v.instr.op,
-                Opcode::Eval0 | Opcode::Eval1 | Opcode::Eval2 | Opcode::Eval3
-            )
-        {
-            "  (suppressed: locked by Eval0)"
-        } else if v.before.masked && !v.after.masked && v.before.acc == v.after.acc {
-            "  (suppressed: masked by Dis)"
-        } else {
-            ""
-        };
+        let how = v.note().map_or_else(String::new, |n| format!("  ({n})"));
         w(
             stdout,
             format!(
@@ -195,15 +88,11 @@ arrived, and the registers before → after it acted",
         w(stdout, format!("    before  {}", state(&v.before)))?;
         w(stdout, format!("    after   {}", state(&v.after)))?;
     }
-    let refresh = watch
-        .visits
-        .iter()
-        .rev()
-        .find(|v| v.instr.op == Opcode::Refresh);
+    let refresh = visits.iter().rev().find(|v| v.instr.op == Opcode::Refresh);
     if let Some(r) = refresh {
         w(stdout, format!("shifted out: {}", values(&r.before.acc)))?;
     }
-    let hidden = watch.visits.len() - shown;
+    let hidden = visits.len() - shown;
     if hidden > 0 {
         w(
             stdout,

@@ -12,7 +12,6 @@ pub mod scene;
 pub mod scenes;
 pub mod stats;
 pub mod tradeoff;
-pub mod until;
 pub mod vcd;
 
 use crate::error::CliError;

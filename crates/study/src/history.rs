@@ -1,0 +1,153 @@
+//! One pixel's history: every instruction that reached processor `x` on scanline `y`,
+//! with the registers before and after it acted (`cwisim history`), computed by the
+//! cycle-stepped engine through a [`Probe`].
+
+use crate::error::StudyError;
+use crate::until::UntilLine;
+use cwisim_isa::text::format_value;
+use cwisim_isa::{Instruction, Opcode, TraceRead};
+use cwisim_xproc::{replay_probed, Machine, NullSink, Probe, ProcessorState};
+
+/// Replays `trace` up to scanline `y` and returns every visit of a token to processor
+/// `x` on it. `Ok(Err(n))`: the trace outputs only `n` scanlines.
+pub fn pixel_history(
+    trace: &mut dyn TraceRead,
+    machine: &Machine,
+    x: usize,
+    y: u64,
+) -> Result<Result<Vec<Visit>, u64>, StudyError> {
+    let mut watch = Watch {
+        x,
+        y,
+        visits: Vec::new(),
+    };
+    let mut reader = UntilLine::new(trace, Some(y));
+    replay_probed::<f64>(&mut reader, machine, &mut watch, &mut NullSink)?;
+    let lines = reader.lines_read();
+    if lines <= y {
+        return Ok(Err(lines));
+    }
+    Ok(Ok(watch.visits))
+}
+
+/// One visit of a token to the watched processor.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Visit {
+    /// The cycle the token arrived.
+    pub cycle: u64,
+    /// The instruction's index in the trace, from 0.
+    pub index: u64,
+    /// The instruction.
+    pub instr: Instruction,
+    /// Whether it addressed this processor (else its token only passed through).
+    pub addressed: bool,
+    /// The processor's registers and flags before it acted.
+    pub before: ProcessorState,
+    /// And after.
+    pub after: ProcessorState,
+}
+
+impl Visit {
+    /// Whether the processor changed.
+    pub fn changed(&self) -> bool {
+        self.before != self.after
+    }
+
+    /// What the visit amounted to, when not a plain action: `"passes through"`,
+    /// `"suppressed: locked by Eval0"`, `"suppressed: masked by Dis"`.
+    pub fn note(&self) -> Option<&'static str> {
+        let changed = self.changed();
+        if !self.addressed {
+            Some("passes through")
+        } else if !changed
+            && self.before.locked
+            && matches!(
+                self.instr.op,
+                Opcode::Eval0 | Opcode::Eval1 | Opcode::Eval2 | Opcode::Eval3
+            )
+        {
+            Some("suppressed: locked by Eval0")
+        } else if self.before.masked && !self.after.masked && self.before.acc == self.after.acc {
+            Some("suppressed: masked by Dis")
+        } else {
+            None
+        }
+    }
+}
+
+struct Watch {
+    x: usize,
+    y: u64,
+    visits: Vec<Visit>,
+}
+
+impl Probe for Watch {
+    fn watches(&self, p: usize) -> bool {
+        p == self.x
+    }
+
+    fn visit(
+        &mut self,
+        cycle: u64,
+        _p: usize,
+        index: u64,
+        line: u64,
+        instr: &Instruction,
+        addressed: bool,
+        before: &ProcessorState,
+        after: &ProcessorState,
+    ) {
+        if line == self.y {
+            self.visits.push(Visit {
+                cycle,
+                index,
+                instr: *instr,
+                addressed,
+                before: before.clone(),
+                after: after.clone(),
+            });
+        }
+    }
+}
+
+/// Values as the text trace writes them, comma-separated.
+pub fn values(v: &[f64]) -> String {
+    v.iter()
+        .map(|x| format_value(*x))
+        .collect::<Vec<_>>()
+        .join(",")
+}
+
+/// The registers and flags, one line: `acc=… I=… dI=… ddI=… [locked masked neg]`;
+/// a preload register shows `-` when it holds no unconsumed value.
+pub fn state(s: &ProcessorState) -> String {
+    let reg = |k: usize| {
+        if s.has[k] {
+            values(&s.reg[k])
+        } else {
+            "-".to_string()
+        }
+    };
+    let mut flags = Vec::new();
+    if s.locked {
+        flags.push("locked");
+    }
+    if s.masked {
+        flags.push("masked");
+    }
+    if s.negative_enabled {
+        flags.push("neg");
+    }
+    format!(
+        "acc={} I={} dI={} ddI={} flags={}",
+        values(&s.acc),
+        reg(0),
+        reg(1),
+        reg(2),
+        if flags.is_empty() {
+            "-".to_string()
+        } else {
+            flags.join(",")
+        }
+    )
+}
