@@ -164,18 +164,8 @@ fn synthetic() -> Vec<Case> {
 
 fn scene_case(name: &'static str, scene: ScreenScene) -> Case {
     let h = header(&scene);
-    let mut instructions = Vec::new();
-    struct Collect<'a>(&'a mut Vec<Instruction>);
-    impl TraceWrite for Collect<'_> {
-        fn write(&mut self, i: &Instruction) -> std::io::Result<()> {
-            self.0.push(*i);
-            Ok(())
-        }
-        fn finish(&mut self) -> std::io::Result<()> {
-            Ok(())
-        }
-    }
-    emit(&scene, &Options::default(), &mut Collect(&mut instructions)).expect("emit");
+    let mut instructions: Vec<Instruction> = Vec::new();
+    emit(&scene, &Options::default(), &mut instructions).expect("emit");
     Case {
         name,
         header: h,

@@ -192,6 +192,38 @@ impl Instruction {
     pub fn nop() -> Self {
         Self::without_operands(Opcode::Nop)
     }
+    /// An instruction of `op` taking from the operands offered what its signature uses:
+    /// `x` for an `X` operand, `count` for a `Count`, `period` for a `Period`, and for
+    /// each intensity operand in slot `s` (I, dI, ddI) the `channels` values
+    /// `values[s × channels..(s + 1) × channels]`. Nothing is checked: generators of test
+    /// streams and fuzzers keep what they offer in range, or check the result
+    /// ([`Self::check`]).
+    ///
+    /// # Panics
+    /// When `op` carries intensities and `values` holds fewer than `3 × channels`.
+    pub fn from_operands(
+        op: Opcode,
+        x: u32,
+        count: u32,
+        period: u32,
+        values: &[f64],
+        channels: usize,
+    ) -> Self {
+        let mut i = Self::without_operands(op);
+        for kind in op.operands() {
+            match kind {
+                OperandKind::X => i.x = x,
+                OperandKind::Count => i.dx = count,
+                OperandKind::Period => i.dx = period,
+                _ => {
+                    let s = kind.value_slot().expect("an intensity operand");
+                    i.values[s] = Intensity::new(&values[s * channels..(s + 1) * channels]);
+                }
+            }
+        }
+        i
+    }
+
     fn without_operands(op: Opcode) -> Self {
         Self::with(op, 0, 0, Intensity::NONE, Intensity::NONE, Intensity::NONE)
     }

@@ -1,7 +1,7 @@
 //! Lossless round trips between the three encodings, on random traces (proptest).
 
 use cwisim_isa::io::read_all;
-use cwisim_isa::{Encoding, Instruction, Intensity, Opcode, OperandKind, TraceHeader};
+use cwisim_isa::{Encoding, Instruction, Opcode, TraceHeader};
 use proptest::prelude::*;
 
 fn any_value() -> impl Strategy<Value = f64> {
@@ -31,26 +31,15 @@ fn trace() -> impl Strategy<Value = (TraceHeader, Vec<Instruction>)> {
                 proptest::collection::vec(any_value(), 3 * usize::from(channels)),
             )
                 .prop_map(move |(k, x, n, vals)| {
-                    let op = Opcode::ALL[k];
                     let c = usize::from(channels);
-                    let mut i = Instruction {
-                        op,
-                        x: 0,
-                        dx: 0,
-                        values: [Intensity::NONE; 3],
-                    };
-                    for kind in op.operands() {
-                        match kind {
-                            OperandKind::X => i.x = x,
-                            OperandKind::Count => i.dx = n.min(width - x),
-                            OperandKind::Period => i.dx = n.max(1),
-                            _ => {
-                                let s = kind.value_slot().unwrap();
-                                i.values[s] = Intensity::new(&vals[s * c..s * c + c]);
-                            }
-                        }
-                    }
-                    i
+                    Instruction::from_operands(
+                        Opcode::ALL[k],
+                        x,
+                        n.min(width - x),
+                        n.max(1),
+                        &vals,
+                        c,
+                    )
                 });
             (Just(header), proptest::collection::vec(instr, 0..60))
         })

@@ -14,34 +14,7 @@ use cwisim_xproc::ImageSink;
 use renderer::{Rect, Rectangles};
 
 fn example() -> Rectangles {
-    Rectangles::new(
-        16,
-        10,
-        vec![
-            Rect {
-                x0: 2,
-                y0: 1,
-                x1: 12,
-                y1: 6,
-                value: 0.5,
-            },
-            Rect {
-                x0: 6,
-                y0: 3,
-                x1: 15,
-                y1: 9,
-                value: 0.25,
-            },
-            Rect {
-                x0: 0,
-                y0: 7,
-                x1: 4,
-                y1: 10,
-                value: 1.0,
-            },
-        ],
-    )
-    .expect("valid rectangles")
+    renderer::three_rectangles()
 }
 
 /// The emitted stream, as the text trace a person reviews.

@@ -16,7 +16,7 @@
 //! a NumPy array ([`encode_cost_npy`]: `uint32`, shape `(scanlines, width)`).
 
 use crate::error::StudyError;
-use crate::plot::{draw_on, err, nice_step, Align, Label, Rgb};
+use crate::plot::{draw_on, err, nice_step, rgb, Align, Label, Rgb};
 use cwisim_isa::{
     Instruction, Location, Opcode, OperandKind, TraceError, TraceHeader, TraceRead, TraceWrite,
 };
@@ -397,7 +397,7 @@ pub fn render_cost_image(map: &CostMap, name: &str) -> Result<Rgb, StudyError> {
                 let (lo, hi) = (edge(k + 1), edge(k) - 1);
                 root.draw(&Rectangle::new(
                     [(bx, lo), (bx + bw - 1, hi)],
-                    color(count_color(k as u32, max)).filled(),
+                    rgb(count_color(k as u32, max)).filled(),
                 ))
                 .map_err(err)?;
                 if k % every == 0 || k == bands - 1 {
@@ -410,7 +410,7 @@ pub fn render_cost_image(map: &CostMap, name: &str) -> Result<Rgb, StudyError> {
             let grad_h = grad_bottom - top;
             root.draw(&Rectangle::new(
                 [(bx, bottom - zero_h), (bx + bw - 1, bottom - 1)],
-                color(ZERO_COLOR).filled(),
+                rgb(ZERO_COLOR).filled(),
             ))
             .map_err(err)?;
             root.draw(&Rectangle::new(
@@ -424,7 +424,7 @@ pub fn render_cost_image(map: &CostMap, name: &str) -> Result<Rgb, StudyError> {
                 let py = grad_bottom - 1 - r;
                 root.draw(&PathElement::new(
                     vec![(bx, py), (bx + bw - 1, py)],
-                    color(viridis(t)),
+                    rgb(viridis(t)),
                 ))
                 .map_err(err)?;
             }
@@ -489,10 +489,6 @@ fn frame_bar(
         BLACK.stroke_width(1),
     ))
     .map_err(err)
-}
-
-fn color(c: [u8; 3]) -> RGBColor {
-    RGBColor(c[0], c[1], c[2])
 }
 
 #[cfg(test)]

@@ -339,7 +339,8 @@ pub const GROUPS: [Group; 8] = [
 /// The red of overrun markers (no bar segment uses it).
 pub const OVERRUN: [u8; 3] = [214, 39, 40];
 
-fn rgb(c: [u8; 3]) -> RGBColor {
+/// A palette entry as plotters' colour.
+pub fn rgb(c: [u8; 3]) -> RGBColor {
     RGBColor(c[0], c[1], c[2])
 }
 

@@ -7,7 +7,7 @@
 //! sampling; a circle is exact visibility, a square eval0 (or a screen scene). Errors
 //! below [`ERROR_FLOOR`] (an exact image) are drawn on the floor.
 
-use crate::plot::{draw_on, err, Align, Label, Rgb};
+use crate::plot::{draw_on, err, rgb, Align, Label, Rgb};
 use crate::tradeoff::Row;
 use plotters::prelude::*;
 
@@ -27,10 +27,6 @@ const PALETTE: [[u8; 3]; 8] = [
     [227, 119, 194],
     [127, 127, 127],
 ];
-
-fn rgb(c: [u8; 3]) -> RGBColor {
-    RGBColor(c[0], c[1], c[2])
-}
 
 /// Draws the chart of `rows` for the scene called `name`.
 pub fn render_tradeoff_plot(rows: &[Row], name: &str) -> Result<Rgb, String> {

@@ -5,7 +5,7 @@
 
 mod common;
 
-use cwisim_isa::{Instruction, Intensity, Opcode, OperandKind, TraceHeader};
+use cwisim_isa::{Instruction, Opcode, TraceHeader};
 use cwisim_xproc::{run, run_numeric, Machine, Numeric, Timing};
 use proptest::prelude::*;
 
@@ -36,25 +36,8 @@ fn instruction(width: u32, channels: usize) -> impl Strategy<Value = Instruction
         proptest::collection::vec(value(), 3 * channels),
     )
         .prop_map(move |(k, x, n, vals)| {
-            let op = Opcode::ALL[k];
-            let mut i = Instruction {
-                op,
-                x: 0,
-                dx: 0,
-                values: [Intensity::NONE; 3],
-            };
-            for kind in op.operands() {
-                match kind {
-                    OperandKind::X => i.x = x,
-                    OperandKind::Count => i.dx = n.min(width - x),
-                    OperandKind::Period => i.dx = n.clamp(1, 5),
-                    _ => {
-                        let s = kind.value_slot().unwrap();
-                        i.values[s] = Intensity::new(&vals[s * channels..(s + 1) * channels]);
-                    }
-                }
-            }
-            i
+            let (count, period) = (n.min(width - x), n.clamp(1, 5));
+            Instruction::from_operands(Opcode::ALL[k], x, count, period, &vals, channels)
         })
 }
 

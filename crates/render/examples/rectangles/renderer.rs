@@ -54,6 +54,27 @@ impl Rectangles {
     }
 }
 
+/// The example's scene: three overlapping rectangles in 16 × 10 pixels.
+pub fn three_rectangles() -> Rectangles {
+    let rect = |x0, y0, x1, y1, value| Rect {
+        x0,
+        y0,
+        x1,
+        y1,
+        value,
+    };
+    Rectangles::new(
+        16,
+        10,
+        vec![
+            rect(2, 1, 12, 6, 0.5),
+            rect(6, 3, 15, 9, 0.25),
+            rect(0, 7, 4, 10, 1.0),
+        ],
+    )
+    .expect("valid rectangles")
+}
+
 /// A frame needs no preparation: the plan is the renderer itself.
 struct Plan<'a>(&'a Rectangles);
 
