@@ -56,12 +56,7 @@ fn options(visibility: Visibility) -> Options {
 fn prepare(w: &WorldScene, visibility: Visibility) -> ScreenScene {
     let (tris, _) = project(w, Shading::Gouraud).expect("projects");
     let (polygons, _) = resolve(&tris, w.channels(), visibility);
-    ScreenScene {
-        width: w.width(),
-        height: w.height(),
-        channels: w.channels() as u8,
-        polygons,
-    }
+    w.screen(polygons)
 }
 
 /// The array and its timing on a screen scene, into an image (or nowhere), through the

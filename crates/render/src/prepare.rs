@@ -64,12 +64,7 @@ impl PolygonScene {
                 let (polygons, vis) =
                     cwisim_world::resolve(&tris, w.channels(), settings.visibility);
                 prepared.visibility_time = start.elapsed();
-                prepared.screen = ScreenScene {
-                    width: w.width(),
-                    height: w.height(),
-                    channels: w.channels() as u8,
-                    polygons,
-                };
+                prepared.screen = w.screen(polygons);
                 prepared.project = Some(project);
                 prepared.visibility = vis;
                 prepared.visibility_mode = Some(settings.visibility);

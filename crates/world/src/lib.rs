@@ -216,12 +216,7 @@ pub fn to_screen(
     let (tris, project) = project::project(scene, shading)?;
     let (polygons, visibility) = resolve(&tris, scene.channels(), visibility);
     Ok(Prepared {
-        screen: ScreenScene {
-            width: scene.width(),
-            height: scene.height(),
-            channels: scene.channels() as u8,
-            polygons,
-        },
+        screen: scene.screen(polygons),
         project,
         visibility,
     })

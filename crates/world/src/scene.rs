@@ -271,6 +271,17 @@ impl WorldScene {
         self.spec.channels as usize
     }
 
+    /// The screen scene of `polygons` (what visibility made of this scene), at this
+    /// scene's image size and channels.
+    pub fn screen(&self, polygons: Vec<cwisim_scene::Polygon>) -> cwisim_scene::ScreenScene {
+        cwisim_scene::ScreenScene {
+            width: self.width(),
+            height: self.height(),
+            channels: self.channels() as u8,
+            polygons,
+        }
+    }
+
     /// The same scene with another image size (the camera keeps its vertical field of
     /// view; the horizontal one follows the aspect ratio).
     pub fn with_size(mut self, width: u32, height: u32) -> Result<Self, SceneError> {
