@@ -78,7 +78,8 @@ per face for flat) with back faces culled, and its hidden surfaces removed: \
 every pixel holds the exact box-filtered coverage); --visibility eval0 sends whole \
 triangles front to back and lets the array's Eval0 claim the pixels a nearer triangle fully \
 covers (the hardware's way; edge pixels are approximate, see docs/VISIBILITY.md). The \
-Y-processor splits the polygons into trapezia and emits the scanline instructions \
+renderer (--renderer NAME; `cwisim renderers` lists them; the default, vanrij, is van Rij's \
+Y-processor) splits the polygons into trapezia and emits the scanline instructions \
 (box-filter coverage with van Rij's twelve DO_FILL cases, or point sampling; flat or \
 Gouraud), and the X-processor array executes them on the machine model.\n\n\
 The summary gives the polygons and trapezia, the instructions by opcode, the cycles per \

@@ -27,8 +27,8 @@ pub enum RenderError {
         /// The registered names.
         known: Vec<&'static str>,
     },
-    /// The renderer emitted an instruction the array refuses, or failed while emitting:
-    /// a fault of the renderer.
+    /// The renderer failed while emitting (its frame plan returned an error): a fault of
+    /// the renderer. An instruction the array refuses is an [`RenderError::Array`].
     #[error("the renderer `{renderer}` failed: {source}")]
     Renderer {
         /// The renderer.
@@ -36,7 +36,8 @@ pub enum RenderError {
         /// What went wrong.
         source: std::io::Error,
     },
-    /// Feeding the array (or a tap beside it, such as a cost map) failed.
+    /// The array refused an instruction (one the renderer emitted outside the array, say)
+    /// or failed, or a tap beside it (a cost map) did.
     #[error("the array failed: {0}")]
     Array(std::io::Error),
 }

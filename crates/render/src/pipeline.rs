@@ -31,7 +31,9 @@ pub struct ArrayConfig {
 /// What watches the stream besides the array.
 #[derive(Default)]
 pub struct Taps<'a> {
-    /// Gets every instruction (and comment) as the array does: a trace file, a cost map.
+    /// Gets every instruction as the array does: a cost map, a counter. Comments reach it
+    /// only on one thread (bands emitted on threads keep none); a trace file with the
+    /// renderer's comments is written by [`emit`].
     pub also: Option<&'a mut dyn TraceWrite>,
     /// Told the number of scanlines done after each one.
     pub progress: Option<&'a mut dyn FnMut(u64)>,
@@ -116,7 +118,7 @@ pub fn render(
 pub fn emit(renderer: &dyn Renderer, sink: &mut dyn TraceWrite) -> Result<Counters, RenderError> {
     if renderer.needs_previous_frame() && renderer.frames() > 1 {
         return Err(RenderError::Usage(format!(
-            "the renderer `{}` draws each frame from the previous frame's output: render it through the array (`cwisim render --trace`)",
+            "the renderer `{}` draws each frame from the previous frame's output, so its stream exists only while it runs through the array (`cwisim render`); it cannot be emitted alone",
             renderer.name()
         )));
     }

@@ -60,6 +60,13 @@ mod tests {
         names.sort();
         names.dedup();
         assert_eq!(names.len(), REGISTRY.len());
+        // every entry builds a renderer that answers to the entry's name
+        let source = crate::Source::resolve(Some("fig25".as_ref())).unwrap();
+        for entry in REGISTRY {
+            let settings = crate::Settings::default();
+            let renderer = (entry.build)(source.load(None).unwrap(), &settings).unwrap();
+            assert_eq!(renderer.name(), entry.name);
+        }
         let e = find("nishita-typo").unwrap_err();
         assert_eq!(
             e.to_string(),

@@ -133,7 +133,9 @@ impl Counters {
     }
 }
 
-/// A JSON object, name → value, in order.
+/// A JSON object, name → value. (JSON objects are unordered: `serde_json` documents
+/// come out with their keys sorted; the summary and `tradeoff`'s CSV keep the renderer's
+/// order.)
 impl serde::Serialize for Counters {
     fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         let mut map = s.serialize_map(Some(self.entries.len()))?;

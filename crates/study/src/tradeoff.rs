@@ -298,15 +298,21 @@ pub fn tradeoff_rows(
 
 /// The table, as `tradeoff` prints it.
 pub fn write_table(out: &mut dyn Write, rows: &[Row]) -> std::io::Result<()> {
+    let rw = rows
+        .iter()
+        .map(|r| r.renderer.len())
+        .chain([8])
+        .max()
+        .unwrap_or(8);
     writeln!(
         out,
-        "{:<8} {:<8} {:<4} {:<5} {:<34} {:>4} {:>8} {:>9} {:>6} {:>4} {:>8} {:>9} {:>9} {:>6} {:>5}  pareto",
+        "{:<rw$} {:<8} {:<4} {:<5} {:<34} {:>4} {:>8} {:>9} {:>6} {:>4} {:>8} {:>9} {:>9} {:>6} {:>5}  pareto",
         "renderer", "shading", "aa", "vis", "numeric", "bits", "instr", "busy cyc", "worst", "late", "host ms", "max err", "RMS err", "PSNR", "ovfl"
     )?;
     for r in rows {
         writeln!(
             out,
-            "{:<8} {:<8} {:<4} {:<5} {:<34} {:>4} {:>8} {:>9} {:>5.1}% {:>4} {:>8.2} {:>9.2e} {:>9.2e} {:>6} {:>5}  {}",
+            "{:<rw$} {:<8} {:<4} {:<5} {:<34} {:>4} {:>8} {:>9} {:>5.1}% {:>4} {:>8.2} {:>9.2e} {:>9.2e} {:>6} {:>5}  {}",
             r.renderer,
             r.shading,
             r.aa,
@@ -333,8 +339,8 @@ pub fn write_table(out: &mut dyn Write, rows: &[Row]) -> std::io::Result<()> {
 }
 
 /// The table as CSV (one header line, one line per setting). After the fixed columns
-/// come the renderers' own counters, one column per name (the union over the rows, in the
-/// order first met), empty where a row's renderer does not count it.
+/// come the renderers' own counters, one column `counter_NAME` per name (the union over
+/// the rows, in the order first met), empty where a row's renderer does not count it.
 pub fn csv(rows: &[Row]) -> String {
     let mut names: Vec<&'static str> = Vec::new();
     for r in rows {
@@ -348,7 +354,7 @@ pub fn csv(rows: &[Row]) -> String {
         "renderer,shading,aa,visibility,numeric,register_bits,instructions,busy_cycles,worst_line_share,late_lines,host_ms,max_error,rms_error,psnr_db,overflows,pareto",
     );
     for name in &names {
-        s.push(',');
+        s.push_str(",counter_");
         s.push_str(name);
     }
     s.push('\n');

@@ -1,7 +1,7 @@
 //! A custom renderer through the X-processor array: `cargo run -p cwisim-render --example
 //! rectangles`. Takes three overlapping rectangles, renders them through the pipeline
 //! (the same one `cwisim render` runs, here on two threads), prints what the array did,
-//! and writes the stream as an annotated text trace, `rectangles.cwt`, which
+//! and writes the stream as a text trace, `rectangles.cwt`, which
 //! `cwisim run`, `cwisim stats` and `cwisim diff` read like any other.
 
 mod renderer;
