@@ -81,7 +81,7 @@ fn the_pot_matches_its_reference_picture() {
 fn every_embedded_scene_renders_and_scenes_lists_them() {
     let dir = scratch("embedded");
     let list = cwisim_ok(&dir, &["scenes"]);
-    for name in ["pot", "fig25", "cases12", "still-life"] {
+    for name in ["pot", "fig25", "cases12", "still-life", "teapot"] {
         assert!(list.lines().any(|l| l.starts_with(name)), "{list}");
         let png = format!("{name}.png");
         cwisim_ok(&dir, &["render", name, "-q", "-o", &png]);
@@ -120,9 +120,9 @@ fn every_embedded_scene_renders_and_scenes_lists_them() {
         std::fs::read(dir.join("a.npy")).unwrap(),
         std::fs::read(dir.join("b.npy")).unwrap()
     );
-    let out = cwisim(&dir, &["scenes", "teapot"]);
+    let out = cwisim(&dir, &["scenes", "coffee-pot"]);
     assert_eq!(out.status.code(), Some(2));
-    let out = cwisim(&dir, &["render", "teapot"]);
+    let out = cwisim(&dir, &["render", "coffee-pot"]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(

@@ -34,6 +34,11 @@ pub const EMBEDDED: &[Embedded] = &[
         about: "world, RGB: a red vase, a green box and a blue cone on a table, occluding each other",
         text: include_str!("../scenes/still-life.json"),
     },
+    Embedded {
+        name: "teapot",
+        about: "world, grey, 500×500 as in Nishita et al.: the Utah teapot, Newell's 32 bicubic Bézier patches with Crow's bottom, tessellated 8×8 per patch, two-sided (its inside shows through the lid gap)",
+        text: include_str!("../scenes/teapot.json"),
+    },
 ];
 
 /// The embedded scene called `name`.

@@ -17,9 +17,12 @@
 //!
 //! [`parse_any`] / [`load_any`] read any scene file (screen or world); [`embedded`] holds
 //! the scenes built into the binary.
+//!
+//! - [`bezier`] — bicubic Bézier patches (the Utah teapot), evaluated and tessellated.
 
 #![warn(missing_docs)]
 
+pub mod bezier;
 pub mod camera;
 pub mod embedded;
 pub mod face;

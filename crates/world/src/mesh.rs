@@ -12,8 +12,9 @@
 //! faces around that vertex that differ from this face's by less than the mesh's
 //! `crease_angle`, so smooth surfaces shade smoothly and creases stay sharp.
 
+use crate::bezier::{patches_from, tessellate};
 use crate::obj;
-use crate::scene::{MeshSpec, Revolution, Scale, Transform};
+use crate::scene::{BezierSource, MeshSpec, Revolution, Scale, Transform};
 use cwisim_scene::{SceneError, SceneErrorKind};
 use glam::{DMat3, DMat4, DQuat, DVec3, EulerRot};
 use std::path::Path;
@@ -97,7 +98,12 @@ pub(crate) struct Raw {
 /// Builds mesh `k` of a scene.
 pub fn build(spec: &MeshSpec, k: usize, base: Option<&Path>) -> Result<Mesh, BuildError> {
     let name = spec.name.clone().unwrap_or_else(|| format!("mesh {k}"));
-    let (raw, face_field): (Raw, Box<dyn Fn(usize) -> String>) = if let Some(r) = &spec.revolution {
+    let (raw, face_field): (Raw, Box<dyn Fn(usize) -> String>) = if let Some(b) = &spec.bezier {
+        (
+            bezier(b, k)?,
+            Box::new(move |f| format!("meshes[{k}].bezier (triangle {f})")),
+        )
+    } else if let Some(r) = &spec.revolution {
         (
             revolution(r, k)?,
             Box::new(move |f| format!("meshes[{k}].revolution (face {f})")),
@@ -346,6 +352,35 @@ pub const MAX_SEGMENTS: u32 = 1024;
 /// between a ring and the axis. The front is on the right of the profile traversed in
 /// order, in the (radius → right, height → up) plane: a profile that starts on the axis
 /// at the bottom and climbs outward faces outward.
+/// Bézier patches, each tessellated `tessellate` × `tessellate` into triangles with the
+/// patch's own normals (the limit at degenerate poles); shared patch edges give
+/// bit-identical points, so the mesh has no cracks (`crate::bezier::tessellate`).
+fn bezier(b: &BezierSource, k: usize) -> Result<Raw, BuildError> {
+    let indices: Vec<[usize; 16]> = b
+        .patches
+        .iter()
+        .map(|p| std::array::from_fn(|j| p[j] as usize))
+        .collect();
+    let patches = patches_from(&b.vertices, &indices)
+        .map_err(|e| geometry(format!("meshes[{k}].bezier"), e))?;
+    let mut raw = Raw {
+        positions: Vec::new(),
+        faces: Vec::new(),
+        normals: Some(Vec::new()),
+    };
+    let normals = raw.normals.as_mut().expect("set above");
+    for patch in &patches {
+        let grid = tessellate(patch, b.tessellate as usize);
+        let base = raw.positions.len() as u32;
+        raw.positions.extend(&grid.points);
+        for t in &grid.triangles {
+            raw.faces.push(t.iter().map(|&i| base + i).collect());
+            normals.push(t.iter().map(|&i| grid.normals[i as usize]).collect());
+        }
+    }
+    Ok(raw)
+}
+
 pub(crate) fn revolution(r: &Revolution, k: usize) -> Result<Raw, BuildError> {
     let field = |s: &str| format!("meshes[{k}].revolution.{s}");
     if !(3..=MAX_SEGMENTS).contains(&r.segments) {
@@ -461,6 +496,7 @@ mod tests {
             normals: None,
             obj: None,
             revolution: None,
+            bezier: None,
         }
     }
 

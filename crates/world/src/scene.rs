@@ -179,10 +179,97 @@ pub struct Revolution {
     pub segments: u32,
 }
 
+/// Bicubic Bézier patches (the Utah teapot's form): control points, and per patch the
+/// indices of its 4×4 control points, row-major (`u` along a row, `v` down the rows).
+/// Polygon renderers draw each patch tessellated `tessellate` × `tessellate`, with
+/// normals from the patch's derivatives (`crate::bezier`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BezierSource {
+    /// Control points `[x, y, z]`.
+    pub vertices: Vec<[f64; 3]>,
+    /// Per patch, 16 indices into `vertices`.
+    pub patches: Vec<Vec<u64>>,
+    /// Quads per patch side, `1..=MAX_TESSELLATION`.
+    pub tessellate: u32,
+}
+
+/// The finest tessellation of a Bézier patch: 64 × 64 quads.
+pub const MAX_TESSELLATION: u32 = 64;
+/// The most triangles a Bézier mesh may tessellate into: 2^22.
+pub const MAX_BEZIER_TRIANGLES: u64 = 1 << 22;
+
+impl BezierSource {
+    /// Checks counts, indices, coordinates and the tessellation level; every fault names
+    /// its JSON path under `field` (`meshes[k].bezier`).
+    pub fn validate(&self, field: &str) -> Result<(), SceneError> {
+        use SceneErrorKind as K;
+        if self.patches.is_empty() {
+            return Err(SceneError::at_field(
+                K::Shape,
+                format!("{field}.patches"),
+                "expected at least one patch",
+            ));
+        }
+        for (i, v) in self.vertices.iter().enumerate() {
+            check_point(&format!("{field}.vertices[{i}]"), *v)?;
+        }
+        for (k, p) in self.patches.iter().enumerate() {
+            if p.len() != 16 {
+                return Err(SceneError::at_field(
+                    K::Shape,
+                    format!("{field}.patches[{k}]"),
+                    format!(
+                        "expected 16 control-point indices (4×4, row-major), found {}",
+                        p.len()
+                    ),
+                ));
+            }
+            for (j, &index) in p.iter().enumerate() {
+                if index >= self.vertices.len() as u64 {
+                    return Err(SceneError::at_field(
+                        K::Shape,
+                        format!("{field}.patches[{k}][{j}]"),
+                        format!(
+                            "vertex index {index} is out of range: there are {} vertices (indices from 0)",
+                            self.vertices.len()
+                        ),
+                    ));
+                }
+            }
+        }
+        if !(1..=MAX_TESSELLATION).contains(&self.tessellate) {
+            return Err(SceneError::at_field(
+                K::Limit,
+                format!("{field}.tessellate"),
+                format!(
+                    "expected quads per patch side in 1..={MAX_TESSELLATION}, found {}",
+                    self.tessellate
+                ),
+            ));
+        }
+        let triangles =
+            self.patches.len() as u64 * 2 * u64::from(self.tessellate) * u64::from(self.tessellate);
+        if triangles > MAX_BEZIER_TRIANGLES {
+            return Err(SceneError::at_field(
+                K::Limit,
+                format!("{field}.tessellate"),
+                format!(
+                    "{} patches tessellated {} × {} would make {triangles} triangles; the limit is {MAX_BEZIER_TRIANGLES} (2^22)",
+                    self.patches.len(),
+                    self.tessellate,
+                    self.tessellate
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// One mesh: where its geometry comes from, its material, and how it is placed.
 ///
 /// Exactly one geometry source: `vertices` + `faces` (inline), `obj` (a Wavefront OBJ
-/// file, relative to the scene file), or `revolution`.
+/// file, relative to the scene file), `revolution`, or `bezier`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MeshSpec {
@@ -217,6 +304,9 @@ pub struct MeshSpec {
     /// A surface of revolution.
     #[serde(default)]
     pub revolution: Option<Revolution>,
+    /// Bicubic Bézier patches.
+    #[serde(default)]
+    pub bezier: Option<BezierSource>,
 }
 
 fn default_crease() -> f64 {
@@ -451,6 +541,7 @@ impl WorldSpec {
                 m.vertices.is_some() || m.faces.is_some() || m.normals.is_some(),
                 m.obj.is_some(),
                 m.revolution.is_some(),
+                m.bezier.is_some(),
             ];
             match sources.iter().filter(|s| **s).count() {
                 1 => {}
@@ -458,16 +549,19 @@ impl WorldSpec {
                     return Err(SceneError::at_field(
                         K::Schema,
                         format!("meshes[{k}]"),
-                        "expected one geometry source: \"vertices\" + \"faces\", \"obj\" or \"revolution\"",
+                        "expected one geometry source: \"vertices\" + \"faces\", \"obj\", \"revolution\" or \"bezier\"",
                     ))
                 }
                 _ => {
                     return Err(SceneError::at_field(
                         K::Schema,
                         format!("meshes[{k}]"),
-                        "expected only one geometry source: \"vertices\" + \"faces\", \"obj\" or \"revolution\"",
+                        "expected only one geometry source: \"vertices\" + \"faces\", \"obj\", \"revolution\" or \"bezier\"",
                     ))
                 }
+            }
+            if let Some(b) = &m.bezier {
+                b.validate(&f("bezier"))?;
             }
             if sources[0] && (m.vertices.is_none() || m.faces.is_none()) {
                 return Err(SceneError::at_field(
