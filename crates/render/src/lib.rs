@@ -16,6 +16,8 @@
 //! * [`settings`] — how to draw ([`Settings`]), in plain types.
 //! * [`prepare`] — screen-space polygons from any scene ([`PolygonScene`]), what polygon
 //!   renderers start from.
+//! * [`span`] — the span fitter: per-pixel targets over a run sent as the fewest
+//!   `Eval1`/`Eval2`/`Eval3` pieces within a tolerance, for renderers that shade per pixel.
 //! * [`vanrij`] — van Rij's DO_FILL (`cwisim-ypipe`), the first renderer and the default.
 //!
 //! ```
@@ -42,6 +44,7 @@ pub mod registry;
 pub mod renderer;
 pub mod settings;
 pub mod source;
+pub mod span;
 pub mod vanrij;
 
 pub use error::RenderError;
