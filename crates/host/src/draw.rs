@@ -20,6 +20,10 @@ pub enum ShadingArg {
     /// vertex): Eval2 spans.
     #[default]
     Gouraud,
+    /// World scenes, exact visibility: the normal and the point interpolated over each
+    /// triangle and lit at every pixel, each row sent through the span fitter
+    /// (--shade-tolerance).
+    Phong,
 }
 
 /// `--aa`.
@@ -49,6 +53,7 @@ impl From<ShadingArg> for Shading {
         match s {
             ShadingArg::Flat => Shading::Flat,
             ShadingArg::Gouraud => Shading::Gouraud,
+            ShadingArg::Phong => Shading::Phong,
         }
     }
 }
@@ -97,6 +102,10 @@ pub struct DrawArgs {
     /// of view; a screen scene is scaled).
     #[arg(long, value_name = "WxH")]
     pub size: Option<Size>,
+    /// With --shading phong: how far (in intensity) the span fitter's Eval1/Eval2/Eval3
+    /// pieces may stray from the per-pixel Phong value. 0 sends one Eval1 per pixel.
+    #[arg(long, value_name = "E", default_value_t = 1.0 / 512.0)]
+    pub shade_tolerance: f64,
 }
 
 impl Default for DrawArgs {
@@ -108,6 +117,7 @@ impl Default for DrawArgs {
             visibility: VisibilityArg::Exact,
             eval0_tolerance: 1.0 / 512.0,
             size: None,
+            shade_tolerance: 1.0 / 512.0,
         }
     }
 }
@@ -133,6 +143,7 @@ impl DrawArgs {
             visibility: self.visibility.into(),
             eval0_tolerance: self.eval0_tolerance,
             size: self.size,
+            shade_tolerance: self.shade_tolerance,
         }
     }
 

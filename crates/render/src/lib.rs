@@ -16,6 +16,8 @@
 //! * [`settings`] — how to draw ([`Settings`]), in plain types.
 //! * [`prepare`] — screen-space polygons from any scene ([`PolygonScene`]), what polygon
 //!   renderers start from.
+//! * [`phong`] — Phong shading through the array: every pixel lit on the host, each
+//!   trapezium row sent through the span fitter (`vanrij --shading phong`).
 //! * [`span`] — the span fitter: per-pixel targets over a run sent as the fewest
 //!   `Eval1`/`Eval2`/`Eval3` pieces within a tolerance, for renderers that shade per pixel.
 //! * [`vanrij`] — van Rij's DO_FILL (`cwisim-ypipe`), the first renderer and the default.
@@ -38,6 +40,7 @@
 #![warn(missing_docs)]
 
 pub mod error;
+pub mod phong;
 pub mod pipeline;
 pub mod prepare;
 pub mod registry;

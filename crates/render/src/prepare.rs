@@ -6,7 +6,9 @@
 use crate::error::RenderError;
 use crate::settings::Settings;
 use crate::source::{LoadedScene, Source};
-use cwisim_scene::ScreenScene;
+use cwisim_scene::{ScreenScene, Shading};
+use cwisim_world::face::ScreenTriangle;
+use cwisim_world::shade::PhongShader;
 use cwisim_world::{AnyScene, ProjectStats, Visibility, VisibilityStats};
 use std::time::{Duration, Instant};
 
@@ -31,6 +33,21 @@ pub struct PolygonScene {
     pub transform_time: Duration,
     /// Wall time of hidden-surface removal (world scenes).
     pub visibility_time: Duration,
+    /// With Phong shading: what per-pixel shading needs of the world.
+    pub phong: Option<PhongSurfaces>,
+}
+
+/// What per-pixel (Phong) shading needs: the projected triangles with their world
+/// corners and normals, the source triangle of every polygon, and the scene's lighting.
+#[derive(Clone, Debug)]
+pub struct PhongSurfaces {
+    /// The projected, lit triangles.
+    pub triangles: Vec<ScreenTriangle>,
+    /// For each polygon of the screen scene (an exact visible fragment), the triangle it
+    /// is a piece of.
+    pub sources: Vec<usize>,
+    /// The lighting.
+    pub shader: PhongShader,
 }
 
 impl PolygonScene {
@@ -53,16 +70,39 @@ impl PolygonScene {
             load_time: loaded.load_time,
             transform_time: Duration::ZERO,
             visibility_time: Duration::ZERO,
+            phong: None,
         };
+        let phong = settings.shading == Shading::Phong;
         match loaded.scene {
+            AnyScene::Screen(_) if phong => {
+                return Err(RenderError::Usage(
+                    "Phong shading needs a world scene (normals in 3D); a screen scene has only intensities: use --shading gouraud or flat".into(),
+                ))
+            }
             AnyScene::Screen(s) => prepared.screen = s,
+            AnyScene::World(_) if phong && settings.visibility != Visibility::Exact => {
+                return Err(RenderError::Usage(
+                    "Phong shading is drawn on exact visible surfaces only: use --visibility exact (eval0 claims hold one value per pixel run, not a per-pixel shade)".into(),
+                ))
+            }
             AnyScene::World(w) => {
                 let start = Instant::now();
                 let (tris, project) = cwisim_world::project::project(&w, settings.shading)?;
                 prepared.transform_time = start.elapsed();
                 let start = Instant::now();
-                let (polygons, vis) =
-                    cwisim_world::resolve(&tris, w.channels(), settings.visibility);
+                let (polygons, vis) = if phong {
+                    let (fragments, stats) =
+                        cwisim_world::visibility::exact_fragments(&tris, w.channels());
+                    let sources = fragments.iter().map(|f| f.source).collect();
+                    prepared.phong = Some(PhongSurfaces {
+                        triangles: tris,
+                        sources,
+                        shader: PhongShader::new(&w),
+                    });
+                    (fragments.into_iter().map(|f| f.polygon).collect(), Some(stats))
+                } else {
+                    cwisim_world::resolve(&tris, w.channels(), settings.visibility)
+                };
                 prepared.visibility_time = start.elapsed();
                 prepared.screen = w.screen(polygons);
                 prepared.project = Some(project);

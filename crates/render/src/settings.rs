@@ -54,6 +54,9 @@ pub struct Settings {
     /// Draw at another size (a world scene's camera keeps its vertical field of view; a
     /// screen scene is scaled).
     pub size: Option<Size>,
+    /// With Phong shading: how far the span fitter's pieces may stray from the per-pixel
+    /// intensity (0: one `Eval1` per pixel, exact).
+    pub shade_tolerance: f64,
 }
 
 impl Default for Settings {
@@ -64,6 +67,7 @@ impl Default for Settings {
             visibility: Visibility::Exact,
             eval0_tolerance: 1.0 / 512.0,
             size: None,
+            shade_tolerance: 1.0 / 512.0,
         }
     }
 }
@@ -75,6 +79,12 @@ impl Settings {
             return Err(format!(
                 "--eval0-tolerance must be a finite number ≥ 0, found {}",
                 self.eval0_tolerance
+            ));
+        }
+        if !(self.shade_tolerance >= 0.0 && self.shade_tolerance.is_finite()) {
+            return Err(format!(
+                "--shade-tolerance must be a finite number ≥ 0, found {}",
+                self.shade_tolerance
             ));
         }
         Ok(())

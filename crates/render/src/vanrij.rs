@@ -4,6 +4,7 @@
 //! A thin adapter over `cwisim-ypipe`, where the scan conversion lives.
 
 use crate::error::RenderError;
+use crate::phong::PhongFrame;
 use crate::prepare::PolygonScene;
 use crate::renderer::{Counters, FramePlan, Renderer};
 use crate::settings::Settings;
@@ -18,7 +19,7 @@ use std::time::Duration;
 
 /// The registry's one line about it.
 pub const ABOUT: &str =
-    "van Rij's DO_FILL (CWI CS-R9427): trapezia, exact box-filter coverage in twelve cases, flat or Gouraud, Eval0 claims";
+    "van Rij's DO_FILL (CWI CS-R9427): trapezia, exact box-filter coverage in twelve cases, flat or Gouraud, Eval0 claims; Phong lit per pixel through the span fitter";
 
 /// DO_FILL's counter names for cases 1–12.
 const CASES: [&str; 12] = [
@@ -31,6 +32,8 @@ const CASES: [&str; 12] = [
 pub struct VanRij {
     scene: PolygonScene,
     options: Options,
+    /// The span fitter's tolerance (Phong shading).
+    shade_tolerance: f64,
 }
 
 impl VanRij {
@@ -56,6 +59,7 @@ impl VanRij {
                 aa: settings.aa,
                 claim,
             },
+            shade_tolerance: settings.shade_tolerance,
         }
     }
 
@@ -124,6 +128,14 @@ impl Renderer for VanRij {
         _index: u32,
         _previous: Option<&'a Image>,
     ) -> Result<Box<dyn FramePlan + 'a>, RenderError> {
+        if let Some(surfaces) = &self.scene.phong {
+            return Ok(Box::new(PhongFrame::new(
+                &self.scene.screen,
+                surfaces,
+                self.options.aa,
+                self.shade_tolerance,
+            )));
+        }
         Ok(Box::new(Frame {
             plan: ScanPlan::new(&self.scene.screen, &self.options),
             options: &self.options,
@@ -135,8 +147,12 @@ impl Renderer for VanRij {
             Some(v) => format!(", {v} visibility"),
             None => String::new(),
         };
+        let fitted = match self.scene.phong {
+            Some(_) => format!(" (span tolerance {})", self.shade_tolerance),
+            None => String::new(),
+        };
         format!(
-            "{} shading, {}{visibility}",
+            "{} shading{fitted}, {}{visibility}",
             self.options.shading.title(),
             self.options.aa.title()
         )

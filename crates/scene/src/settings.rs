@@ -14,6 +14,9 @@ pub enum Shading {
     /// lit at every vertex).
     #[default]
     Gouraud,
+    /// World scenes: the normal and the point interpolated (perspective-correctly) over
+    /// each triangle and lit at every pixel, sent through the span fitter.
+    Phong,
 }
 
 /// How a pixel's value is sampled from what covers it.
@@ -57,8 +60,11 @@ trait Named: Sized + Copy + PartialEq + 'static {
 
 impl Named for Shading {
     const WHAT: &'static str = "shading";
-    const ALL: &'static [(Self, &'static str)] =
-        &[(Shading::Flat, "flat"), (Shading::Gouraud, "gouraud")];
+    const ALL: &'static [(Self, &'static str)] = &[
+        (Shading::Flat, "flat"),
+        (Shading::Gouraud, "gouraud"),
+        (Shading::Phong, "phong"),
+    ];
 }
 
 impl Named for Antialias {
@@ -69,7 +75,7 @@ impl Named for Antialias {
 
 impl Shading {
     /// Every value, in order.
-    pub const ALL: [Shading; 2] = [Shading::Flat, Shading::Gouraud];
+    pub const ALL: [Shading; 3] = [Shading::Flat, Shading::Gouraud, Shading::Phong];
 
     /// Its one spelling: "flat", "gouraud" (the [`Display`](fmt::Display) form).
     pub fn name(self) -> &'static str {
@@ -81,6 +87,7 @@ impl Shading {
         match self {
             Shading::Flat => "flat",
             Shading::Gouraud => "Gouraud",
+            Shading::Phong => "Phong",
         }
     }
 }
@@ -137,8 +144,8 @@ mod tests {
         }
         assert_eq!("GOURAUD".parse::<Shading>(), Ok(Shading::Gouraud));
         assert_eq!(
-            "phong".parse::<Shading>().unwrap_err(),
-            "unknown shading `phong`; expected flat or gouraud"
+            "metal".parse::<Shading>().unwrap_err(),
+            "unknown shading `metal`; expected flat or gouraud or phong"
         );
         assert_eq!(Antialias::Box.to_string(), "box");
     }

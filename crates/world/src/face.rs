@@ -26,6 +26,20 @@ pub struct ScreenTriangle {
     pub mesh: u32,
     /// Which face of that mesh.
     pub face: u32,
+    /// Where its corners are in the world, and their shading normals: what per-pixel
+    /// (Phong) shading interpolates.
+    pub surface: Surface,
+}
+
+/// A screen triangle's corners in the world: positions, and unit shading normals turned
+/// toward the viewer (the face's normal for flat shading; a back face of a two-sided mesh
+/// has them reversed, as its lighting has).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Surface {
+    /// World positions of the three corners.
+    pub world: [glam::DVec3; 3],
+    /// Unit shading normals at the three corners.
+    pub normals: [glam::DVec3; 3],
 }
 
 impl ScreenTriangle {
@@ -79,6 +93,7 @@ mod tests {
             intensity: i,
             mesh: 0,
             face: 0,
+            surface: Surface::default(),
         }
     }
 

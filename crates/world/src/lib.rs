@@ -31,6 +31,7 @@ pub mod mesh;
 pub mod obj;
 pub mod project;
 pub mod scene;
+pub mod shade;
 pub mod visibility;
 
 use cwisim_scene::Shading;

@@ -12,7 +12,7 @@
 //!   intensity is calculated for each polygon"), the same value at all corners.
 
 use crate::camera::Camera;
-use crate::face::ScreenTriangle;
+use crate::face::{ScreenTriangle, Surface};
 use crate::lighting::Lighting;
 use crate::mesh::Mesh;
 use crate::scene::WorldScene;
@@ -129,6 +129,10 @@ pub fn project(
                     stats.back_faces_drawn += 1;
                 }
                 let toward = if back { -1.0 } else { 1.0 };
+                let normals = match flat {
+                    Some((_, n)) => [toward * n; 3],
+                    None => tri.map(|c| toward * face.normals[c]),
+                };
                 let intensity = match flat {
                     Some((centroid, n)) => {
                         let i = lighting.intensity(material, centroid, toward * n, camera.eye);
@@ -149,6 +153,7 @@ pub fn project(
                     intensity,
                     mesh: k as u32,
                     face: f as u32,
+                    surface: Surface { world: p, normals },
                 });
             }
         }

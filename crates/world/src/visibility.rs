@@ -576,6 +576,7 @@ mod tests {
             intensity,
             mesh: 0,
             face: 0,
+            surface: Default::default(),
         }
     }
 

@@ -25,6 +25,7 @@ fn tri(points: [P; 3], inv_depth: [f64; 3]) -> ScreenTriangle {
         intensity,
         mesh: 0,
         face: 0,
+        surface: Default::default(),
     }
 }
 

@@ -360,6 +360,20 @@ fn push_claim(
     }
 }
 
+/// The pixels `first..end` whose centre lies in `t` in pixel row `row` (half-open:
+/// `[x_left, x_right)` at `y = row + 0.5`, and `y_top <= y < y_bot`), within the image's
+/// `width`; `None` when there are none. Point sampling's rule, shared by every emitter.
+pub fn sampled_span(t: &Trapezium, row: u32, width: u32) -> Option<(i64, i64)> {
+    let y = f64::from(row) + 0.5;
+    if !(t.y_top <= y && y < t.y_bot) {
+        return None;
+    }
+    let (xl, xr) = (t.left.x_at(y), t.right.x_at(y));
+    let first = ceil_i64(xl - 0.5).max(0);
+    let end = ceil_i64(xr - 0.5).min(i64::from(width));
+    (end > first).then_some((first, end))
+}
+
 /// Point-sampled fill (no anti-aliasing) of `t` in pixel row `row`: the pixels whose
 /// centre lies in the trapezium (half-open: `[x_left, x_right)` at `y = row + 0.5`, and
 /// `y_top <= y < y_bot`), one `Eval1` (flat) or `Eval2` (Gouraud) — sections 3.1 and 3.2.
@@ -389,16 +403,10 @@ pub fn sampled_row_into(
     notes: bool,
     fill: &mut RowFill,
 ) -> bool {
+    let Some((first, end)) = sampled_span(t, row, width) else {
+        return false;
+    };
     let y = f64::from(row) + 0.5;
-    if !(t.y_top <= y && y < t.y_bot) {
-        return false;
-    }
-    let (xl, xr) = (t.left.x_at(y), t.right.x_at(y));
-    let first = ceil_i64(xl - 0.5).max(0);
-    let end = ceil_i64(xr - 0.5).min(i64::from(width));
-    if end <= first {
-        return false;
-    }
     let rs = RowShade::new(t, shade, y, channels);
     fill.reset(None);
     if let Claim::Eval0 { tolerance } = claim {

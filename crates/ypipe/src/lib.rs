@@ -148,7 +148,10 @@ impl<'s> ScanPlan<'s> {
                 .iter()
                 .map(|p| match options.shading {
                     Shading::Flat => Shade::Flat(flat_intensity(p, channels)),
-                    Shading::Gouraud => Shade::Gouraud,
+                    // Phong needs 3D normals per pixel, which screen polygons do not
+                    // carry: `cwisim-render` draws it with its own emitter; here it is
+                    // drawn as Gouraud, from the vertex intensities
+                    Shading::Gouraud | Shading::Phong => Shade::Gouraud,
                 })
                 .collect(),
         }
