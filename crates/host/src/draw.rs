@@ -106,6 +106,10 @@ pub struct DrawArgs {
     /// pieces may stray from the per-pixel Phong value. 0 sends one Eval1 per pixel.
     #[arg(long, value_name = "E", default_value_t = 1.0 / 512.0)]
     pub shade_tolerance: f64,
+    /// Tessellate the scene's Bézier meshes N×N quads per patch (1 to 64) instead of as
+    /// the scene says.
+    #[arg(long, value_name = "N")]
+    pub tessellate: Option<u32>,
 }
 
 impl Default for DrawArgs {
@@ -118,6 +122,7 @@ impl Default for DrawArgs {
             eval0_tolerance: 1.0 / 512.0,
             size: None,
             shade_tolerance: 1.0 / 512.0,
+            tessellate: None,
         }
     }
 }
@@ -144,6 +149,7 @@ impl DrawArgs {
             eval0_tolerance: self.eval0_tolerance,
             size: self.size,
             shade_tolerance: self.shade_tolerance,
+            tessellate: self.tessellate,
         }
     }
 
@@ -153,7 +159,7 @@ impl DrawArgs {
         let entry = registry::find(&self.renderer)?;
         let settings = self.settings();
         settings.check().map_err(CliError::Usage)?;
-        let loaded = Source::resolve(scene)?.load(self.size)?;
+        let loaded = Source::resolve(scene)?.load_for(&settings)?;
         Ok(build(entry, loaded, &settings)?)
     }
 }

@@ -57,6 +57,8 @@ pub struct Settings {
     /// With Phong shading: how far the span fitter's pieces may stray from the per-pixel
     /// intensity (0: one `Eval1` per pixel, exact).
     pub shade_tolerance: f64,
+    /// Tessellate Bézier meshes `n` × `n` per patch instead of as the scene says.
+    pub tessellate: Option<u32>,
 }
 
 impl Default for Settings {
@@ -68,6 +70,7 @@ impl Default for Settings {
             eval0_tolerance: 1.0 / 512.0,
             size: None,
             shade_tolerance: 1.0 / 512.0,
+            tessellate: None,
         }
     }
 }

@@ -61,6 +61,21 @@ impl Source {
         }
     }
 
+    /// Reads the scene (any kind) as `settings` draw it: at its `size`, its Bézier meshes
+    /// at its `tessellate`, when given.
+    pub fn load_for(&self, settings: &crate::Settings) -> Result<LoadedScene, RenderError> {
+        let mut loaded = self.load(settings.size)?;
+        if let Some(n) = settings.tessellate {
+            let start = Instant::now();
+            loaded.scene = loaded
+                .scene
+                .with_tessellation(n)
+                .map_err(|e| RenderError::Usage(format!("--tessellate {n}: {e}")))?;
+            loaded.load_time += start.elapsed();
+        }
+        Ok(loaded)
+    }
+
     /// Reads the scene (any kind), at `size` when given. A [`Source::Built`] scene has
     /// nothing to read: build its [`LoadedScene`] with [`LoadedScene::built`].
     pub fn load(&self, size: Option<Size>) -> Result<LoadedScene, RenderError> {

@@ -11,12 +11,15 @@
 //! the array.
 
 use crate::error::StudyError;
-use cwisim_render::{registry, render, ArrayConfig, PolygonScene, Settings, Size, Source, Taps};
+use cwisim_render::{
+    registry, render, ArrayConfig, PolygonScene, Renderer, Settings, Size, Source, Taps,
+};
 use cwisim_scene::{Antialias, Shading};
 use cwisim_world::Visibility;
 use cwisim_xproc::{ImageSink, Machine, Numeric, Timing};
 use cwisim_ypipe::exact::scene_box_filtered;
 use serde::Serialize;
+use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -35,12 +38,14 @@ pub const DEFAULT_FORMATS: &[&str] = &[
 pub struct Row {
     /// The renderer feeding the array.
     pub renderer: &'static str,
-    /// `flat` or `gouraud`.
+    /// `flat`, `gouraud` or `phong`.
     pub shading: &'static str,
     /// `none` or `box`.
     pub aa: &'static str,
     /// `exact`, `eval0`, or `-` (screen scenes).
     pub visibility: &'static str,
+    /// Quads per Bézier patch side (scenes with Bézier meshes, when the grid varies it).
+    pub tessellate: Option<u32>,
     /// The array's numeric format.
     pub numeric: String,
     /// Register bits per processor and channel (I, dI, ddI and the accumulator).
@@ -81,36 +86,59 @@ pub struct Setting {
     pub numeric: Numeric,
 }
 
-/// The settings of the grid, in order: renderer, then visibility (world scenes only),
-/// shading, anti-aliasing and numeric format.
+/// The axes of the grid besides the renderers and the numeric formats.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Axes {
+    /// A world scene: both visibilities, and Phong shading (on exact visibility).
+    pub world: bool,
+    /// The image size.
+    pub size: Option<Size>,
+    /// Tessellations of the scene's Bézier meshes (empty: as the scene says).
+    pub tessellations: Vec<u32>,
+}
+
+/// The settings of the grid, in order: renderer, tessellation (scenes with Bézier
+/// meshes), visibility (world scenes), shading (Phong on world scenes with exact
+/// visibility), anti-aliasing and numeric format.
 pub fn grid(
     renderers: &[&'static registry::Entry],
-    world: bool,
-    size: Option<Size>,
+    axes: &Axes,
     formats: &[Numeric],
 ) -> Vec<Setting> {
     let mut out = Vec::new();
-    let visibilities: &[Visibility] = if world {
+    let visibilities: &[Visibility] = if axes.world {
         &[Visibility::Exact, Visibility::Eval0]
     } else {
         &[Visibility::Exact]
     };
+    let tessellations: Vec<Option<u32>> = if axes.tessellations.is_empty() {
+        vec![None]
+    } else {
+        axes.tessellations.iter().map(|&n| Some(n)).collect()
+    };
     for &renderer in renderers {
-        for &visibility in visibilities {
-            for shading in [Shading::Gouraud, Shading::Flat] {
-                for aa in [Antialias::Box, Antialias::None] {
-                    for numeric in formats {
-                        out.push(Setting {
-                            renderer,
-                            settings: Settings {
-                                shading,
-                                aa,
-                                visibility,
-                                size,
-                                ..Settings::default()
-                            },
-                            numeric: *numeric,
-                        });
+        for &tessellate in &tessellations {
+            for &visibility in visibilities {
+                for shading in [Shading::Phong, Shading::Gouraud, Shading::Flat] {
+                    if shading == Shading::Phong && !(axes.world && visibility == Visibility::Exact)
+                    {
+                        continue;
+                    }
+                    for aa in [Antialias::Box, Antialias::None] {
+                        for numeric in formats {
+                            out.push(Setting {
+                                renderer,
+                                settings: Settings {
+                                    shading,
+                                    aa,
+                                    visibility,
+                                    size: axes.size,
+                                    tessellate,
+                                    ..Settings::default()
+                                },
+                                numeric: *numeric,
+                            });
+                        }
                     }
                 }
             }
@@ -181,12 +209,52 @@ pub fn mark_pareto(rows: &mut [Row]) {
 /// The exact image of the scene SCENE names, at `size`: the box-filtered Gouraud image of
 /// its exact visible surfaces, computed by the independent reference.
 pub fn exact_image(scene: Option<&Path>, size: Option<Size>) -> Result<Vec<f64>, StudyError> {
-    let settings = Settings {
-        size,
-        ..Settings::default()
+    reference_image(
+        scene,
+        &Settings {
+            size,
+            ..Settings::default()
+        },
+    )
+}
+
+/// The reference a setting is measured against, for its geometry (size, tessellation):
+/// for flat and Gouraud shading the exact box-filtered Gouraud image of the exact visible
+/// surfaces (`cwisim_ypipe::exact`, independent of the renderers and the array); for
+/// Phong, Phong's own best image — box filter, span tolerance 0 (the per-pixel value at
+/// every centre a triangle covers whole), `f64` registers — so that a Phong row's error
+/// is what its span tolerance, point sampling and register format add.
+pub fn reference_image(scene: Option<&Path>, setting: &Settings) -> Result<Vec<f64>, StudyError> {
+    let loaded = Source::resolve(scene)?.load_for(setting)?;
+    if setting.shading == Shading::Phong {
+        let best = Settings {
+            aa: Antialias::Box,
+            visibility: Visibility::Exact,
+            shade_tolerance: 0.0,
+            ..*setting
+        };
+        let renderer = cwisim_render::vanrij::VanRij::new(loaded, &best)?;
+        let h = renderer.header();
+        let mut sink = ImageSink::new(
+            h.width as usize,
+            h.channel_count(),
+            ImageSink::DEFAULT_LIMIT_BYTES,
+        );
+        render(
+            &renderer,
+            &ArrayConfig::default(),
+            1,
+            &mut sink,
+            Taps::default(),
+        )?;
+        return Ok(sink.finish()?.data);
+    }
+    let gouraud = Settings {
+        shading: Shading::Gouraud,
+        visibility: Visibility::Exact,
+        ..*setting
     };
-    let loaded = Source::resolve(scene)?.load(size)?;
-    let p = PolygonScene::new(loaded, &settings)?;
+    let p = PolygonScene::new(loaded, &gouraud)?;
     Ok(scene_box_filtered(&p.screen))
 }
 
@@ -209,7 +277,7 @@ pub fn measure(
     machine: &Machine,
 ) -> Result<Measured, StudyError> {
     let start = Instant::now();
-    let loaded = Source::resolve(scene)?.load(setting.settings.size)?;
+    let loaded = Source::resolve(scene)?.load_for(&setting.settings)?;
     let renderer = (setting.renderer.build)(loaded, &setting.settings)?;
     let h = renderer.header();
     let mut sink = ImageSink::new(
@@ -238,6 +306,7 @@ pub fn measure(
 pub fn tradeoff_rows(
     scene: Option<&Path>,
     size: Option<Size>,
+    tessellations: &[u32],
     renderers: &[String],
     formats: &[Numeric],
     machine: &Machine,
@@ -252,9 +321,19 @@ pub fn tradeoff_rows(
             .map(|n| registry::find(n))
             .collect::<Result<_, _>>()?
     };
-    let world = Source::resolve(scene)?.load(size)?.scene.kind() == "world";
-    let reference = exact_image(scene, size)?;
-    let settings = grid(&entries, world, size, formats);
+    let probe = Source::resolve(scene)?.load(size)?.scene;
+    let axes = Axes {
+        world: probe.kind() == "world",
+        size,
+        tessellations: if probe.has_patches() {
+            tessellations.to_vec()
+        } else {
+            Vec::new()
+        },
+    };
+    let settings = grid(&entries, &axes, formats);
+    // the references made so far, by (Phong, tessellation)
+    let mut references: BTreeMap<(bool, Option<u32>), Vec<f64>> = BTreeMap::new();
     let mut rows = Vec::with_capacity(settings.len());
     for (k, setting) in settings.iter().enumerate() {
         progress(k, settings.len());
@@ -265,14 +344,25 @@ pub fn tradeoff_rows(
         }
         times.sort();
         let stats = &measured.stats;
-        let (max_error, rms_error, psnr_db) = errors(&measured.image, &reference);
+        let key = (
+            setting.settings.shading == Shading::Phong,
+            setting.settings.tessellate,
+        );
+        let reference = match references.entry(key) {
+            std::collections::btree_map::Entry::Occupied(e) => e.into_mut(),
+            std::collections::btree_map::Entry::Vacant(e) => {
+                e.insert(reference_image(scene, &setting.settings)?)
+            }
+        };
+        let (max_error, rms_error, psnr_db) = errors(&measured.image, reference.as_slice());
         let worst = stats.lines.iter().map(|l| l.busy_cycles).max().unwrap_or(0);
         let s = &setting.settings;
         rows.push(Row {
             renderer: setting.renderer.name,
             shading: s.shading.name(),
             aa: s.aa.name(),
-            visibility: if world { s.visibility.name() } else { "-" },
+            visibility: if axes.world { s.visibility.name() } else { "-" },
+            tessellate: s.tessellate,
             numeric: short_numeric(&setting.numeric),
             register_bits: register_bits(&setting.numeric),
             instructions: stats.totals.instructions,
@@ -306,14 +396,15 @@ pub fn write_table(out: &mut dyn Write, rows: &[Row]) -> std::io::Result<()> {
         .unwrap_or(8);
     writeln!(
         out,
-        "{:<rw$} {:<8} {:<4} {:<5} {:<34} {:>4} {:>8} {:>9} {:>6} {:>4} {:>8} {:>9} {:>9} {:>6} {:>5}  pareto",
-        "renderer", "shading", "aa", "vis", "numeric", "bits", "instr", "busy cyc", "worst", "late", "host ms", "max err", "RMS err", "PSNR", "ovfl"
+        "{:<rw$} {:>4} {:<8} {:<4} {:<5} {:<34} {:>4} {:>8} {:>9} {:>6} {:>4} {:>8} {:>9} {:>9} {:>6} {:>5}  pareto",
+        "renderer", "tess", "shading", "aa", "vis", "numeric", "bits", "instr", "busy cyc", "worst", "late", "host ms", "max err", "RMS err", "PSNR", "ovfl"
     )?;
     for r in rows {
         writeln!(
             out,
-            "{:<rw$} {:<8} {:<4} {:<5} {:<34} {:>4} {:>8} {:>9} {:>5.1}% {:>4} {:>8.2} {:>9.2e} {:>9.2e} {:>6} {:>5}  {}",
+            "{:<rw$} {:>4} {:<8} {:<4} {:<5} {:<34} {:>4} {:>8} {:>9} {:>5.1}% {:>4} {:>8.2} {:>9.2e} {:>9.2e} {:>6} {:>5}  {}",
             r.renderer,
+            r.tessellate.map_or_else(|| "-".to_string(), |n| n.to_string()),
             r.shading,
             r.aa,
             r.visibility,
@@ -351,7 +442,7 @@ pub fn csv(rows: &[Row]) -> String {
         }
     }
     let mut s = String::from(
-        "renderer,shading,aa,visibility,numeric,register_bits,instructions,busy_cycles,worst_line_share,late_lines,host_ms,max_error,rms_error,psnr_db,overflows,pareto",
+        "renderer,tessellate,shading,aa,visibility,numeric,register_bits,instructions,busy_cycles,worst_line_share,late_lines,host_ms,max_error,rms_error,psnr_db,overflows,pareto",
     );
     for name in &names {
         s.push_str(",counter_");
@@ -360,8 +451,9 @@ pub fn csv(rows: &[Row]) -> String {
     s.push('\n');
     for r in rows {
         s.push_str(&format!(
-            "{},{},{},{},\"{}\",{},{},{},{},{},{},{:e},{:e},{},{},{}",
+            "{},{},{},{},{},\"{}\",{},{},{},{},{},{},{:e},{:e},{},{},{}",
             r.renderer,
+            r.tessellate.map_or_else(String::new, |n| n.to_string()),
             r.shading,
             r.aa,
             r.visibility,
@@ -399,6 +491,7 @@ mod tests {
             shading: "gouraud",
             aa: "box",
             visibility: "exact",
+            tessellate: None,
             numeric: "f64".into(),
             register_bits: 256,
             instructions: 0,
@@ -413,6 +506,35 @@ mod tests {
             counters: Default::default(),
             pareto: false,
         }
+    }
+
+    #[test]
+    fn the_grid_has_phong_on_exact_world_surfaces_and_every_tessellation() {
+        let vanrij = registry::find("vanrij").unwrap();
+        let f64_only = [Numeric::F64];
+        let world = Axes {
+            world: true,
+            size: None,
+            tessellations: vec![4, 8],
+        };
+        let g = grid(&[vanrij], &world, &f64_only);
+        // 2 tessellations × (exact: phong, gouraud, flat; eval0: gouraud, flat) × 2 aa
+        assert_eq!(g.len(), 2 * 5 * 2);
+        for s in &g {
+            let st = &s.settings;
+            assert!(st.shading != Shading::Phong || st.visibility == Visibility::Exact);
+            assert!(matches!(st.tessellate, Some(4) | Some(8)));
+        }
+        let screen = Axes::default();
+        let g = grid(&[vanrij], &screen, &f64_only);
+        assert_eq!(
+            g.len(),
+            2 * 2,
+            "no Phong, no eval0, no tessellation on a screen scene"
+        );
+        assert!(g
+            .iter()
+            .all(|s| s.settings.shading != Shading::Phong && s.settings.tessellate.is_none()));
     }
 
     #[test]

@@ -217,7 +217,9 @@ pub fn render_tradeoff_plot(rows: &[Row], name: &str) -> Result<Rgb, String> {
             labels.push(
                 Label::new(
                     format!(
-                        "{} {} {} {}",
+                        "{}{} {} {} {}",
+                        r.tessellate
+                            .map_or_else(String::new, |n| format!("tessellated {n}, ")),
                         r.shading,
                         r.aa,
                         r.visibility,

@@ -73,6 +73,23 @@ impl AnyScene {
         }
     }
 
+    /// The same scene with its Bézier meshes tessellated `n` × `n` per patch (a screen
+    /// scene, or a world without Bézier meshes, is unchanged).
+    pub fn with_tessellation(self, n: u32) -> Result<AnyScene, SceneError> {
+        match self {
+            AnyScene::World(w) => Ok(AnyScene::World(w.with_tessellation(n)?)),
+            screen => Ok(screen),
+        }
+    }
+
+    /// Whether any mesh is made of Bézier patches.
+    pub fn has_patches(&self) -> bool {
+        match self {
+            AnyScene::World(w) => w.spec.meshes.iter().any(|m| m.bezier.is_some()),
+            AnyScene::Screen(_) => false,
+        }
+    }
+
     /// The same scene drawn at another size: a world scene's camera keeps its vertical
     /// field of view; a screen scene's polygons are scaled (x by `width / old width`, y by
     /// `height / old height`).

@@ -372,6 +372,23 @@ impl WorldScene {
         }
     }
 
+    /// The same scene with its Bézier meshes tessellated `n` × `n` per patch (other
+    /// meshes as they are); refused outside `1..=MAX_TESSELLATION` or past the triangle
+    /// limit, naming the mesh.
+    pub fn with_tessellation(mut self, n: u32) -> Result<Self, SceneError> {
+        for k in 0..self.spec.meshes.len() {
+            let Some(b) = self.spec.meshes[k].bezier.as_mut() else {
+                continue;
+            };
+            b.tessellate = n;
+            b.validate(&format!("meshes[{k}].bezier"))?;
+            self.meshes[k] = mesh::build(&self.spec.meshes[k], k, None).map_err(|e| match e {
+                mesh::BuildError::Scene(e) | mesh::BuildError::File(e) => e,
+            })?;
+        }
+        Ok(self)
+    }
+
     /// The same scene with another image size (the camera keeps its vertical field of
     /// view; the horizontal one follows the aspect ratio).
     pub fn with_size(mut self, width: u32, height: u32) -> Result<Self, SceneError> {

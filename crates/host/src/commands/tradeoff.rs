@@ -25,6 +25,10 @@ pub struct TradeoffArgs {
     /// Draw at this size, WIDTHxHEIGHT (default: the scene's).
     #[arg(long, value_name = "WxH")]
     pub size: Option<Size>,
+    /// For scenes with Bézier meshes: the tessellations to try (quads per patch side),
+    /// comma-separated.
+    #[arg(long = "tessellate", value_name = "N,…", value_delimiter = ',', default_values_t = [4u32, 8, 16])]
+    pub tessellate: Vec<u32>,
     /// The renderers to try, comma-separated (default: every registered renderer;
     /// `cwisim renderers` lists them).
     #[arg(long, value_name = "LIST", value_delimiter = ',')]
@@ -68,6 +72,7 @@ pub fn run(args: &TradeoffArgs, stdout: &mut dyn Write) -> Result<(), CliError> 
     let rows = tradeoff_rows(
         args.scene.as_deref(),
         args.size,
+        &args.tessellate,
         &args.renderers,
         &formats,
         &machine,
