@@ -185,15 +185,21 @@ pub fn parse_scene(text: &str) -> Result<Scene, SceneError> {
 
 /// Reads and validates a scene file; every error names the file.
 pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|e| {
+    let text = read_scene_text(path)?;
+    parse_scene(&text).map_err(|e| e.in_file(path))
+}
+
+/// A scene file's text; a file that cannot be read is an [`SceneErrorKind::Io`] error
+/// naming it (what every reader of scene files starts with).
+pub fn read_scene_text(path: &Path) -> Result<String, SceneError> {
+    std::fs::read_to_string(path).map_err(|e| {
         SceneError::at_field(
             SceneErrorKind::Io,
             "",
             format!("cannot read the scene: {e}"),
         )
         .in_file(path)
-    })?;
-    parse_scene(&text).map_err(|e| e.in_file(path))
+    })
 }
 
 /// The screen kind as it is read: sizes as `u64` so that a too-large one gets the

@@ -35,9 +35,7 @@ pub mod shade;
 pub mod visibility;
 
 use cwisim_scene::Shading;
-use cwisim_scene::{
-    parse_scene, read_kind, Polygon, Scene, SceneError, SceneErrorKind, ScreenScene,
-};
+use cwisim_scene::{parse_scene, read_kind, Polygon, Scene, SceneError, ScreenScene};
 use std::path::Path;
 
 pub use project::ProjectStats;
@@ -129,14 +127,7 @@ pub fn parse_any(text: &str, base: Option<&Path>) -> Result<AnyScene, SceneError
 
 /// Reads a scene file of any kind; errors name the file.
 pub fn load_any(path: &Path) -> Result<AnyScene, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|e| {
-        SceneError::at_field(
-            SceneErrorKind::Io,
-            "",
-            format!("cannot read the scene: {e}"),
-        )
-        .in_file(path)
-    })?;
+    let text = cwisim_scene::read_scene_text(path)?;
     parse_any(&text, path.parent()).map_err(|e| match e.path {
         Some(_) => e, // an OBJ file's error names that file
         None => e.in_file(path),
