@@ -202,6 +202,7 @@ fn parallel_bands_give_the_serial_output_byte_for_byte() {
     for mode in [
         &["--visibility", "exact"][..],
         &["--visibility", "eval0", "--aa", "none"],
+        &["--shading", "phong"],
     ] {
         let mut outputs = Vec::new();
         for threads in ["1", "2", "3"] {
