@@ -81,7 +81,9 @@ covers (the hardware's way; edge pixels are approximate, see docs/VISIBILITY.md)
 renderer (--renderer NAME; `cwisim renderers` lists them; the default, vanrij, is van Rij's \
 Y-processor) splits the polygons into trapezia and emits the scanline instructions \
 (box-filter coverage with van Rij's twelve DO_FILL cases, or point sampling; flat or \
-Gouraud), and the X-processor array executes them on the machine model.\n\n\
+Gouraud; or Phong on world scenes, lit at every pixel and sent through the span fitter \
+within --shade-tolerance, docs/SHADING.md), and the X-processor array executes them on the \
+machine model.\n\n\
 The summary gives the polygons and trapezia, the instructions by opcode, the cycles per \
 frame, the worst scanline against the display's line period, and the wall time of every \
 stage. -o writes a PNG ([0, 1] clamped to 8 bits; the default, SCENE-NAME.png, when no other \

@@ -91,10 +91,29 @@ impl TraceError {
     }
 }
 
+/// `text` with every control character (a line break, a carriage return, an escape)
+/// written as its Rust escape (`\n`, `\r`, `\u{1b}`): a message that echoes what it
+/// read from the input stays one printable line, whatever the input held.
+pub fn printable(text: &str) -> std::borrow::Cow<'_, str> {
+    if !text.chars().any(char::is_control) {
+        return std::borrow::Cow::Borrowed(text);
+    }
+    let mut out = String::with_capacity(text.len() + 8);
+    for c in text.chars() {
+        if c.is_control() {
+            out.extend(c.escape_default());
+        } else {
+            out.push(c);
+        }
+    }
+    std::borrow::Cow::Owned(out)
+}
+
+/// One printable line (see [`printable`]): the file, the location, the message.
 impl fmt::Display for TraceError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         if let Some(p) = &self.path {
-            write!(f, "{}", p.display())?;
+            write!(f, "{}", printable(&p.display().to_string()))?;
             if self.location != Location::File {
                 match self.location {
                     Location::Byte(_) => write!(f, ": {}", self.location)?,
@@ -105,7 +124,7 @@ impl fmt::Display for TraceError {
         } else if self.location != Location::File {
             write!(f, "{}: ", self.location)?;
         }
-        f.write_str(&self.message)
+        f.write_str(&printable(&self.message))
     }
 }
 
@@ -149,5 +168,22 @@ mod tests {
         let e = TraceError::new(ErrorKind::Encoding, Location::File, "unknown")
             .in_file(Path::new("t.txt"));
         assert_eq!(e.to_string(), "t.txt: unknown");
+    }
+}
+
+#[cfg(test)]
+mod printable_tests {
+    use super::*;
+
+    #[test]
+    fn control_characters_are_escaped_and_the_rest_kept() {
+        assert_eq!(printable("plain ünïcode"), "plain ünïcode");
+        assert_eq!(printable("a\nb\r\u{1b}c\t"), "a\\nb\\r\\u{1b}c\\t");
+        let e = TraceError::new(
+            ErrorKind::Syntax,
+            Location::Line { line: 2, column: 3 },
+            "header \"format\" is \"cwisim-\race\"",
+        );
+        assert_eq!(e.to_string(), "2:3: header \"format\" is \"cwisim-\\race\"");
     }
 }

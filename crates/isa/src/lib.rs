@@ -46,7 +46,7 @@ pub mod packed;
 pub mod text;
 
 pub use encoding::{create_trace, Encoding, FileReader};
-pub use error::{ErrorKind, Location, TraceError};
+pub use error::{printable, ErrorKind, Location, TraceError};
 pub use header::{HeaderFault, TraceHeader, FORMAT_VERSION, MAX_CHANNELS, MAX_LINES, MAX_WIDTH};
 pub use instruction::{Instruction, Intensity, OperandError};
 pub use io::{TraceRead, TraceWrite};

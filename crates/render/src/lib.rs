@@ -28,7 +28,7 @@
 //!
 //! let source = Source::resolve(Some("fig25".as_ref())).unwrap();
 //! let settings = Settings::default();
-//! let loaded = source.load(settings.size).unwrap();
+//! let loaded = source.load_for(&settings).unwrap();
 //! let renderer = (registry::find("vanrij").unwrap().build)(loaded, &settings).unwrap();
 //! let h = renderer.header();
 //! let mut image = ImageSink::new(h.width as usize, h.channel_count(), ImageSink::DEFAULT_LIMIT_BYTES);

@@ -100,7 +100,13 @@ impl SceneError {
         }
     }
 
+    /// One printable line: control characters the input put into the message or the
+    /// path are written as escapes (`cwisim_isa::printable`).
     fn render(&self) -> String {
+        cwisim_isa::printable(&self.render_raw()).into_owned()
+    }
+
+    fn render_raw(&self) -> String {
         let mut out = String::new();
         if let Some(p) = &self.path {
             out.push_str(&p.display().to_string());

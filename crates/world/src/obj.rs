@@ -140,11 +140,18 @@ pub(crate) fn read(path: &Path) -> Result<Raw, SceneError> {
     let models = match loaded {
         Ok((models, _materials)) => models,
         Err(e) => {
-            let line = if reader.at_end {
-                // tobj checks some things only once the whole file is read
-                first_bad_index(&String::from_utf8_lossy(&bytes))
+            let counted = Some(reader.newlines + u64::from(reader.partial));
+            let out_of_bounds = matches!(
+                e,
+                tobj::LoadError::FaceVertexOutOfBounds | tobj::LoadError::FaceNormalOutOfBounds
+            );
+            let line = if reader.at_end && out_of_bounds {
+                // tobj checks indices only once the whole file is read: find the face.
+                // Any other fault is on the line it stopped at, even a last line that,
+                // lacking its newline, took it to the end of the file.
+                first_bad_index(&String::from_utf8_lossy(&bytes)).or(counted)
             } else {
-                Some(reader.newlines + u64::from(reader.partial))
+                counted
             };
             let what = match e {
                 tobj::LoadError::PositionParseError => {
