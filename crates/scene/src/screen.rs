@@ -135,7 +135,18 @@ impl Scene {
 /// [`validate`]: ScreenScene::validate
 pub fn parse_scene(text: &str) -> Result<Scene, SceneError> {
     let kind = read_kind(text, SCENE_KINDS)?;
-    let locate = |e: SceneError| locate_error(text, e);
+    let locate = |e: SceneError| {
+        let located = locate_error(text, e);
+        if located.line.is_some() {
+            return located;
+        }
+        // a path that is not in the text as written (a repeated key: the value read is
+        // the last, the path found the first): the typed reading locates the repeat
+        match serde_json::from_str::<RawScreen>(text) {
+            Err(typed) => SceneError::from_json(json_kind(&typed), &typed),
+            Ok(_) => located,
+        }
+    };
     let value: serde_json::Value =
         serde_json::from_str(text).map_err(|e| SceneError::from_json(json_kind(&e), &e))?;
     let root = value.as_object().expect("read_kind checked the object");

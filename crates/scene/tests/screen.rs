@@ -499,3 +499,13 @@ fn depth_is_optional_per_scene_and_checked() {
     assert_eq!(e.kind, SceneErrorKind::NonFinite);
     assert_eq!(e.field.as_deref(), Some("polygons[1].depth[1]"));
 }
+
+/// A repeated key is located where it repeats, whatever the first one held.
+#[test]
+fn a_repeated_key_is_located() {
+    let e =
+        err(r#"{"kind":"screen","width":4,"height":4,"channels":1,"polygons":[],"polygons":[1]}"#);
+    assert_eq!(e.kind, SceneErrorKind::Schema, "{e}");
+    assert!(e.to_string().contains("duplicate field `polygons`"), "{e}");
+    assert_eq!((e.line, e.column.is_some()), (Some(1), true), "{e}");
+}
