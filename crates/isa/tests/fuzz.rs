@@ -14,40 +14,13 @@
 //! `valid_traces_with_extreme_operands` 512 (× 3), `mutated_golden_traces` 3072 (about
 //! 1024 per encoding), `file_reader` 64 (temp files), and one fixed test.
 
+use cwisim_fuzzing::{config, json_members, number_tokens, EXTREMES, TIME_BOUND};
 use cwisim_isa::io::read_all;
 use cwisim_isa::{Encoding, FileReader, Instruction, Location, TraceError, TraceHeader};
 use proptest::prelude::*;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
-use std::time::{Duration, Instant};
-
-/// The most one read may take (generous: debug build, a loaded 2-core machine).
-const TIME_BOUND: Duration = Duration::from_secs(2);
-
-/// `cases` cases, and no regression files written into the source tree (a failure
-/// prints its minimal input; add it as a fixed test).
-fn config(cases: u32) -> ProptestConfig {
-    ProptestConfig {
-        failure_persistence: None,
-        ..ProptestConfig::with_cases(cases)
-    }
-}
-
-/// Numbers that break naive readers, as text.
-const EXTREMES: [&str; 12] = [
-    "0",
-    "-0",
-    "1e308",
-    "-1e308",
-    "1e-320",
-    "4294967296",
-    "18446744073709551616",
-    "NaN",
-    "1e999",
-    "-1",
-    "4294967295",
-    "65537",
-];
+use std::time::Instant;
 
 const ENCODINGS: [Encoding; 3] = [Encoding::Text, Encoding::JsonLines, Encoding::Binary];
 
@@ -207,103 +180,6 @@ fn mutation() -> impl Strategy<Value = Mutation> {
         any::<usize>().prop_map(Mutation::Wrap),
         Just(Mutation::Reseal),
     ]
-}
-
-/// The number tokens of text: maximal runs of `[-+.0-9eE]` holding a digit and not
-/// glued to a word on the left (so `Eval2` has none).
-fn number_tokens(b: &[u8]) -> Vec<(usize, usize)> {
-    let num = |c: u8| c.is_ascii_digit() || matches!(c, b'-' | b'+' | b'.' | b'e' | b'E');
-    let mut out = Vec::new();
-    let mut i = 0;
-    while i < b.len() {
-        if num(b[i]) && (i == 0 || !(b[i - 1].is_ascii_alphanumeric() || b[i - 1] == b'_')) {
-            let s = i;
-            while i < b.len() && num(b[i]) {
-                i += 1;
-            }
-            if b[s..i].iter().any(u8::is_ascii_digit) {
-                out.push((s, i));
-            }
-        } else {
-            i += 1;
-        }
-    }
-    out
-}
-
-/// The end of the JSON string starting at `i` (a `"`).
-fn skip_string(b: &[u8], mut i: usize) -> usize {
-    i += 1;
-    while i < b.len() {
-        match b[i] {
-            b'\\' => i += 2,
-            b'"' => return i + 1,
-            _ => i += 1,
-        }
-    }
-    b.len()
-}
-
-/// The end of the JSON value starting at `i` (roughly, for broken input too).
-fn skip_value(b: &[u8], mut i: usize) -> usize {
-    match b.get(i) {
-        None => i,
-        Some(b'"') => skip_string(b, i),
-        Some(b'{' | b'[') => {
-            let mut depth = 0usize;
-            while i < b.len() {
-                match b[i] {
-                    b'"' => {
-                        i = skip_string(b, i);
-                        continue;
-                    }
-                    b'{' | b'[' => depth += 1,
-                    b'}' | b']' => {
-                        depth = depth.saturating_sub(1);
-                        if depth == 0 {
-                            return i + 1;
-                        }
-                    }
-                    _ => {}
-                }
-                i += 1;
-            }
-            i
-        }
-        Some(_) => {
-            while i < b.len() && !matches!(b[i], b',' | b']' | b'}') && !b[i].is_ascii_whitespace()
-            {
-                i += 1;
-            }
-            i
-        }
-    }
-}
-
-/// Every `"key": value` of JSON text: (key start, value start, value end).
-fn json_members(b: &[u8]) -> Vec<(usize, usize, usize)> {
-    let mut out = Vec::new();
-    let mut i = 0;
-    while i < b.len() {
-        if b[i] == b'"' {
-            let end = skip_string(b, i);
-            let mut j = end;
-            while j < b.len() && b[j].is_ascii_whitespace() {
-                j += 1;
-            }
-            if b.get(j) == Some(&b':') {
-                j += 1;
-                while j < b.len() && b[j].is_ascii_whitespace() {
-                    j += 1;
-                }
-                out.push((i, j, skip_value(b, j)));
-            }
-            i = end;
-        } else {
-            i += 1;
-        }
-    }
-    out
 }
 
 fn varint(mut v: u64) -> Vec<u8> {
