@@ -194,6 +194,71 @@ pub fn json_values(b: &[u8]) -> Vec<(usize, usize)> {
     out
 }
 
+/// JSON text without its member `k` (reduced modulo the members; none: unchanged) and
+/// the comma after it, or else the one before it.
+pub fn delete_member(b: &mut Vec<u8>, k: usize) {
+    let members = json_members(b);
+    if members.is_empty() {
+        return;
+    }
+    let (key, _, ve) = members[k % members.len()];
+    let mut end = ve;
+    while end < b.len() && b[end].is_ascii_whitespace() {
+        end += 1;
+    }
+    let mut start = key;
+    if b.get(end) == Some(&b',') {
+        end += 1;
+    } else if let Some(c) = b[..key].iter().rposition(|&c| c == b',') {
+        if b[c + 1..key].iter().all(u8::is_ascii_whitespace) {
+            start = c;
+        }
+    }
+    b.drain(start..end);
+}
+
+/// JSON text with its member `k` (reduced modulo the members; none: unchanged) written
+/// twice, on one line (so JSON Lines records stay one line).
+pub fn duplicate_member(b: &mut Vec<u8>, k: usize) {
+    let members = json_members(b);
+    if members.is_empty() {
+        return;
+    }
+    let (key, _, ve) = members[k % members.len()];
+    let mut copy = b[key..ve].to_vec();
+    copy.extend_from_slice(b", ");
+    b.splice(key..key, copy);
+}
+
+/// Checks a refusal's place in `text`: a 1-based `line` and `column` inside it, or else
+/// (neither given) a JSON path (`has_field`) naming the value at fault.
+pub fn check_text_location(
+    text: &str,
+    line: Option<u64>,
+    column: Option<u64>,
+    has_field: bool,
+) -> Result<(), TestCaseError> {
+    let (Some(line), Some(column)) = (line, column) else {
+        prop_assert!(
+            line.is_none() && column.is_none(),
+            "a line without a column"
+        );
+        prop_assert!(has_field, "unlocated");
+        return Ok(());
+    };
+    let lines = text.split('\n').count() as u64;
+    prop_assert!(
+        line >= 1 && line <= lines,
+        "line {line} past the last ({lines})"
+    );
+    let len = text.split('\n').nth(line as usize - 1).map_or(0, str::len) as u64;
+    prop_assert!(
+        column >= 1 && column <= len + 1,
+        "column {column} past the end of line {line} ({len} bytes)"
+    );
+    Ok(())
+}
+
 /// `b` mutated by `m`; a splice takes its tail from one of `pool`.
 pub fn apply(pool: &[String], mut b: Vec<u8>, m: &Mutation) -> Vec<u8> {
     let len = b.len();
@@ -224,35 +289,8 @@ pub fn apply(pool: &[String], mut b: Vec<u8>, m: &Mutation) -> Vec<u8> {
                 b.splice(s..e, EXTREMES[x % EXTREMES.len()].bytes());
             }
         }
-        Mutation::DeleteKey(k) => {
-            let members = json_members(&b);
-            if !members.is_empty() {
-                let (key, _, ve) = members[k % members.len()];
-                // with the comma after it, or else the one before it
-                let mut end = ve;
-                while end < len && b[end].is_ascii_whitespace() {
-                    end += 1;
-                }
-                let mut start = key;
-                if b.get(end) == Some(&b',') {
-                    end += 1;
-                } else if let Some(c) = b[..key].iter().rposition(|&c| c == b',') {
-                    if b[c + 1..key].iter().all(u8::is_ascii_whitespace) {
-                        start = c;
-                    }
-                }
-                b.drain(start..end);
-            }
-        }
-        Mutation::DuplicateKey(k) => {
-            let members = json_members(&b);
-            if !members.is_empty() {
-                let (key, _, ve) = members[k % members.len()];
-                let mut copy = b[key..ve].to_vec();
-                copy.extend_from_slice(b",\n");
-                b.splice(key..key, copy);
-            }
-        }
+        Mutation::DeleteKey(k) => delete_member(&mut b, k),
+        Mutation::DuplicateKey(k) => duplicate_member(&mut b, k),
         Mutation::Wrap(k) => {
             let values = json_values(&b);
             if !values.is_empty() {

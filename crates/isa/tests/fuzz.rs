@@ -14,7 +14,9 @@
 //! `valid_traces_with_extreme_operands` 512 (× 3), `mutated_golden_traces` 3072 (about
 //! 1024 per encoding), `file_reader` 64 (temp files), and one fixed test.
 
-use cwisim_fuzzing::{config, json_members, number_tokens, EXTREMES, TIME_BOUND};
+use cwisim_fuzzing::{
+    config, delete_member, duplicate_member, json_members, number_tokens, EXTREMES, TIME_BOUND,
+};
 use cwisim_isa::io::read_all;
 use cwisim_isa::{Encoding, FileReader, Instruction, Location, TraceError, TraceHeader};
 use proptest::prelude::*;
@@ -281,30 +283,11 @@ fn apply(enc: Encoding, mut b: Vec<u8>, m: &Mutation) -> Vec<u8> {
             if members.is_empty() {
                 return b;
             }
-            let (key, vs, ve) = members[k % members.len()];
             match m {
-                Mutation::DeleteKey(_) => {
-                    // with the comma after it, or else the one before it
-                    let mut end = ve;
-                    while end < len && b[end].is_ascii_whitespace() {
-                        end += 1;
-                    }
-                    let mut start = key;
-                    if b.get(end) == Some(&b',') {
-                        end += 1;
-                    } else if let Some(c) = b[..key].iter().rposition(|&c| c == b',') {
-                        if b[c + 1..key].iter().all(u8::is_ascii_whitespace) {
-                            start = c;
-                        }
-                    }
-                    b.drain(start..end);
-                }
-                Mutation::DuplicateKey(_) => {
-                    let mut copy = b[key..ve].to_vec();
-                    copy.push(b',');
-                    b.splice(key..key, copy);
-                }
+                Mutation::DeleteKey(_) => delete_member(&mut b, k),
+                Mutation::DuplicateKey(_) => duplicate_member(&mut b, k),
                 _ => {
+                    let (_, vs, ve) = members[k % members.len()];
                     b.insert(ve, b']');
                     b.insert(vs, b'[');
                 }

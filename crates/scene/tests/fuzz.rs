@@ -11,7 +11,7 @@
 //! Cases per run (debug, 2 cores: about 3 s in all): `arbitrary_bytes` 512,
 //! `arbitrary_text` 512, `json_shaped_text` 512, `mutated_scenes` 2048.
 
-use cwisim_fuzzing::{apply, config, mutation, EXTREMES, TIME_BOUND};
+use cwisim_fuzzing::{apply, check_text_location, config, mutation, EXTREMES, TIME_BOUND};
 use cwisim_scene::{parse_scene, Scene, SceneError};
 use proptest::prelude::*;
 use std::path::Path;
@@ -52,26 +52,10 @@ fn check_error(text: &str, e: &SceneError) -> Result<(), TestCaseError> {
     );
     prop_assert!(e.path.is_none(), "{e:?}");
     // Located: a line and column, or at least the JSON path of the value at fault (the
-    // path alone happens when it cannot be found in the text, e.g. under a repeated key).
-    let (Some(line), Some(column)) = (e.line, e.column) else {
-        prop_assert!(e.line.is_none() && e.column.is_none(), "{e:?}");
-        prop_assert!(
-            e.field.as_deref().is_some_and(|f| !f.is_empty()),
-            "unlocated: {e:?}"
-        );
-        return Ok(());
-    };
-    let lines = text.split('\n').count() as u64;
-    prop_assert!(
-        line >= 1 && line <= lines,
-        "{e:?}: past the last line ({lines})"
-    );
-    let len = text.split('\n').nth(line as usize - 1).map_or(0, str::len) as u64;
-    prop_assert!(
-        column >= 1 && column <= len + 1,
-        "{e:?}: past the end of line {line} ({len} bytes)"
-    );
-    Ok(())
+    // path alone happens when it cannot be found in the text).
+    let has_field = e.field.as_deref().is_some_and(|f| !f.is_empty());
+    check_text_location(text, e.line, e.column, has_field)
+        .map_err(|f| TestCaseError::fail(format!("{f}: {e:?}")))
 }
 
 /// Reads `text` and checks every property; returns whether it was accepted.

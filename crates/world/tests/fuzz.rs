@@ -16,7 +16,7 @@
 //! `arbitrary_text` 512, `mutated_scenes` 2048, `mutated_obj_files` 768 (temp files), and
 //! two fixed tests.
 
-use cwisim_fuzzing::{apply, config, mutation, TIME_BOUND};
+use cwisim_fuzzing::{apply, check_text_location, config, mutation, TIME_BOUND};
 use cwisim_scene::SceneError;
 use cwisim_world::{parse_any, AnyScene};
 use proptest::prelude::*;
@@ -103,25 +103,9 @@ fn check_message(_text: &str, e: &SceneError) -> Result<(), TestCaseError> {
 /// Checks that `e` is located in `text` (a line and column within it), or else names
 /// the JSON path at fault.
 fn check_located(text: &str, e: &SceneError) -> Result<(), TestCaseError> {
-    let (Some(line), Some(column)) = (e.line, e.column) else {
-        prop_assert!(e.line.is_none() && e.column.is_none(), "{e:?}");
-        prop_assert!(
-            e.field.as_deref().is_some_and(|f| !f.is_empty()),
-            "unlocated: {e:?}"
-        );
-        return Ok(());
-    };
-    let lines = text.split('\n').count() as u64;
-    prop_assert!(
-        line >= 1 && line <= lines,
-        "{e:?}: past the last line ({lines})"
-    );
-    let len = text.split('\n').nth(line as usize - 1).map_or(0, str::len) as u64;
-    prop_assert!(
-        column >= 1 && column <= len + 1,
-        "{e:?}: past the end of line {line} ({len} bytes)"
-    );
-    Ok(())
+    let has_field = e.field.as_deref().is_some_and(|f| !f.is_empty());
+    check_text_location(text, e.line, e.column, has_field)
+        .map_err(|f| TestCaseError::fail(format!("{f}: {e:?}")))
 }
 
 /// Reads `text` (OBJ files relative to the temporary directory; `obj` is the file and
