@@ -1,10 +1,12 @@
 //! How a scene is drawn, as the command line says it: `--renderer`, `--shading`, `--aa`,
-//! `--visibility`, `--eval0-tolerance`, `--size` — one flattened group shared by
+//! `--visibility`, `--eval0-tolerance`, `--size`, the supersampling renderers' `--samples`,
+//! `--grid`, `--merge-subscanlines`, `--shade-p`, `--shade-contrast`, `--seed` — one flattened group shared by
 //! `render`, `emit`, `stats` and `fit`, converted into `cwisim-render`'s plain
 //! [`Settings`].
 
 use crate::error::CliError;
 use clap::{Args, ValueEnum};
+use cwisim_render::subsample::Grid;
 use cwisim_render::{registry, LoadedScene, Renderer, Settings, Size, Source};
 use cwisim_scene::{Antialias, Shading};
 use cwisim_world::Visibility;
@@ -46,6 +48,28 @@ pub enum VisibilityArg {
     /// The array's own way: whole triangles front to back, each claiming the pixels it
     /// fully covers with Eval0; edge pixels are approximate.
     Eval0,
+}
+
+/// `--grid`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum GridArg {
+    /// l×l samples at the centres of an l×l subdivision of the pixel (at --samples 1, the
+    /// pixel centre: point sampling).
+    #[default]
+    Centre,
+    /// Woo & Chall's shared grid: l×l samples on the pixel's corners, edges and inside,
+    /// trapezoid weights; samples on a pixel's edge are shared with the neighbour, so
+    /// each pixel costs (l−1)² new samples. Needs --samples 2 or more.
+    Corner,
+}
+
+impl From<GridArg> for Grid {
+    fn from(g: GridArg) -> Grid {
+        match g {
+            GridArg::Centre => Grid::Centre,
+            GridArg::Corner => Grid::Corner,
+        }
+    }
 }
 
 impl From<ShadingArg> for Shading {
@@ -110,6 +134,41 @@ pub struct DrawArgs {
     /// the scene says.
     #[arg(long, value_name = "N")]
     pub tessellate: Option<u32>,
+    /// Supersampling renderers (woo-chall): samples per pixel side, an L×L grid per pixel
+    /// (1 to 64).
+    #[arg(
+        long,
+        value_name = "L",
+        default_value_t = 3,
+        help_heading = "Supersampling (woo-chall)"
+    )]
+    pub samples: u32,
+    /// Where a pixel's samples lie.
+    #[arg(long, value_enum, default_value_t = GridArg::Centre, help_heading = "Supersampling (woo-chall)")]
+    pub grid: GridArg,
+    /// Sum a row's L sub-scanlines on the host and send one pass per row, instead of one
+    /// pass per sub-scanline that the array accumulates (the hardware way: its cost grows
+    /// with L).
+    #[arg(long, help_heading = "Supersampling (woo-chall)")]
+    pub merge_subscanlines: bool,
+    /// Probability of a stochastic shading call at a sample whose surface the pixel has
+    /// shaded already [default: the paper's (L−1)/(L²−1)].
+    #[arg(long, value_name = "P", help_heading = "Supersampling (woo-chall)")]
+    pub shade_p: Option<f64>,
+    /// Colour difference (any channel) between a shading call and the pixel's previous
+    /// sample, its left or right neighbour or the row above, beyond which the pixel and
+    /// that neighbour shade every later sample; `inf` never forces.
+    #[arg(
+        long,
+        value_name = "T",
+        default_value_t = 0.1,
+        help_heading = "Supersampling (woo-chall)"
+    )]
+    pub shade_contrast: f64,
+    /// Seed of every random choice (woo-chall's stochastic shading calls): the same seed
+    /// gives the same stream.
+    #[arg(long, value_name = "S", default_value_t = 0)]
+    pub seed: u64,
 }
 
 impl Default for DrawArgs {
@@ -123,6 +182,12 @@ impl Default for DrawArgs {
             size: None,
             shade_tolerance: 1.0 / 512.0,
             tessellate: None,
+            samples: 3,
+            grid: GridArg::Centre,
+            merge_subscanlines: false,
+            shade_p: None,
+            shade_contrast: 0.1,
+            seed: 0,
         }
     }
 }
@@ -150,6 +215,12 @@ impl DrawArgs {
             size: self.size,
             shade_tolerance: self.shade_tolerance,
             tessellate: self.tessellate,
+            samples: self.samples,
+            grid: self.grid.into(),
+            merge_subscanlines: self.merge_subscanlines,
+            shade_p: self.shade_p,
+            shade_contrast: self.shade_contrast,
+            seed: self.seed,
         }
     }
 

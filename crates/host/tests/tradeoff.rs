@@ -74,8 +74,15 @@ fn tradeoff_measures_against_the_exact_image_and_marks_the_pareto_front() {
     );
     assert!(out.contains("pareto"), "{out}");
     let (header, rows) = read_csv(&dir.join("t.csv"));
-    // a screen scene: shading × aa × formats
-    assert_eq!(rows.len(), 2 * 2 * 3);
+    // a screen scene: vanrij's shading × aa × formats, then woo-chall's shading ×
+    // samples × formats
+    assert_eq!(rows.len(), 2 * 2 * 3 + 2 * 4 * 3);
+    assert_eq!(
+        rows.iter()
+            .filter(|r| r.get(&header, "renderer") == "woo-chall")
+            .count(),
+        2 * 4 * 3
+    );
     // the f64, Gouraud, box-filter row against an independent computation of the same
     // error: the array's image (render --npy) against the exact box filter
     cwisim_ok(&dir, &["render", "fig25", "-q", "--npy", "f.npy"]);
@@ -91,7 +98,8 @@ fn tradeoff_measures_against_the_exact_image_and_marks_the_pareto_front() {
     let row = rows
         .iter()
         .find(|r| {
-            r.get(&header, "shading") == "gouraud"
+            r.get(&header, "renderer") == "vanrij"
+                && r.get(&header, "shading") == "gouraud"
                 && r.get(&header, "aa") == "box"
                 && r.get(&header, "numeric") == "f64"
         })

@@ -20,7 +20,10 @@
 //!   trapezium row sent through the span fitter (`vanrij --shading phong`).
 //! * [`span`] — the span fitter: per-pixel targets over a run sent as the fewest
 //!   `Eval1`/`Eval2`/`Eval3` pieces within a tolerance, for renderers that shade per pixel.
+//! * [`subsample`] — the sub-scanline sampler: an `l × l` grid per pixel (centres, or the
+//!   shared corner grid), positions and weights, for every renderer that supersamples.
 //! * [`vanrij`] — van Rij's DO_FILL (`cwisim-ypipe`), the first renderer and the default.
+//! * [`woochall`] — Woo & Chall's point-sampled scanline visibility (`woo-chall`).
 //!
 //! ```
 //! use cwisim_render::{registry, render, ArrayConfig, Settings, Source, Taps};
@@ -48,7 +51,9 @@ pub mod renderer;
 pub mod settings;
 pub mod source;
 pub mod span;
+pub mod subsample;
 pub mod vanrij;
+pub mod woochall;
 
 pub use error::RenderError;
 pub use pipeline::{emit, render, ArrayConfig, Rendered, Taps};

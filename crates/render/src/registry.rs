@@ -18,17 +18,29 @@ pub struct Entry {
     pub about: &'static str,
     /// Makes the renderer of a scene under settings.
     pub build: Build,
+    /// It samples each pixel on an `l × l` grid (`Settings::samples`, `grid`, …) and
+    /// resolves visibility itself: `Settings::aa` and `visibility` do not apply to it.
+    pub supersampled: bool,
 }
 
 /// The renderer used when none is named.
 pub const DEFAULT_RENDERER: &str = "vanrij";
 
 /// Every renderer, the default first.
-pub const REGISTRY: &[Entry] = &[Entry {
-    name: "vanrij",
-    about: crate::vanrij::ABOUT,
-    build: crate::vanrij::VanRij::build,
-}];
+pub const REGISTRY: &[Entry] = &[
+    Entry {
+        name: "vanrij",
+        about: crate::vanrij::ABOUT,
+        build: crate::vanrij::VanRij::build,
+        supersampled: false,
+    },
+    Entry {
+        name: "woo-chall",
+        about: crate::woochall::ABOUT,
+        build: crate::woochall::WooChall::build,
+        supersampled: true,
+    },
+];
 
 /// The registered names, in order.
 pub fn names() -> Vec<&'static str> {

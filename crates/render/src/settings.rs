@@ -1,6 +1,7 @@
 //! How to draw: the settings every renderer reads, in plain types (the command line's
 //! argument groups convert into them; nothing here knows about clap).
 
+use crate::subsample::Grid;
 use cwisim_scene::{Antialias, Shading};
 use cwisim_world::Visibility;
 use std::fmt;
@@ -59,6 +60,21 @@ pub struct Settings {
     pub shade_tolerance: f64,
     /// Tessellate Bézier meshes `n` × `n` per patch instead of as the scene says.
     pub tessellate: Option<u32>,
+    /// Supersampling renderers: samples per pixel side (`l`: an `l × l` grid).
+    pub samples: u32,
+    /// Supersampling renderers: where the samples lie.
+    pub grid: Grid,
+    /// Supersampling renderers: the host sums a row's sub-scanlines into one pass,
+    /// rather than sending each as a pass the array accumulates.
+    pub merge_subscanlines: bool,
+    /// Woo & Chall: probability of a stochastic shading call (`None`: the paper's
+    /// `(l − 1)/(l² − 1)`).
+    pub shade_p: Option<f64>,
+    /// Woo & Chall: colour difference between shading calls above which a pixel and
+    /// its neighbour are forced to shade every sample (infinite: never).
+    pub shade_contrast: f64,
+    /// Seed of every random choice a renderer makes.
+    pub seed: u64,
 }
 
 impl Default for Settings {
@@ -71,6 +87,12 @@ impl Default for Settings {
             size: None,
             shade_tolerance: 1.0 / 512.0,
             tessellate: None,
+            samples: 3,
+            grid: Grid::Centre,
+            merge_subscanlines: false,
+            shade_p: None,
+            shade_contrast: 0.1,
+            seed: 0,
         }
     }
 }
@@ -88,6 +110,19 @@ impl Settings {
             return Err(format!(
                 "--shade-tolerance must be a finite number ≥ 0, found {}",
                 self.shade_tolerance
+            ));
+        }
+        if let Some(p) = self.shade_p {
+            if !(0.0..=1.0).contains(&p) {
+                return Err(format!(
+                    "--shade-p must be a probability in [0, 1], found {p}"
+                ));
+            }
+        }
+        if self.shade_contrast.is_nan() || self.shade_contrast < 0.0 {
+            return Err(format!(
+                "--shade-contrast must be a number ≥ 0 (inf: never force), found {}",
+                self.shade_contrast
             ));
         }
         Ok(())

@@ -40,8 +40,10 @@ pub struct Row {
     pub renderer: &'static str,
     /// `flat`, `gouraud` or `phong`.
     pub shading: &'static str,
-    /// `none` or `box`.
+    /// `none` or `box` (`-` for a supersampling renderer).
     pub aa: &'static str,
+    /// Samples per pixel side of a supersampling renderer (its grid is `l × l`).
+    pub samples: Option<u32>,
     /// `exact`, `eval0`, or `-` (screen scenes).
     pub visibility: &'static str,
     /// Quads per Bézier patch side (scenes with Bézier meshes, when the grid varies it).
@@ -86,6 +88,10 @@ pub struct Setting {
     pub numeric: Numeric,
 }
 
+/// Samples per pixel side tried for a supersampling renderer: from point sampling to
+/// 64 samples per pixel, enough to see the error fall as `l` grows.
+pub const SAMPLES_AXIS: [u32; 4] = [1, 2, 4, 8];
+
 /// The axes of the grid besides the renderers and the numeric formats.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Axes {
@@ -99,7 +105,8 @@ pub struct Axes {
 
 /// The settings of the grid, in order: renderer, tessellation (scenes with Bézier
 /// meshes), visibility (world scenes), shading (Phong on world scenes with exact
-/// visibility), anti-aliasing and numeric format.
+/// visibility), anti-aliasing and numeric format. A supersampling renderer resolves
+/// visibility itself and samples instead of filtering: its axis is [`SAMPLES_AXIS`].
 pub fn grid(
     renderers: &[&'static registry::Entry],
     axes: &Axes,
@@ -117,6 +124,31 @@ pub fn grid(
         axes.tessellations.iter().map(|&n| Some(n)).collect()
     };
     for &renderer in renderers {
+        if renderer.supersampled {
+            for &tessellate in &tessellations {
+                for shading in [Shading::Phong, Shading::Gouraud, Shading::Flat] {
+                    if shading == Shading::Phong && !axes.world {
+                        continue;
+                    }
+                    for samples in SAMPLES_AXIS {
+                        for numeric in formats {
+                            out.push(Setting {
+                                renderer,
+                                settings: Settings {
+                                    shading,
+                                    samples,
+                                    size: axes.size,
+                                    tessellate,
+                                    ..Settings::default()
+                                },
+                                numeric: *numeric,
+                            });
+                        }
+                    }
+                }
+            }
+            continue;
+        }
         for &tessellate in &tessellations {
             for &visibility in visibilities {
                 for shading in [Shading::Phong, Shading::Gouraud, Shading::Flat] {
@@ -360,8 +392,17 @@ pub fn tradeoff_rows(
         rows.push(Row {
             renderer: setting.renderer.name,
             shading: s.shading.name(),
-            aa: s.aa.name(),
-            visibility: if axes.world { s.visibility.name() } else { "-" },
+            aa: if setting.renderer.supersampled {
+                "-"
+            } else {
+                s.aa.name()
+            },
+            samples: setting.renderer.supersampled.then_some(s.samples),
+            visibility: if axes.world && !setting.renderer.supersampled {
+                s.visibility.name()
+            } else {
+                "-"
+            },
             tessellate: s.tessellate,
             numeric: short_numeric(&setting.numeric),
             register_bits: register_bits(&setting.numeric),
@@ -396,17 +437,18 @@ pub fn write_table(out: &mut dyn Write, rows: &[Row]) -> std::io::Result<()> {
         .unwrap_or(8);
     writeln!(
         out,
-        "{:<rw$} {:>4} {:<8} {:<4} {:<5} {:<34} {:>4} {:>8} {:>9} {:>6} {:>4} {:>8} {:>9} {:>9} {:>6} {:>5}  pareto",
-        "renderer", "tess", "shading", "aa", "vis", "numeric", "bits", "instr", "busy cyc", "worst", "late", "host ms", "max err", "RMS err", "PSNR", "ovfl"
+        "{:<rw$} {:>4} {:<8} {:<4} {:>2} {:<5} {:<34} {:>4} {:>8} {:>9} {:>6} {:>4} {:>8} {:>9} {:>9} {:>6} {:>5}  pareto",
+        "renderer", "tess", "shading", "aa", "l", "vis", "numeric", "bits", "instr", "busy cyc", "worst", "late", "host ms", "max err", "RMS err", "PSNR", "ovfl"
     )?;
     for r in rows {
         writeln!(
             out,
-            "{:<rw$} {:>4} {:<8} {:<4} {:<5} {:<34} {:>4} {:>8} {:>9} {:>5.1}% {:>4} {:>8.2} {:>9.2e} {:>9.2e} {:>6} {:>5}  {}",
+            "{:<rw$} {:>4} {:<8} {:<4} {:>2} {:<5} {:<34} {:>4} {:>8} {:>9} {:>5.1}% {:>4} {:>8.2} {:>9.2e} {:>9.2e} {:>6} {:>5}  {}",
             r.renderer,
             r.tessellate.map_or_else(|| "-".to_string(), |n| n.to_string()),
             r.shading,
             r.aa,
+            r.samples.map_or_else(|| "-".to_string(), |n| n.to_string()),
             r.visibility,
             r.numeric,
             r.register_bits,
@@ -442,7 +484,7 @@ pub fn csv(rows: &[Row]) -> String {
         }
     }
     let mut s = String::from(
-        "renderer,tessellate,shading,aa,visibility,numeric,register_bits,instructions,busy_cycles,worst_line_share,late_lines,host_ms,max_error,rms_error,psnr_db,overflows,pareto",
+        "renderer,tessellate,shading,aa,samples,visibility,numeric,register_bits,instructions,busy_cycles,worst_line_share,late_lines,host_ms,max_error,rms_error,psnr_db,overflows,pareto",
     );
     for name in &names {
         s.push_str(",counter_");
@@ -451,11 +493,12 @@ pub fn csv(rows: &[Row]) -> String {
     s.push('\n');
     for r in rows {
         s.push_str(&format!(
-            "{},{},{},{},{},\"{}\",{},{},{},{},{},{},{:e},{:e},{},{},{}",
+            "{},{},{},{},{},{},\"{}\",{},{},{},{},{},{},{:e},{:e},{},{},{}",
             r.renderer,
             r.tessellate.map_or_else(String::new, |n| n.to_string()),
             r.shading,
             r.aa,
+            r.samples.map_or_else(String::new, |n| n.to_string()),
             r.visibility,
             r.numeric,
             r.register_bits,
@@ -490,6 +533,7 @@ mod tests {
             renderer: "r",
             shading: "gouraud",
             aa: "box",
+            samples: None,
             visibility: "exact",
             tessellate: None,
             numeric: "f64".into(),

@@ -70,10 +70,13 @@ impl ScreenTriangle {
     }
 
     /// The intensity at screen point `p` (affine; extrapolated outside the triangle).
+    /// Evaluated as `I₀ + w₁(I₁ − I₀) + w₂(I₂ − I₀)`, so a flat triangle's intensity is
+    /// its vertices' exactly, wherever it is taken.
     pub fn intensity_at(&self, p: [f64; 2], channels: usize) -> Option<Vector> {
         let w = self.barycentric(p)?;
-        Some(cwisim_scene::vector(channels, |c| {
-            w[0] * self.intensity[0][c] + w[1] * self.intensity[1][c] + w[2] * self.intensity[2][c]
+        let [a, b, c] = &self.intensity;
+        Some(cwisim_scene::vector(channels, |k| {
+            a[k] + w[1] * (b[k] - a[k]) + w[2] * (c[k] - a[k])
         }))
     }
 }

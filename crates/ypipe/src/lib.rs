@@ -115,9 +115,12 @@ pub fn scene_trapezia(scene: &ScreenScene) -> Vec<trapezoid::Trapezium> {
 }
 
 fn flat_intensity(p: &cwisim_scene::Polygon, channels: usize) -> [f64; MAX_CHANNELS] {
+    // the mean, as the first value plus the mean difference from it: a polygon whose
+    // vertices agree (a lit face) keeps their value exactly
     let n = p.intensity.len().max(1) as f64;
-    trapezoid::vector(channels, |c| {
-        p.intensity.iter().map(|v| v[c]).sum::<f64>() / n
+    trapezoid::vector(channels, |c| match p.intensity.first() {
+        Some(first) => first[c] + p.intensity.iter().map(|v| v[c] - first[c]).sum::<f64>() / n,
+        None => 0.0,
     })
 }
 

@@ -1,0 +1,183 @@
+//! Triangles from any scene. A world scene is projected and lit (per vertex for
+//! Gouraud, per face for flat; Phong keeps the world corners and normals and lights per
+//! sample) with back faces culled — no hidden-surface removal: the samples resolve it.
+//! A screen scene's polygons are triangulated (ear clipping, the `earcut` crate); a
+//! polygon's `depth`, when the scene carries it, is its nearness (smaller depth nearer),
+//! and without depth a later polygon lies in front of an earlier one (painting order).
+
+use super::triangle::Tri;
+use crate::error::RenderError;
+use crate::source::{LoadedScene, Source};
+use cwisim_isa::TraceHeader;
+use cwisim_scene::{ScreenScene, Shading, Vector};
+use cwisim_world::face::ScreenTriangle;
+use cwisim_world::shade::PhongShader;
+use cwisim_world::{AnyScene, ProjectStats};
+use std::time::{Duration, Instant};
+
+/// The triangles of a scene, and what making them did.
+pub struct Triangles {
+    /// Where the scene came from.
+    pub source: Source,
+    /// `"screen"` or `"world"`.
+    pub kind: &'static str,
+    /// Image width, pixels.
+    pub width: u32,
+    /// Image height, pixels.
+    pub height: u32,
+    /// Channels.
+    pub channels: u8,
+    header: TraceHeader,
+    /// The triangles (zero-area ones dropped).
+    pub tris: Vec<Tri>,
+    /// With Phong shading: the projected triangles (`Tri::source` indexes them) and the
+    /// lighting.
+    pub phong: Option<(Vec<ScreenTriangle>, PhongShader)>,
+    /// What projection did (world scenes).
+    pub project: Option<ProjectStats>,
+    /// Polygons triangulated (screen scenes).
+    pub polygons: u64,
+    /// Wall time of reading the scene.
+    pub load_time: Duration,
+    /// Wall time of projection and lighting, or triangulation.
+    pub transform_time: Duration,
+}
+
+impl Triangles {
+    /// The triangles of `loaded`, lit for `shading`.
+    pub fn new(loaded: LoadedScene, shading: Shading) -> Result<Triangles, RenderError> {
+        let start = Instant::now();
+        let kind = loaded.scene.kind();
+        let (mut project, mut phong, mut polygons) = (None, None, 0);
+        let (width, height, channels, tris) = match loaded.scene {
+            AnyScene::Screen(s) => {
+                if shading == Shading::Phong {
+                    return Err(RenderError::Usage(
+                        "Phong shading needs a world scene (normals in 3D); a screen scene has only intensities: use --shading gouraud or flat".into(),
+                    ));
+                }
+                polygons = s.polygons.len() as u64;
+                (s.width, s.height, s.channels, screen_triangles(&s))
+            }
+            AnyScene::World(w) => {
+                let (screen, stats) = cwisim_world::project::project(&w, shading)?;
+                let tris = screen
+                    .iter()
+                    .enumerate()
+                    .filter_map(|(k, t)| {
+                        Tri::new(t.points, t.inv_depth, t.intensity, t.mesh, k as u32)
+                    })
+                    .collect();
+                project = Some(stats);
+                if shading == Shading::Phong {
+                    phong = Some((screen, PhongShader::new(&w)));
+                }
+                (w.width(), w.height(), w.channels() as u8, tris)
+            }
+        };
+        let header = TraceHeader::new(width, height, channels)
+            .map_err(|e| RenderError::Usage(format!("the scene does not fit the array: {e}")))?;
+        Ok(Triangles {
+            source: loaded.source,
+            kind,
+            width,
+            height,
+            channels,
+            header,
+            tris,
+            phong,
+            project,
+            polygons,
+            load_time: loaded.load_time,
+            transform_time: start.elapsed(),
+        })
+    }
+
+    /// The array it draws into.
+    pub fn header(&self) -> TraceHeader {
+        self.header
+    }
+
+    /// One shading call: the colour of `tri` at `(x, y)`.
+    pub fn shade(&self, tri: &Tri, x: f64, y: f64) -> Vector {
+        let channels = usize::from(self.channels);
+        match &self.phong {
+            Some((tris, shader)) => {
+                let mut v = shader
+                    .at(&tris[tri.source as usize], [x, y])
+                    .unwrap_or_default();
+                for c in v.iter_mut() {
+                    *c = c.max(0.0);
+                }
+                v
+            }
+            None => tri.intensity_at(x, y, channels),
+        }
+    }
+
+    /// The summary's geometry row.
+    pub fn summary_rows(&self) -> Vec<(&'static str, String)> {
+        match &self.project {
+            Some(g) => vec![(
+                "geometry",
+                format!(
+                    "{} mesh(es), {} faces → {} triangles: {} back faces culled, {} drawn ({} back faces of two-sided meshes, {} edge-on dropped); no hidden-surface removal before sampling",
+                    g.meshes,
+                    g.faces,
+                    g.triangles,
+                    g.culled,
+                    g.triangles - g.culled - g.edge_on,
+                    g.back_faces_drawn,
+                    g.edge_on
+                ),
+            )],
+            None => vec![(
+                "geometry",
+                format!(
+                    "{} polygon(s) → {} triangles (ear clipping)",
+                    self.polygons,
+                    self.tris.len()
+                ),
+            )],
+        }
+    }
+
+    /// The scene part of `--stats-json`.
+    pub fn scene_json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "name": self.source.name(),
+            "kind": self.kind,
+            "triangles": self.tris.len(),
+            "project": self.project,
+        })
+    }
+}
+
+/// A screen scene's polygons as triangles.
+fn screen_triangles(s: &ScreenScene) -> Vec<Tri> {
+    let channels = s.channel_count();
+    let mut earcut = earcut::Earcut::new();
+    let mut indices: Vec<u32> = Vec::new();
+    let mut tris = Vec::new();
+    for (k, p) in s.polygons.iter().enumerate() {
+        earcut.earcut(p.vertices.iter().copied(), &[] as &[u32], &mut indices);
+        let near = |v: usize| match &p.depth {
+            Some(d) => -d[v],
+            None => k as f64,
+        };
+        let intensity = |v: usize| cwisim_scene::vector(channels, |c| p.intensity[v][c]);
+        for t in indices.chunks_exact(3) {
+            let v = [t[0] as usize, t[1] as usize, t[2] as usize];
+            if let Some(tri) = Tri::new(
+                v.map(|i| p.vertices[i]),
+                v.map(near),
+                v.map(intensity),
+                k as u32,
+                k as u32,
+            ) {
+                tris.push(tri);
+            }
+        }
+    }
+    tris
+}
