@@ -26,6 +26,9 @@ pub enum ShadingArg {
     /// triangle and lit at every pixel, each row sent through the span fitter
     /// (--shade-tolerance).
     Phong,
+    /// No shading calls (woo-chall only, the paper's "hidden" timing mode): 1 on the
+    /// visible triangles' edges, 0 elsewhere.
+    Hidden,
 }
 
 /// `--aa`.
@@ -78,6 +81,7 @@ impl From<ShadingArg> for Shading {
             ShadingArg::Flat => Shading::Flat,
             ShadingArg::Gouraud => Shading::Gouraud,
             ShadingArg::Phong => Shading::Phong,
+            ShadingArg::Hidden => Shading::Hidden,
         }
     }
 }

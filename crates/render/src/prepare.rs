@@ -72,6 +72,11 @@ impl PolygonScene {
             visibility_time: Duration::ZERO,
             phong: None,
         };
+        if settings.shading == Shading::Hidden {
+            return Err(RenderError::Usage(
+                "--shading hidden (edges of the visible triangles, no shading calls) is drawn by renderers that resolve visibility per sample: use --renderer woo-chall".into(),
+            ));
+        }
         let phong = settings.shading == Shading::Phong;
         match loaded.scene {
             AnyScene::Screen(_) if phong => {

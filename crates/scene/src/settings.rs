@@ -17,6 +17,11 @@ pub enum Shading {
     /// World scenes: the normal and the point interpolated (perspective-correctly) over
     /// each triangle and lit at every pixel, sent through the span fitter.
     Phong,
+    /// No shading at all (Woo & Chall's "hidden" mode, for timing visibility alone): a
+    /// sample is 1 where the visible triangle changes from its left or upper neighbour
+    /// (a visible edge), 0 elsewhere. Only renderers that resolve visibility per sample
+    /// draw it.
+    Hidden,
 }
 
 /// How a pixel's value is sampled from what covers it.
@@ -64,6 +69,7 @@ impl Named for Shading {
         (Shading::Flat, "flat"),
         (Shading::Gouraud, "gouraud"),
         (Shading::Phong, "phong"),
+        (Shading::Hidden, "hidden"),
     ];
 }
 
@@ -75,7 +81,12 @@ impl Named for Antialias {
 
 impl Shading {
     /// Every value, in order.
-    pub const ALL: [Shading; 3] = [Shading::Flat, Shading::Gouraud, Shading::Phong];
+    pub const ALL: [Shading; 4] = [
+        Shading::Flat,
+        Shading::Gouraud,
+        Shading::Phong,
+        Shading::Hidden,
+    ];
 
     /// Its one spelling: "flat", "gouraud" (the [`Display`](fmt::Display) form).
     pub fn name(self) -> &'static str {
@@ -88,6 +99,7 @@ impl Shading {
             Shading::Flat => "flat",
             Shading::Gouraud => "Gouraud",
             Shading::Phong => "Phong",
+            Shading::Hidden => "no (hidden-line)",
         }
     }
 }

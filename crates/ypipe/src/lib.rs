@@ -154,7 +154,9 @@ impl<'s> ScanPlan<'s> {
                     // Phong needs 3D normals per pixel, which screen polygons do not
                     // carry: `cwisim-render` draws it with its own emitter; here it is
                     // drawn as Gouraud, from the vertex intensities
-                    Shading::Gouraud | Shading::Phong => Shade::Gouraud,
+                    // hidden-line drawing is refused before a scene gets here (renderers that
+                    // resolve visibility per sample draw it)
+                    Shading::Gouraud | Shading::Phong | Shading::Hidden => Shade::Gouraud,
                 })
                 .collect(),
         }

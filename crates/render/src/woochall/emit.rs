@@ -179,6 +179,10 @@ fn send(
                     x += 1;
                 }
                 let run = &targets[start * ch..x * ch];
+                if run.iter().all(|&v| v == 0.0) {
+                    // nothing to add (a black surface, a hidden-line interior)
+                    continue;
+                }
                 let tolerance = match rule.tolerance {
                     // a pass's share of the row's tolerance
                     Some(t) => t / passes as f64,

@@ -109,6 +109,8 @@ impl WooChall {
         // the row's sub-scanlines; on the corner grid the first is the previous row's last
         let mut sublines: Vec<Subline> = vec![Subline::default(); l];
         let mut carried = false;
+        // the winners of the sub-scanline above (hidden-line drawing)
+        let mut above: Vec<u32> = Vec::new();
         for row in 0..t.height {
             let (first, _) = s.of_pixel(row);
             let start = if carried {
@@ -120,10 +122,15 @@ impl WooChall {
             for (o, sub) in sublines.iter_mut().enumerate().skip(start) {
                 let j = first + o;
                 lists.subline(j as u32, &mut sub.winners, &mut list_stats);
-                let y = s.subline_y(j);
-                shader.subline(y, &sub.winners, &t.tris, &mut sub.rgb, |tri, x, y| {
-                    t.shade(tri, x, y)
-                });
+                if self.shading == Shading::Hidden {
+                    shade::hidden_subline(&sub.winners, &above, channels, &mut sub.rgb);
+                } else {
+                    let y = s.subline_y(j);
+                    shader.subline(y, &sub.winners, &t.tris, &mut sub.rgb, |tri, x, y| {
+                        t.shade(tri, x, y)
+                    });
+                }
+                above.clone_from(&sub.winners);
             }
             shader.end_row();
             carried = s.grid == crate::subsample::Grid::Corner;

@@ -156,3 +156,39 @@ impl RowShader {
         }
     }
 }
+
+/// `--shading hidden` (§6: hidden-line removal, visibility without shading calls): a
+/// sample with geometry is 1 in every channel where its triangle differs from its left
+/// neighbour's or from the one above it (`above`: the previous sub-scanline's winners,
+/// empty at the top of the image), 0 elsewhere; the background is 0.
+pub fn hidden_subline(winners: &[u32], above: &[u32], channels: usize, rgb: &mut Vec<Vector>) {
+    rgb.clear();
+    rgb.resize(winners.len(), [0.0; cwisim_isa::MAX_CHANNELS]);
+    for (k, &w) in winners.iter().enumerate() {
+        if w == NONE {
+            continue;
+        }
+        let left = if k > 0 { winners[k - 1] } else { NONE };
+        let up = above.get(k).copied().unwrap_or(NONE);
+        if w != left || w != up {
+            rgb[k] = cwisim_scene::vector(channels, |_| 1.0);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hidden_lines_mark_where_the_triangle_changes() {
+        let n = NONE;
+        let mut rgb = Vec::new();
+        hidden_subline(&[n, 1, 1, 1, 2, 2], &[n, 1, 1, 2, 2, 2], 1, &mut rgb);
+        let got: Vec<f64> = rgb.iter().map(|v| v[0]).collect();
+        assert_eq!(got, [0.0, 1.0, 0.0, 1.0, 1.0, 0.0]);
+        // the top of the image: every sample with geometry is an edge
+        hidden_subline(&[1, 1], &[], 1, &mut rgb);
+        assert_eq!(rgb.iter().map(|v| v[0]).collect::<Vec<_>>(), [1.0, 1.0]);
+    }
+}
