@@ -157,7 +157,7 @@ mod tests {
         assert_eq!("GOURAUD".parse::<Shading>(), Ok(Shading::Gouraud));
         assert_eq!(
             "metal".parse::<Shading>().unwrap_err(),
-            "unknown shading `metal`; expected flat or gouraud or phong"
+            "unknown shading `metal`; expected flat or gouraud or phong or hidden"
         );
         assert_eq!(Antialias::Box.to_string(), "box");
     }
