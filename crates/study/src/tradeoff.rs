@@ -40,7 +40,7 @@ pub struct Row {
     pub renderer: &'static str,
     /// `flat`, `gouraud` or `phong`.
     pub shading: &'static str,
-    /// `none` or `box`.
+    /// `none`, `box` (exact) or `box-centre` (the report's coverage × centre value).
     pub aa: &'static str,
     /// `exact`, `eval0`, or `-` (screen scenes).
     pub visibility: &'static str,
@@ -99,7 +99,8 @@ pub struct Axes {
 
 /// The settings of the grid, in order: renderer, tessellation (scenes with Bézier
 /// meshes), visibility (world scenes), shading (Phong on world scenes with exact
-/// visibility), anti-aliasing and numeric format.
+/// visibility), anti-aliasing (`box`, `box-centre` with Gouraud shading, `none`) and numeric
+/// format.
 pub fn grid(
     renderers: &[&'static registry::Entry],
     axes: &Axes,
@@ -124,7 +125,12 @@ pub fn grid(
                     {
                         continue;
                     }
-                    for aa in [Antialias::Box, Antialias::None] {
+                    for aa in [Antialias::Box, Antialias::BoxCentre, Antialias::None] {
+                        // the report's box filter differs from the exact one only where
+                        // the intensity varies over a polygon: Gouraud
+                        if aa == Antialias::BoxCentre && shading != Shading::Gouraud {
+                            continue;
+                        }
                         for numeric in formats {
                             out.push(Setting {
                                 renderer,
@@ -518,8 +524,14 @@ mod tests {
             tessellations: vec![4, 8],
         };
         let g = grid(&[vanrij], &world, &f64_only);
-        // 2 tessellations × (exact: phong, gouraud, flat; eval0: gouraud, flat) × 2 aa
-        assert_eq!(g.len(), 2 * 5 * 2);
+        // 2 tessellations × (exact: phong, gouraud, flat; eval0: gouraud, flat) × 2 aa,
+        // and the report's box filter with Gouraud (exact and eval0)
+        assert_eq!(g.len(), 2 * (5 * 2 + 2));
+        let centre = g.iter().filter(|s| s.settings.aa == Antialias::BoxCentre);
+        assert!(centre
+            .clone()
+            .all(|s| s.settings.shading == Shading::Gouraud));
+        assert_eq!(centre.count(), 2 * 2);
         for s in &g {
             let st = &s.settings;
             assert!(st.shading != Shading::Phong || st.visibility == Visibility::Exact);
@@ -529,8 +541,8 @@ mod tests {
         let g = grid(&[vanrij], &screen, &f64_only);
         assert_eq!(
             g.len(),
-            2 * 2,
-            "no Phong, no eval0, no tessellation on a screen scene"
+            2 * 2 + 1,
+            "no Phong, no eval0, no tessellation on a screen scene; box-centre with Gouraud"
         );
         assert!(g
             .iter()
