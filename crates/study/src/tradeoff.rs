@@ -402,13 +402,13 @@ pub fn write_table(out: &mut dyn Write, rows: &[Row]) -> std::io::Result<()> {
         .unwrap_or(8);
     writeln!(
         out,
-        "{:<rw$} {:>4} {:<8} {:<4} {:<5} {:<34} {:>4} {:>8} {:>9} {:>6} {:>4} {:>8} {:>9} {:>9} {:>6} {:>5}  pareto",
+        "{:<rw$} {:>4} {:<8} {:<10} {:<5} {:<34} {:>4} {:>8} {:>9} {:>6} {:>4} {:>8} {:>9} {:>9} {:>6} {:>5}  pareto",
         "renderer", "tess", "shading", "aa", "vis", "numeric", "bits", "instr", "busy cyc", "worst", "late", "host ms", "max err", "RMS err", "PSNR", "ovfl"
     )?;
     for r in rows {
         writeln!(
             out,
-            "{:<rw$} {:>4} {:<8} {:<4} {:<5} {:<34} {:>4} {:>8} {:>9} {:>5.1}% {:>4} {:>8.2} {:>9.2e} {:>9.2e} {:>6} {:>5}  {}",
+            "{:<rw$} {:>4} {:<8} {:<10} {:<5} {:<34} {:>4} {:>8} {:>9} {:>5.1}% {:>4} {:>8.2} {:>9.2e} {:>9.2e} {:>6} {:>5}  {}",
             r.renderer,
             r.tessellate.map_or_else(|| "-".to_string(), |n| n.to_string()),
             r.shading,
