@@ -36,9 +36,13 @@ pub enum ShadingArg {
 pub enum AaArg {
     /// Point sampling at pixel centres.
     None,
-    /// Box filter: the exact covered area of every pixel (DO_FILL's twelve cases).
+    /// Box filter, exact: the integral of the intensity over every pixel's covered part
+    /// (DO_FILL's twelve cases).
     #[default]
     Box,
+    /// Box filter as van Rij's report computes it: the covered area times the intensity
+    /// at the pixel centre (the same instructions; with flat shading the same image).
+    BoxCentre,
 }
 
 /// `--visibility`.
@@ -91,6 +95,7 @@ impl From<AaArg> for Antialias {
         match a {
             AaArg::None => Antialias::None,
             AaArg::Box => Antialias::Box,
+            AaArg::BoxCentre => Antialias::BoxCentre,
         }
     }
 }

@@ -74,15 +74,37 @@ fn tradeoff_measures_against_the_exact_image_and_marks_the_pareto_front() {
     );
     assert!(out.contains("pareto"), "{out}");
     let (header, rows) = read_csv(&dir.join("t.csv"));
-    // a screen scene: vanrij's shading × aa × formats, then woo-chall's shading ×
+    // a screen scene: vanrij's (shading × aa, and box-centre with Gouraud) × formats, then woo-chall's shading ×
     // samples × formats
-    assert_eq!(rows.len(), 2 * 2 * 3 + 2 * 4 * 3);
+    assert_eq!(rows.len(), (2 * 2 + 1) * 3 + 2 * 4 * 3);
     assert_eq!(
         rows.iter()
             .filter(|r| r.get(&header, "renderer") == "woo-chall")
             .count(),
         2 * 4 * 3
     );
+    // the exact box filter and the report's: the same instructions and cycles, errors of
+    // rounding against the report's approximation
+    let gouraud_f64 = |aa: &str| {
+        rows.iter()
+            .find(|r| {
+                r.get(&header, "renderer") == "vanrij"
+                    && r.get(&header, "shading") == "gouraud"
+                    && r.get(&header, "aa") == aa
+                    && r.get(&header, "numeric") == "f64"
+            })
+            .unwrap_or_else(|| panic!("the Gouraud {aa} f64 row"))
+    };
+    let (exact_row, centre_row) = (gouraud_f64("box"), gouraud_f64("box-centre"));
+    for column in ["instructions", "busy_cycles"] {
+        assert_eq!(
+            exact_row.get(&header, column),
+            centre_row.get(&header, column)
+        );
+    }
+    let error = |r: &CsvRow| -> f64 { r.get(&header, "max_error").parse().unwrap() };
+    assert!(error(exact_row) < 1e-9, "{}", error(exact_row));
+    assert!(error(centre_row) > 1e-2, "{}", error(centre_row));
     // the f64, Gouraud, box-filter row against an independent computation of the same
     // error: the array's image (render --npy) against the exact box filter
     cwisim_ok(&dir, &["render", "fig25", "-q", "--npy", "f.npy"]);

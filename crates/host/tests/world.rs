@@ -25,7 +25,7 @@ fn the_default_render_is_the_pot_with_a_summary() {
     let out = cwisim_ok(&dir, &["render"]);
     assert!(dir.join("pot.png").exists(), "writes pot.png by default");
     for needle in [
-        "scene        pot (world, 400×400, grey): Gouraud shading, box filter, exact visibility",
+        "scene        pot (world, 400×400, grey): Gouraud shading, box filter (exact), exact visibility",
         "geometry     1 mesh(es), 480 faces → 928 triangles",
         "visibility   exact: ",
         "Y-processor  ",

@@ -13,7 +13,9 @@
 //!   of trapezia) so holds exactly the per-pixel Phong value at its centre; an edge pixel
 //!   holds, for each triangle that covers part of it, the covered area times that
 //!   triangle's shade at the point nearest the centre (the report's Gouraud box filter
-//!   does the same with the centre's Gouraud value: `docs/ERRATA.md`).
+//!   does the same with the centre's Gouraud value: `docs/ERRATA.md`). `--aa box` and
+//!   `--aa box-centre` are the same here: unlike the Gouraud function, the Phong shade
+//!   is not affine, and no instruction carries its exact integral over a pixel.
 //! * With point sampling the pixels are those whose centre lies in the row (the rule
 //!   every emitter shares, `cwisim_ypipe::dofill::sampled_span`), coverage 1.
 //!
@@ -73,7 +75,8 @@ impl<'a> PhongFrame<'a> {
         coverage.clear();
         let width = i64::from(self.screen.width);
         match self.aa {
-            Antialias::Box => {
+            // Phong's box filter is coverage × the shade at the centre either way
+            Antialias::Box | Antialias::BoxCentre => {
                 let slice = Slice::of(t, row)?;
                 let (l0, _, _, r1) = slice.edge_pixels();
                 let (first, last) = (l0.max(0), r1.min(width - 1));

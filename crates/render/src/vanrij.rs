@@ -10,6 +10,7 @@ use crate::renderer::{Counters, FramePlan, Renderer};
 use crate::settings::Settings;
 use crate::source::LoadedScene;
 use cwisim_isa::{TraceHeader, TraceWrite};
+use cwisim_scene::Antialias;
 use cwisim_world::Visibility;
 use cwisim_xproc::{Image, RunStats};
 use cwisim_ypipe::{emit_rows, header, Claim, EmitStats, Options, ScanPlan};
@@ -151,10 +152,14 @@ impl Renderer for VanRij {
             Some(_) => format!(" (span tolerance {})", self.shade_tolerance),
             None => String::new(),
         };
+        // Phong's box filter is coverage × the shade at the centre, whichever box
+        let aa = match self.scene.phong {
+            Some(_) if self.options.aa.is_box() => Antialias::BoxCentre.title(),
+            _ => self.options.aa.title(),
+        };
         format!(
-            "{} shading{fitted}, {}{visibility}",
+            "{} shading{fitted}, {aa}{visibility}",
             self.options.shading.title(),
-            self.options.aa.title()
         )
     }
 

@@ -29,9 +29,14 @@ pub enum Shading {
 pub enum Antialias {
     /// Point sampling at pixel centres.
     None,
-    /// Box filter: the exact covered area of every pixel.
+    /// Box filter, exact: every pixel holds the integral of the intensity over the
+    /// polygon's part of it (the covered area times the mean intensity there).
     #[default]
     Box,
+    /// Box filter as van Rij's report computes it: the exact covered area times the
+    /// intensity at the pixel centre (docs/ERRATA.md, D7). The same instructions as
+    /// [`Antialias::Box`]; it differs only where the intensity varies (Gouraud).
+    BoxCentre,
 }
 
 /// The names of a setting's values, in order, and the value of each.
@@ -75,8 +80,11 @@ impl Named for Shading {
 
 impl Named for Antialias {
     const WHAT: &'static str = "anti-aliasing";
-    const ALL: &'static [(Self, &'static str)] =
-        &[(Antialias::None, "none"), (Antialias::Box, "box")];
+    const ALL: &'static [(Self, &'static str)] = &[
+        (Antialias::None, "none"),
+        (Antialias::Box, "box"),
+        (Antialias::BoxCentre, "box-centre"),
+    ];
 }
 
 impl Shading {
@@ -106,19 +114,27 @@ impl Shading {
 
 impl Antialias {
     /// Every value, in order.
-    pub const ALL: [Antialias; 2] = [Antialias::None, Antialias::Box];
+    pub const ALL: [Antialias; 3] = [Antialias::None, Antialias::Box, Antialias::BoxCentre];
 
-    /// Its one spelling: "none", "box" (the [`Display`](fmt::Display) form).
+    /// Its one spelling: "none", "box", "box-centre" (the [`Display`](fmt::Display)
+    /// form).
     pub fn name(self) -> &'static str {
         Named::name(self)
     }
 
-    /// How a summary says it: "point sampling" or "box filter".
+    /// How a summary says it: "point sampling", "box filter (exact)" or "box filter
+    /// (coverage × centre value)".
     pub fn title(self) -> &'static str {
         match self {
             Antialias::None => "point sampling",
-            Antialias::Box => "box filter",
+            Antialias::Box => "box filter (exact)",
+            Antialias::BoxCentre => "box filter (coverage × centre value)",
         }
+    }
+
+    /// A box filter, exact or the report's: the pixels' covered area counts.
+    pub fn is_box(self) -> bool {
+        matches!(self, Antialias::Box | Antialias::BoxCentre)
     }
 }
 
@@ -160,5 +176,11 @@ mod tests {
             "unknown shading `metal`; expected flat or gouraud or phong or hidden"
         );
         assert_eq!(Antialias::Box.to_string(), "box");
+        assert_eq!(Antialias::BoxCentre.to_string(), "box-centre");
+        assert_eq!("Box-Centre".parse::<Antialias>(), Ok(Antialias::BoxCentre));
+        assert_eq!(
+            "centre".parse::<Antialias>().unwrap_err(),
+            "unknown anti-aliasing `centre`; expected none or box or box-centre"
+        );
     }
 }

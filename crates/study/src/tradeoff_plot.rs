@@ -3,8 +3,8 @@
 //! cycles, and rings on the settings that are Pareto-optimal in cycles, register bits and
 //! error.
 //!
-//! Colour is the numeric format; a filled marker is the box filter, a hollow one point
-//! sampling; a circle is exact visibility, a square eval0 (or a screen scene). Errors
+//! Colour is the numeric format; a filled marker is a box filter (exact or the
+//! report's), a hollow one point sampling; a circle is exact visibility, a square eval0 (or a screen scene). Errors
 //! below [`ERROR_FLOOR`] (an exact image) are drawn on the floor.
 
 use crate::plot::{draw_on, err, rgb, Align, Label, Rgb};
@@ -151,7 +151,7 @@ pub fn render_tradeoff_plot(rows: &[Row], name: &str) -> Result<Rgb, String> {
                 rgb(PALETTE
                     [formats.iter().position(|f| *f == r.numeric).unwrap_or(0) % PALETTE.len()]);
             let (px, py) = chart.backend_coord(&(r.busy_cycles.max(1) as f64, y_of(r)));
-            let style = if r.aa == "box" {
+            let style = if r.aa != "none" {
                 color.filled()
             } else {
                 color.stroke_width(2)

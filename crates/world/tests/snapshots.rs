@@ -1,5 +1,7 @@
 //! Snapshots of the instruction streams the embedded scenes emit (annotated text traces):
-//! figure 25, and the pot at 64×64 with exact visibility. Review a changed snapshot with
+//! figure 25, and the pot at 64×64 with exact visibility, each with the exact box filter
+//! (the default) and the report's (`_centre`: coverage × centre value; the same
+//! instructions but for their operands). Review a changed snapshot with
 //! `cargo insta review` before accepting it.
 
 use cwisim_isa::text::TextWriter;
@@ -7,7 +9,15 @@ use cwisim_isa::TraceWrite;
 use cwisim_scene::ScreenScene;
 use cwisim_world::embedded::embedded;
 use cwisim_world::{parse_any, to_screen, AnyScene, Visibility};
-use cwisim_ypipe::{emit, header, Options, Shading};
+use cwisim_ypipe::{emit, header, Antialias, Options, Shading};
+
+/// The report's box filter.
+fn centre() -> Options {
+    Options {
+        aa: Antialias::BoxCentre,
+        ..Options::default()
+    }
+}
 
 fn text(scene: &ScreenScene, options: &Options) -> String {
     let mut buf = Vec::new();
@@ -29,6 +39,7 @@ fn fig25_stream() {
         panic!("fig25 is a screen scene")
     };
     insta::assert_snapshot!(text(&s, &Options::default()));
+    insta::assert_snapshot!("fig25_stream_centre", text(&s, &centre()));
 }
 
 #[test]
@@ -42,4 +53,5 @@ fn pot_64x64_stream() {
     let again = to_screen(&w, Shading::Gouraud, Visibility::Exact).expect("prepared");
     assert_eq!(trace, text(&again.screen, &Options::default()));
     insta::assert_snapshot!(trace);
+    insta::assert_snapshot!("pot_64x64_stream_centre", text(&prepared.screen, &centre()));
 }

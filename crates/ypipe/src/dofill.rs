@@ -15,6 +15,17 @@
 //! the same stretches need one order less: `Eval1` for the middle part and `Eval2` for
 //! sequences.
 //!
+//! That is the report's box filter ([`BoxValue::Centre`], `--aa box-centre`): each pixel
+//! holds its exact coverage times the intensity at its centre. [`BoxValue::Exact`]
+//! (`--aa box`) sends the same instructions carrying the exact integral of the
+//! intensity over each pixel's covered part ([`crate::integral`]): a separately
+//! calculated pixel's `Eval1` holds its integral; a sequence's or share-sequence's
+//! `Eval3` the quadratic in the pixel index that its integrals are (docs/ERRATA.md, "The
+//! exact box filter"); a middle part is already exact. Where the intensity is constant
+//! over the row both are exact and the instructions identical; where it changes down the
+//! row but not along it, the report's sequence is an `Eval2` and the exact one an
+//! `Eval3` (the only difference in the opcode mix; the count is the same).
+//!
 //! With [`Claim::Eval0`] the stretches whose pixels are all fully covered (a middle part
 //! or a separately calculated pixel of coverage exactly 1) are claimed with `Eval0`
 //! instead, and so is the whole span of a point-sampled row: one `Eval0` when the row is
@@ -22,6 +33,7 @@
 
 use crate::coverage::{Case, Slice};
 use crate::floor::ceil_i64;
+use crate::integral::{forward_differences, RowPlane};
 use crate::trapezoid::{vector, Trapezium, Vector};
 use crate::Claim;
 use cwisim_isa::{Instruction, Intensity};
@@ -34,6 +46,17 @@ pub enum Shade {
     Flat(Vector),
     /// Gouraud: interpolated along the edges, then across each scanline.
     Gouraud,
+}
+
+/// What a box-filtered pixel holds.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum BoxValue {
+    /// The integral of the intensity over the pixel's covered part (`--aa box`).
+    #[default]
+    Exact,
+    /// The covered area times the intensity at the pixel centre: the report's
+    /// approximation (`--aa box-centre`, docs/ERRATA.md, D7).
+    Centre,
 }
 
 /// The kind of a stretch of pixels.
@@ -205,8 +228,10 @@ fn map(v: &Vector, channels: usize, f: impl Fn(f64, usize) -> f64) -> Intensity 
     intensity(&vector(channels, |c| f(v[c], c)), channels)
 }
 
-/// Box-filtered fill of `t` in pixel row `row` of an image `width` wide. With
-/// [`Claim::Eval0`], the stretches of coverage exactly 1 are claimed with `Eval0`.
+/// Box-filtered fill of `t` in pixel row `row` of an image `width` wide, each pixel
+/// holding what `value` says. With [`Claim::Eval0`], the stretches of coverage exactly 1
+/// are claimed with `Eval0`.
+#[allow(clippy::too_many_arguments)]
 pub fn box_row(
     t: &Trapezium,
     row: u32,
@@ -214,9 +239,13 @@ pub fn box_row(
     shade: &Shade,
     channels: usize,
     claim: Claim,
+    value: BoxValue,
 ) -> Option<RowFill> {
     let mut fill = RowFill::default();
-    box_row_into(t, row, width, shade, channels, claim, true, &mut fill).then_some(fill)
+    box_row_into(
+        t, row, width, shade, channels, claim, value, true, &mut fill,
+    )
+    .then_some(fill)
 }
 
 /// [`box_row`] into a reused `fill` (cleared first), writing its note only when `notes`;
@@ -229,6 +258,7 @@ pub fn box_row_into(
     shade: &Shade,
     channels: usize,
     claim: Claim,
+    value: BoxValue,
     notes: bool,
     fill: &mut RowFill,
 ) -> bool {
@@ -237,6 +267,11 @@ pub fn box_row_into(
     };
     let h = s.height();
     let rs = RowShade::new(t, shade, 0.5 * (s.y0 + s.y1), channels);
+    // the exact values, where they differ from the report's (a varying intensity)
+    let plane = match value {
+        BoxValue::Exact => Some(RowPlane::new(t, shade, &s, channels)).filter(|p| !p.constant()),
+        BoxValue::Centre => None,
+    };
     let (l0, l1, r0, r1) = s.edge_pixels();
     let mut specials = [l0, l1, r0, r1];
     specials.sort_unstable();
@@ -300,32 +335,12 @@ pub fn box_row_into(
         let n = (last - first + 1) as u32;
         let x = first as u32;
         let fpi = rs.at(first);
-        let instr = match proc_ {
-            Procedure::Single => Instruction::eval1(x, 1, map(&fpi, channels, |v, _| v * ac)),
-            Procedure::MiddlePart if rs.flat() => {
-                Instruction::eval1(x, n, map(&fpi, channels, |v, _| v * ac))
+        let instr = match (proc_, &plane) {
+            (Procedure::Single, Some(p)) => {
+                Instruction::eval1(x, 1, intensity(&p.pixel(first), channels))
             }
-            Procedure::MiddlePart => Instruction::eval2(
-                x,
-                n,
-                map(&fpi, channels, |v, _| v * ac),
-                map(&rs.di, channels, |d, _| d * ac),
-            ),
-            _ if rs.flat() => Instruction::eval2(
-                x,
-                n,
-                map(&fpi, channels, |v, _| v * ac),
-                map(&fpi, channels, |v, _| inc * v),
-            ),
-            _ => Instruction::eval3(
-                x,
-                n,
-                map(&fpi, channels, |v, _| v * ac),
-                map(&fpi, channels, |v, c| {
-                    rs.di[c] * inc + rs.di[c] * ac + inc * v
-                }),
-                map(&rs.di, channels, |d, _| 2.0 * d * inc),
-            ),
+            (Procedure::Sequence | Procedure::ShareSequence, Some(p)) => exact_run(p, first, last),
+            _ => centre_instruction(proc_, x, n, ac, inc, &fpi, &rs),
         };
         if notes {
             if n == 1 {
@@ -337,6 +352,76 @@ pub fn box_row_into(
         fill.instructions.push((proc_, instr));
     }
     !fill.instructions.is_empty()
+}
+
+/// The report's instruction for a stretch `x .. x + n` of procedure `proc_`: coverage
+/// `ac` at its first pixel growing by `inc` per pixel, times the intensity at each pixel
+/// centre (`fpi` at the first, changing by `rs.di`).
+fn centre_instruction(
+    proc_: Procedure,
+    x: u32,
+    n: u32,
+    ac: f64,
+    inc: f64,
+    fpi: &Vector,
+    rs: &RowShade,
+) -> Instruction {
+    let channels = rs.channels;
+    match proc_ {
+        Procedure::Single | Procedure::Claim => {
+            Instruction::eval1(x, 1, map(fpi, channels, |v, _| v * ac))
+        }
+        Procedure::MiddlePart if rs.flat() => {
+            Instruction::eval1(x, n, map(fpi, channels, |v, _| v * ac))
+        }
+        Procedure::MiddlePart => Instruction::eval2(
+            x,
+            n,
+            map(fpi, channels, |v, _| v * ac),
+            map(&rs.di, channels, |d, _| d * ac),
+        ),
+        _ if rs.flat() => Instruction::eval2(
+            x,
+            n,
+            map(fpi, channels, |v, _| v * ac),
+            map(fpi, channels, |v, _| inc * v),
+        ),
+        _ => Instruction::eval3(
+            x,
+            n,
+            map(fpi, channels, |v, _| v * ac),
+            map(fpi, channels, |v, c| {
+                rs.di[c] * inc + rs.di[c] * ac + inc * v
+            }),
+            map(&rs.di, channels, |d, _| 2.0 * d * inc),
+        ),
+    }
+}
+
+/// The exact values of a sequence or share-sequence `first ..= last` as one `Eval3`:
+/// the quadratic through the exact integrals at its first, middle and last pixel.
+fn exact_run(p: &RowPlane, first: i64, last: i64) -> Instruction {
+    let n = (last - first + 1) as u32;
+    let (e0, em, el) = (
+        p.pixel(first),
+        p.pixel(first + (last - first) / 2),
+        p.pixel(last),
+    );
+    let mut ops = [[0.0; cwisim_isa::MAX_CHANNELS]; 3];
+    for c in 0..p.channels {
+        let (v, d, dd) = forward_differences(n, e0[c], em[c], el[c]);
+        ops[0][c] = v;
+        ops[1][c] = d;
+        ops[2][c] = dd;
+    }
+    let ch = p.channels;
+    Instruction::eval3(
+        first as u32,
+        n,
+        intensity(&ops[0], ch),
+        intensity(&ops[1], ch),
+        intensity(&ops[2], ch),
+    )
 }
 
 /// Claims pixels `first ..= last` into `fill`, with its note (` claim 3..=9 (2 Eval0)`)

@@ -10,8 +10,10 @@
 //! 4. [`scan`] — an edge list and an active edge table grouped by Identifier visit the
 //!    trapezia row by row (Algorithms 7–8).
 //! 5. [`dofill`] — each row of a trapezium becomes instructions: box-filter coverage in
-//!    the twelve cases of DO_FILL ([`coverage`]), or point sampling; flat or Gouraud;
-//!    optionally claiming fully covered pixels with `Eval0` ([`Claim`]).
+//!    the twelve cases of DO_FILL ([`coverage`]), each pixel holding the exact integral
+//!    of its intensity ([`integral`]) or the report's coverage × centre value; or point
+//!    sampling; flat or Gouraud; optionally claiming fully covered pixels with `Eval0`
+//!    ([`Claim`]).
 //! 6. [`emit`](fn@emit) — the stream goes to any [`TraceWrite`] (a trace file, the
 //!    array simulator, a counter), one `Refresh` per scanline.
 //!
@@ -27,10 +29,11 @@ pub mod coverage;
 pub mod dofill;
 pub mod exact;
 mod floor;
+pub mod integral;
 pub mod scan;
 pub mod trapezoid;
 
-use crate::dofill::{box_row_into, sampled_row_into, Procedure, RowFill, Shade};
+use crate::dofill::{box_row_into, sampled_row_into, BoxValue, Procedure, RowFill, Shade};
 use cwisim_isa::{Instruction, TraceHeader, TraceWrite, MAX_CHANNELS};
 use cwisim_scene::ScreenScene;
 use std::io;
@@ -59,7 +62,8 @@ pub enum Claim {
 pub struct Options {
     /// Shading.
     pub shading: Shading,
-    /// Anti-aliasing.
+    /// Anti-aliasing: `Box` the exact box filter, `BoxCentre` the report's (coverage ×
+    /// the intensity at the pixel centre), `None` point sampling.
     pub aa: Antialias,
     /// What a polygon does to the pixels it fully covers: with box filtering the runs of
     /// coverage exactly 1, with point sampling its whole span (`docs/ERRATA.md`, D9).
@@ -228,10 +232,14 @@ pub fn emit_rows(
             scan::Visit::Fill(row, t) => {
                 let shade = &shades[t.polygon as usize];
                 let (w, claim) = (scene.width, options.claim);
-                let filled = match options.aa {
-                    Antialias::Box => {
-                        box_row_into(t, row, w, shade, channels, claim, notes, &mut fill)
+                let boxed = |value| {
+                    move |fill: &mut RowFill| {
+                        box_row_into(t, row, w, shade, channels, claim, value, notes, fill)
                     }
+                };
+                let filled = match options.aa {
+                    Antialias::Box => boxed(BoxValue::Exact)(&mut fill),
+                    Antialias::BoxCentre => boxed(BoxValue::Centre)(&mut fill),
                     Antialias::None => {
                         sampled_row_into(t, row, w, shade, channels, claim, notes, &mut fill)
                     }

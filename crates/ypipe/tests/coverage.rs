@@ -133,7 +133,8 @@ proptest! {
         let grad = gx.hypot(gy);
         let p = Polygon { vertices: verts, intensity: i.iter().map(|x| vec![*x]).collect(), depth: None };
         let s = scene(24, 16, vec![p]);
-        let (img, _) = render(&s, &Options::default());
+        let centre = Options { aa: cwisim_ypipe::Antialias::BoxCentre, ..Options::default() };
+        let (img, _) = render(&s, &centre);
         let exact = cwisim_ypipe::exact::scene_box_filtered(&s);
         let cover = scene_coverage(&s);
         for k in 0..img.len() {

@@ -1,12 +1,23 @@
 //! The emitted instruction stream of every named fixture, as reviewed snapshots: one
 //! trapezium row per DO_FILL case (tests/fixtures/caseNN.json) and the three triangles
-//! of the report's figure 25 (also with `Eval0` claims).
+//! of the report's figure 25 (also with `Eval0` claims). Each Gouraud box-filtered
+//! stream twice: in the exact mode (`caseNN`, the default `--aa box`) and in the
+//! report's (`caseNN_centre`, `--aa box-centre`), with the same instructions but for
+//! their operands (`tests/exact_box.rs`).
 
 mod common;
 
 use common::{fixture, render, text};
 use cwisim_ypipe::exact::scene_coverage;
 use cwisim_ypipe::{Antialias, Claim, Options, Shading};
+
+/// The report's box filter: coverage × the intensity at the pixel centre.
+fn centre() -> Options {
+    Options {
+        aa: Antialias::BoxCentre,
+        ..Options::default()
+    }
+}
 
 #[test]
 fn each_of_the_twelve_cases_has_its_fixture_and_stream() {
@@ -21,7 +32,8 @@ fn each_of_the_twelve_cases_has_its_fixture_and_stream() {
             stats.cases
         );
         assert_eq!(stats.cases.iter().sum::<u64>(), 1, "{name}: one row");
-        insta::assert_snapshot!(name, text(&scene, &Options::default()));
+        insta::assert_snapshot!(name.clone(), text(&scene, &Options::default()));
+        insta::assert_snapshot!(format!("{name}_centre"), text(&scene, &centre()));
     }
 }
 
@@ -29,6 +41,7 @@ fn each_of_the_twelve_cases_has_its_fixture_and_stream() {
 fn figure_25_pairs_edges_by_identifier() {
     let scene = fixture("fig25.json");
     insta::assert_snapshot!("fig25", text(&scene, &Options::default()));
+    insta::assert_snapshot!("fig25_centre", text(&scene, &centre()));
     // With the AET grouped by Identifier every trapezium is filled between its own two
     // edges, so with intensity 1 the image is exactly the triangles' coverage. (Sorted on
     // Xmax alone, row 6 would pair edges of different triangles, as the report shows.)
@@ -85,6 +98,16 @@ fn figure_25_with_eval0_claims() {
     };
     let trace = text(&scene, &options);
     insta::assert_snapshot!("fig25_claim", trace);
+    insta::assert_snapshot!(
+        "fig25_claim_centre",
+        text(
+            &scene,
+            &Options {
+                aa: Antialias::BoxCentre,
+                ..options
+            }
+        )
+    );
     let (w, h) = (scene.width as usize, scene.height as usize);
     let mut claimed = vec![0u32; w * h];
     let mut row = 0;

@@ -38,6 +38,28 @@ pub fn render(scene: &ScreenScene, options: &Options) -> (Vec<f64>, EmitStats) {
     (image.data, stats)
 }
 
+/// The scene through the Y-processor and the array: the image and the array's statistics
+/// (dropped negative contributions among them).
+pub fn render_run(scene: &ScreenScene, options: &Options) -> (Vec<f64>, cwisim_xproc::RunStats) {
+    let h = header(scene);
+    let mut sink = ImageSink::new(h.width as usize, h.channel_count(), 1 << 30);
+    let run = {
+        let mut w = EngineWriter::<f64>::new(&h, &Machine::default(), Timing::Fast, &mut sink)
+            .expect("machine");
+        emit(scene, options, &mut w).expect("every emitted instruction fits the array");
+        w.finish().expect("finish");
+        w.into_stats().expect("statistics after finish")
+    };
+    (sink.finish().expect("image").data, run)
+}
+
+/// The scene's instructions, `Refresh` included.
+pub fn instructions(scene: &ScreenScene, options: &Options) -> Vec<cwisim_isa::Instruction> {
+    let mut out = Vec::new();
+    emit(scene, options, &mut out).expect("emit into memory");
+    out
+}
+
 /// The scene as an annotated text trace.
 pub fn text(scene: &ScreenScene, options: &Options) -> String {
     let mut buf = Vec::new();
