@@ -35,6 +35,9 @@ pub struct PolygonScene {
     pub visibility_time: Duration,
     /// With Phong shading: what per-pixel shading needs of the world.
     pub phong: Option<PhongSurfaces>,
+    /// Meshes whose material lets light through (`transmittance` > 0), drawn opaque
+    /// here: polygon renderers keep the nearest surface only.
+    pub transparent_meshes: u64,
 }
 
 /// What per-pixel (Phong) shading needs: the projected triangles with their world
@@ -71,6 +74,7 @@ impl PolygonScene {
             transform_time: Duration::ZERO,
             visibility_time: Duration::ZERO,
             phong: None,
+            transparent_meshes: 0,
         };
         if settings.shading == Shading::Hidden {
             return Err(RenderError::Usage(
@@ -91,6 +95,12 @@ impl PolygonScene {
                 ))
             }
             AnyScene::World(w) => {
+                prepared.transparent_meshes = w
+                    .spec
+                    .meshes
+                    .iter()
+                    .filter(|m| m.material.transmittance > 0.0)
+                    .count() as u64;
                 let start = Instant::now();
                 let (tris, project) = cwisim_world::project::project(&w, settings.shading)?;
                 prepared.transform_time = start.elapsed();
@@ -143,6 +153,15 @@ impl PolygonScene {
                 format!(
                     "exact: {} visible fragments of {} triangles ({} wholly hidden; {} occluding pairs; {} hole cuts; {} slivers dropped, {:.1e} px² in all)",
                     v.fragments, v.triangles, v.hidden, v.occluding_pairs, v.hole_cuts, v.dropped_slivers, v.dropped_area
+                ),
+            ));
+        }
+        if self.transparent_meshes > 0 {
+            rows.push((
+                "note",
+                format!(
+                    "{} mesh(es) with a transmittance drawn opaque: this renderer keeps the nearest surface (woo-chall composites layers)",
+                    self.transparent_meshes
                 ),
             ));
         }

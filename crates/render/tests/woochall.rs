@@ -384,11 +384,12 @@ fn keep_obj_calls_are_surface_changes() {
     let mut lists = cwisim_render::woochall::lists::Lists::new(&tris.tris, sampler);
     let mut stats = Default::default();
     let mut winners = Vec::new();
+    let mut layers = Default::default();
     let mut expected = 0u64;
     for row in 0..tris.height {
         let mut last: Vec<Option<u32>> = vec![None; tris.width as usize];
         for j in 0..3 {
-            lists.subline(row * 3 + j, &mut winners, &mut stats);
+            lists.subline(row * 3 + j, &mut winners, &mut layers, &mut stats);
             for (k, &w) in winners.iter().enumerate() {
                 if w == u32::MAX {
                     continue;
@@ -486,4 +487,73 @@ fn bad_settings_are_refused_with_their_flag() {
         ..woo(2)
     })
     .contains("--shade-contrast"));
+}
+
+/// Three squares facing the camera, lit by ambient light alone (intensity = `k_a`):
+/// two half-transparent ones in front of an opaque one.
+fn layered_scene(front_t: f64, middle_t: f64) -> LoadedScene {
+    let quad = |z: f64, k_a: f64, t: f64| {
+        format!(
+            r#"{{ "material": {{ "k_a": {k_a}, "k_d": 0, "k_s": 0, "n": 1, "transmittance": {t} }},
+                "vertices": [[-1, -1, {z}], [1, -1, {z}], [1, 1, {z}], [-1, 1, {z}]],
+                "faces": [[0, 1, 2, 3]] }}"#
+        )
+    };
+    let text = format!(
+        r#"{{ "kind": "world", "width": 32, "height": 32, "channels": 1,
+            "camera": {{ "eye": [0, 0, 5], "target": [0, 0, 0], "fov_y": 40 }},
+            "ambient": 1, "lights": [],
+            "meshes": [{}, {}, {}] }}"#,
+        quad(0.5, 0.8, front_t),
+        quad(0.0, 0.4, middle_t),
+        quad(-0.5, 0.2, 0.0)
+    );
+    LoadedScene::built("layers", parse_any(&text, None).unwrap())
+}
+
+#[test]
+fn transparent_layers_composite_nearest_first() {
+    for (samples, merge) in [(1, false), (3, false), (3, true)] {
+        let settings = Settings {
+            shading: Shading::Flat,
+            merge_subscanlines: merge,
+            ..woo(samples)
+        };
+        let img = image_of("woo-chall", layered_scene(0.5, 0.5), &settings, 1);
+        // by hand: (1 − ½)·0.8 + ½(1 − ½)·0.4 + ½·½·0.2
+        let want = 0.5 * 0.8 + 0.25 * 0.4 + 0.25 * 0.2;
+        let centre = img[16 * 32 + 16];
+        assert!(
+            (centre - want).abs() < 1e-12,
+            "l = {samples}: {centre} vs {want}"
+        );
+        // opaque: the front square alone
+        let opaque = image_of("woo-chall", layered_scene(0.0, 0.5), &settings, 1);
+        assert!((opaque[16 * 32 + 16] - 0.8).abs() < 1e-12);
+    }
+    // every layer behind a transparent front is a shading call
+    let r = (registry::find("woo-chall").unwrap().build)(layered_scene(0.5, 0.5), &woo(1)).unwrap();
+    let h = r.header();
+    let mut sink = ImageSink::new(h.width as usize, h.channel_count(), 1 << 30);
+    let c = render(&*r, &ArrayConfig::default(), 1, &mut sink, Taps::default())
+        .unwrap()
+        .counters;
+    // at l = 1 every sample's front is shaded once, and each layer behind it once more
+    let (geometry, layers) = (c.get("geometry").unwrap(), c.get("shading_layers").unwrap());
+    assert!(layers > 0);
+    assert_eq!(c.get("shading"), Some(geometry + layers));
+}
+
+#[test]
+fn a_transmittance_outside_zero_to_one_is_refused_where_it_is() {
+    let text = r#"{ "kind": "world", "width": 8, "height": 8, "channels": 1,
+        "camera": { "eye": [0, 0, 5], "target": [0, 0, 0], "fov_y": 40 },
+        "ambient": 1, "lights": [],
+        "meshes": [{ "material": { "k_a": 1, "k_d": 0, "k_s": 0, "n": 1, "transmittance": 1.5 },
+                     "vertices": [[-1, -1, 0], [1, -1, 0], [1, 1, 0]], "faces": [[0, 1, 2]] }] }"#;
+    let e = parse_any(text, None).unwrap_err().to_string();
+    assert!(
+        e.contains("meshes[0].material.transmittance") && e.contains("[0, 1]"),
+        "{e}"
+    );
 }

@@ -73,6 +73,7 @@ mod tests {
             k_d: PerChannel::All(0.8),
             k_s: PerChannel::All(0.4),
             n: 10.0,
+            transmittance: 0.0,
         }
     }
 

@@ -487,6 +487,7 @@ mod tests {
                 k_d: PerChannel::All(0.5),
                 k_s: PerChannel::All(0.0),
                 n: 1.0,
+                transmittance: 0.0,
             },
             two_sided: false,
             crease_angle: 50.0,

@@ -141,6 +141,15 @@ pub struct Material {
     pub k_s: PerChannel,
     /// Specular exponent `n` (shininess), ≥ 0.
     pub n: f64,
+    /// The fraction of light from behind that passes through, in `[0, 1]` (0, the
+    /// default: opaque). Drawn by renderers that composite layers per sample
+    /// (`woo-chall`); the others draw the mesh opaque and say so.
+    #[serde(default, skip_serializing_if = "is_opaque")]
+    pub transmittance: f64,
+}
+
+fn is_opaque(t: &f64) -> bool {
+    *t == 0.0
 }
 
 /// A placement: scale, then rotate (degrees about x, then y, then z), then translate.
@@ -529,6 +538,17 @@ impl WorldSpec {
                     K::Limit,
                     f("material.n"),
                     format!("expected a specular exponent ≥ 0, found {}", mat.n),
+                ));
+            }
+            finite(&f("material.transmittance"), mat.transmittance)?;
+            if !(0.0..=1.0).contains(&mat.transmittance) {
+                return Err(SceneError::at_field(
+                    K::Limit,
+                    f("material.transmittance"),
+                    format!(
+                        "expected a transmittance in [0, 1] (0 opaque, 1 invisible), found {}",
+                        mat.transmittance
+                    ),
                 ));
             }
             finite(&f("crease_angle"), m.crease_angle)?;

@@ -33,6 +33,24 @@ pub struct ListStats {
     pub depth_tests: u64,
 }
 
+/// The layers behind a transparent winner, per sample: for each such sample column, the
+/// triangles behind the front one, nearest first, down to the first opaque one (or all
+/// that cover it, when none is).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Layers {
+    /// `(column, start, end)`: the sample's layers are `tris[start..end]`; in column order.
+    pub entries: Vec<(u32, u32, u32)>,
+    /// The layers of every entry, one after the other.
+    pub tris: Vec<u32>,
+}
+
+impl Layers {
+    fn clear(&mut self) {
+        self.entries.clear();
+        self.tris.clear();
+    }
+}
+
 /// One triangle's span on a sub-scanline: sample columns `lo..=hi`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Span {
@@ -91,8 +109,16 @@ impl<'a> Lists<'a> {
 
     /// The winner of every sample column of sub-scanline `j` into `winners` (a triangle
     /// index, or [`NONE`]). Sub-scanlines must come in increasing order.
-    pub fn subline(&mut self, j: u32, winners: &mut Vec<u32>, stats: &mut ListStats) {
+    /// Where the winner is transparent, the layers behind it go to `layers`.
+    pub fn subline(
+        &mut self,
+        j: u32,
+        winners: &mut Vec<u32>,
+        layers: &mut Layers,
+        stats: &mut ListStats,
+    ) {
         let columns = self.sampler.columns();
+        layers.clear();
         winners.clear();
         winners.resize(columns, NONE);
         // yActiveList: drop the finished, add the starting
@@ -162,6 +188,9 @@ impl<'a> Lists<'a> {
             stats.depth_tests += self.x_active.len() as u64;
             stats.geometry += 1;
             winners[k as usize] = best;
+            if self.tris[best as usize].transmittance > 0.0 {
+                self.layers_behind(best, x, y, k, layers);
+            }
             if best != previous {
                 runs += 1;
                 previous = best;
@@ -172,6 +201,37 @@ impl<'a> Lists<'a> {
             }
         }
         stats.max_visible_spans = stats.max_visible_spans.max(runs);
+    }
+}
+
+impl Lists<'_> {
+    /// The triangles of `xActiveList` behind `front` at `(x, y)`, nearest first, down
+    /// to the first opaque one (§3: "do until visible surface is opaque").
+    fn layers_behind(&self, front: u32, x: f64, y: f64, k: u32, layers: &mut Layers) {
+        let start = layers.tris.len() as u32;
+        let mut behind: Vec<(f64, u32)> = self
+            .x_active
+            .iter()
+            .filter(|s| s.tri != front)
+            .map(|s| (self.tris[s.tri as usize].near_at(x, y), s.tri))
+            .collect();
+        // nearest first; on a tie the earlier triangle, as for the winner
+        behind.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+        let front_near = self.tris[front as usize].near_at(x, y);
+        for (near, tri) in behind {
+            // only what lies behind the front (a tie that lost to it counts as behind)
+            if near > front_near || (near == front_near && tri < front) {
+                continue;
+            }
+            layers.tris.push(tri);
+            if self.tris[tri as usize].transmittance == 0.0 {
+                break;
+            }
+        }
+        let end = layers.tris.len() as u32;
+        if end > start {
+            layers.entries.push((k, start, end));
+        }
     }
 }
 

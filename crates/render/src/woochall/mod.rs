@@ -28,7 +28,7 @@ use cwisim_isa::{Instruction, TraceHeader, TraceWrite};
 use cwisim_scene::Shading;
 use cwisim_xproc::{Image, RunStats};
 use emit::{emit_row, EmitCounts, EmitRule, Subline};
-use lists::{ListStats, Lists};
+use lists::{Layers, ListStats, Lists};
 use prepare::Triangles;
 use shade::{RowShader, ShadeRule, ShadeStats};
 use std::io;
@@ -111,6 +111,7 @@ impl WooChall {
         let mut carried = false;
         // the winners of the sub-scanline above (hidden-line drawing)
         let mut above: Vec<u32> = Vec::new();
+        let mut layers = Layers::default();
         for row in 0..t.height {
             let (first, _) = s.of_pixel(row);
             let start = if carried {
@@ -121,14 +122,19 @@ impl WooChall {
             };
             for (o, sub) in sublines.iter_mut().enumerate().skip(start) {
                 let j = first + o;
-                lists.subline(j as u32, &mut sub.winners, &mut list_stats);
+                lists.subline(j as u32, &mut sub.winners, &mut layers, &mut list_stats);
                 if self.shading == Shading::Hidden {
                     shade::hidden_subline(&sub.winners, &above, channels, &mut sub.rgb);
                 } else {
                     let y = s.subline_y(j);
-                    shader.subline(y, &sub.winners, &t.tris, &mut sub.rgb, |tri, x, y| {
-                        t.shade(tri, x, y)
-                    });
+                    shader.subline(
+                        y,
+                        &sub.winners,
+                        &layers,
+                        &t.tris,
+                        &mut sub.rgb,
+                        |tri, x, y| t.shade(tri, x, y),
+                    );
                 }
                 above.clone_from(&sub.winners);
             }
@@ -188,6 +194,7 @@ impl FramePlan for WooFrame {
             .with("shading_stochastic", s.stochastic)
             .with("shading_forced", s.forced_calls)
             .with("forced_pixels", s.forced_pixels)
+            .with("shading_layers", s.layer_calls)
     }
 
     fn emit_rows(&self, rows: Range<u32>, sink: &mut dyn TraceWrite) -> io::Result<Counters> {

@@ -65,7 +65,10 @@ impl Triangles {
                     .iter()
                     .enumerate()
                     .filter_map(|(k, t)| {
-                        Tri::new(t.points, t.inv_depth, t.intensity, t.mesh, k as u32)
+                        let mut tri =
+                            Tri::new(t.points, t.inv_depth, t.intensity, t.mesh, k as u32)?;
+                        tri.transmittance = w.spec.meshes[t.mesh as usize].material.transmittance;
+                        Some(tri)
                     })
                     .collect();
                 project = Some(stats);

@@ -11,7 +11,7 @@
 //! row's colours, the stochastic draws), so one frame is shaded on one thread, in order;
 //! the seed makes it reproducible.
 
-use super::lists::NONE;
+use super::lists::{Layers, NONE};
 use super::triangle::Tri;
 use crate::subsample::Sampler;
 use cwisim_scene::Vector;
@@ -44,6 +44,8 @@ pub struct ShadeStats {
     pub forced_calls: u64,
     /// Pixels forced to super-sample shading (counted once per row).
     pub forced_pixels: u64,
+    /// Calls shading a layer behind a transparent surface (every layer is shaded).
+    pub layer_calls: u64,
 }
 
 /// `keepObj` and the rest of the shading state of one frame.
@@ -77,16 +79,23 @@ impl RowShader {
 
     /// Shades the samples of one sub-scanline `y` of the current row: `rgb[k]` for every
     /// column `k` (zero on the background). `shade(tri, x, y)` is one shading call.
+    ///
+    /// Where the winner is transparent, the sample's colour is the layers' composite:
+    /// `Σ (1 − t_i) Π_{j<i} t_j · colour_i`, nearest first, the front layer shaded by the
+    /// rule above (`keepObj` keeps the front surface's colour) and every layer behind it
+    /// by its own shading call.
     pub fn subline(
         &mut self,
         y: f64,
         winners: &[u32],
+        layers: &Layers,
         tris: &[Tri],
         rgb: &mut Vec<Vector>,
         mut shade: impl FnMut(&Tri, f64, f64) -> Vector,
     ) {
         rgb.clear();
         rgb.resize(winners.len(), [0.0; cwisim_isa::MAX_CHANNELS]);
+        let mut next_layered = layers.entries.iter().peekable();
         for (k, &w) in winners.iter().enumerate() {
             if w == NONE {
                 continue;
@@ -117,6 +126,22 @@ impl RowShader {
             };
             self.keep[x] = Some((tri.surface, colour));
             rgb[k] = colour;
+            if let Some(&(_, start, end)) = next_layered.next_if(|e| e.0 as usize == k) {
+                let sx = self.sampler.column_x(k);
+                let mut through = tri.transmittance;
+                let mut sum = colour.map(|c| (1.0 - through) * c);
+                for &behind in &layers.tris[start as usize..end as usize] {
+                    let layer = &tris[behind as usize];
+                    let c = shade(layer, sx, y);
+                    self.stats.calls += 1;
+                    self.stats.layer_calls += 1;
+                    for (s, v) in sum.iter_mut().zip(c) {
+                        *s += through * (1.0 - layer.transmittance) * v;
+                    }
+                    through *= layer.transmittance;
+                }
+                rgb[k] = sum;
+            }
         }
     }
 

@@ -24,6 +24,8 @@ pub struct Tri {
     pub surface: u32,
     /// Which source triangle or polygon it is (for per-pixel shading).
     pub source: u32,
+    /// The fraction of what lies behind that shows through it (0: opaque).
+    pub transmittance: f64,
     /// The parameterisation (§4.1): `D = A`, `E = (B − A)/d`, `F = (C − A)/d` in x and
     /// y, with `d = (B − A) × (C − A)`.
     pub param: Param,
@@ -135,6 +137,7 @@ impl Tri {
             intensity,
             surface,
             source,
+            transmittance: 0.0,
             param,
             edges: [Edge::new(a, b), Edge::new(b, c), Edge::new(c, a)],
         })
