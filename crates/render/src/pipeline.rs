@@ -50,6 +50,9 @@ pub struct Rendered {
     pub renderer_time: Duration,
     /// Wall time in the array simulator.
     pub array_time: Duration,
+    /// The renderer's figures per pixel row, one entry per frame
+    /// ([`FramePlan::row_figures`]; `Null` for a frame without them).
+    pub row_figures: Vec<serde_json::Value>,
 }
 
 /// Bands per thread: enough that uneven bands balance out.
@@ -87,9 +90,11 @@ pub fn render(
     let start = Instant::now();
     let mut counters = Counters::default();
     let mut previous: Option<Image> = None;
+    let mut row_figures = Vec::new();
     for index in 0..renderer.frames() {
         let plan = renderer.frame(index, previous.as_ref())?;
         counters.merge(&plan.counters());
+        row_figures.push(plan.row_figures().unwrap_or(serde_json::Value::Null));
         let fault = |source| RenderError::Renderer {
             renderer: renderer.name(),
             source,
@@ -109,7 +114,7 @@ pub fn render(
             previous = Some(frame.replace(empty_image(&header)));
         }
     }
-    feed.close(counters, start.elapsed())
+    feed.close(counters, row_figures, start.elapsed())
 }
 
 /// Emits the whole stream of `renderer`, every frame, into `sink` (a trace file, a
@@ -206,7 +211,12 @@ impl<'a, 's> ScanlineFeed<'a, 's> {
     /// Finishes the array and the taps; `total` is the wall time since emission began
     /// (the renderer's share is what the array did not take: the two interleave, or
     /// overlap on threads).
-    fn close(mut self, counters: Counters, total: Duration) -> Result<Rendered, RenderError> {
+    fn close(
+        mut self,
+        counters: Counters,
+        row_figures: Vec<serde_json::Value>,
+        total: Duration,
+    ) -> Result<Rendered, RenderError> {
         self.finish().map_err(RenderError::Array)?;
         let array_time = self.array_time;
         let stats = self.array.into_stats().expect("finished");
@@ -215,6 +225,7 @@ impl<'a, 's> ScanlineFeed<'a, 's> {
             stats,
             renderer_time: total.saturating_sub(array_time),
             array_time,
+            row_figures,
         })
     }
 

@@ -83,6 +83,13 @@ pub trait FramePlan: Sync {
     /// this band only. Emitting `0..lines` in one call, or in consecutive bands, gives the
     /// same stream.
     fn emit_rows(&self, rows: Range<u32>, sink: &mut dyn TraceWrite) -> io::Result<Counters>;
+
+    /// The renderer's own figures per pixel row of this frame, for `--stats-json`
+    /// (`"renderer_rows"`): an array with one object per row, or `None` when it keeps
+    /// none. Deterministic: no times.
+    fn row_figures(&self) -> Option<serde_json::Value> {
+        None
+    }
 }
 
 /// A renderer's own figures, by name, in the order first counted. Adding counters adds

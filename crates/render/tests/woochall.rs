@@ -557,3 +557,27 @@ fn a_transmittance_outside_zero_to_one_is_refused_where_it_is() {
         "{e}"
     );
 }
+
+#[test]
+fn the_row_figures_add_up_to_the_frame() {
+    let r =
+        (registry::find("woo-chall").unwrap().build)(embedded_scene("pot", 48), &woo(3)).unwrap();
+    let h = r.header();
+    let mut sink = ImageSink::new(h.width as usize, h.channel_count(), 1 << 30);
+    let done = render(&*r, &ArrayConfig::default(), 2, &mut sink, Taps::default()).unwrap();
+    let rows = done.row_figures[0].as_array().unwrap();
+    assert_eq!(rows.len(), 48);
+    let sum = |k: &str| rows.iter().map(|r| r[k].as_u64().unwrap()).sum::<u64>();
+    let max = |k: &str| rows.iter().map(|r| r[k].as_u64().unwrap()).max().unwrap();
+    for k in [
+        "geometry",
+        "shading",
+        "instructions",
+        "forced_pixels",
+        "passes",
+    ] {
+        assert_eq!(Some(sum(k)), done.counters.get(k), "{k}");
+    }
+    assert_eq!(Some(max("max_active")), done.counters.get("max_active"));
+    assert_eq!(sum("instructions"), done.stats.totals.instructions);
+}

@@ -209,6 +209,10 @@ pub fn run_render(
         json["counters"] = serde_json::to_value(&rendered.counters)
             .map_err(|e| CliError::write(path, e.into()))?;
         json["scene"] = crate::summary::scene_json(&drawn);
+        if rendered.row_figures.iter().any(|f| !f.is_null()) {
+            // one array of per-row objects per frame
+            json["renderer_rows"] = serde_json::Value::from(rendered.row_figures.clone());
+        }
         json["numeric"] = serde_json::Value::from(args.numeric.to_string());
         let text = serde_json::to_string_pretty(&json)
             .map_err(|e| CliError::write(path, e.into()))?

@@ -51,6 +51,17 @@ impl Layers {
     }
 }
 
+impl ListStats {
+    /// Adds another stretch's figures (maxima taken, counts summed).
+    pub fn merge(&mut self, o: &ListStats) {
+        self.max_active = self.max_active.max(o.max_active);
+        self.max_visible_spans = self.max_visible_spans.max(o.max_visible_spans);
+        self.geometry += o.geometry;
+        self.spans += o.spans;
+        self.depth_tests += o.depth_tests;
+    }
+}
+
 /// One triangle's span on a sub-scanline: sample columns `lo..=hi`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Span {

@@ -112,8 +112,11 @@ impl WooChall {
         // the winners of the sub-scanline above (hidden-line drawing)
         let mut above: Vec<u32> = Vec::new();
         let mut layers = Layers::default();
+        let mut figures = Vec::with_capacity(t.height as usize);
         for row in 0..t.height {
             let (first, _) = s.of_pixel(row);
+            let mut row_lists = ListStats::default();
+            let shaded_before = shader.stats;
             let start = if carried {
                 sublines.swap(0, l - 1);
                 1
@@ -122,7 +125,7 @@ impl WooChall {
             };
             for (o, sub) in sublines.iter_mut().enumerate().skip(start) {
                 let j = first + o;
-                lists.subline(j as u32, &mut sub.winners, &mut layers, &mut list_stats);
+                lists.subline(j as u32, &mut sub.winners, &mut layers, &mut row_lists);
                 if self.shading == Shading::Hidden {
                     shade::hidden_subline(&sub.winners, &above, channels, &mut sub.rgb);
                 } else {
@@ -143,10 +146,24 @@ impl WooChall {
             let refs: Vec<&Subline> = sublines.iter().collect();
             let mut out = Vec::new();
             let counts = emit_row(s, &refs, &rule, &mut out)?;
+            list_stats.merge(&row_lists);
+            let shaded = &shader.stats;
+            figures.push(serde_json::json!({
+                "row": row,
+                "max_active": row_lists.max_active,
+                "max_visible_spans": row_lists.max_visible_spans,
+                "geometry": row_lists.geometry,
+                "shading": shaded.calls - shaded_before.calls,
+                "forced_pixels": shaded.forced_pixels - shaded_before.forced_pixels,
+                "instructions": counts.instructions,
+                "eval1": counts.edge_pixels + counts.runs.eval1,
+                "passes": counts.passes,
+            }));
             rows.push(out);
             row_counts.push(counts);
         }
         Ok(WooFrame {
+            figures: serde_json::Value::from(figures),
             rows,
             row_counts,
             list_stats,
@@ -159,6 +176,8 @@ impl WooChall {
 
 /// One frame, shaded: its rows' instructions, ready to send.
 struct WooFrame {
+    /// Per pixel row: the lists', the shading's and the emitter's figures.
+    figures: serde_json::Value,
     rows: Vec<Vec<Instruction>>,
     row_counts: Vec<EmitCounts>,
     list_stats: ListStats,
@@ -195,6 +214,10 @@ impl FramePlan for WooFrame {
             .with("shading_forced", s.forced_calls)
             .with("forced_pixels", s.forced_pixels)
             .with("shading_layers", s.layer_calls)
+    }
+
+    fn row_figures(&self) -> Option<serde_json::Value> {
+        Some(self.figures.clone())
     }
 
     fn emit_rows(&self, rows: Range<u32>, sink: &mut dyn TraceWrite) -> io::Result<Counters> {
