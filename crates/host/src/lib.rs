@@ -38,6 +38,7 @@ pub mod demo;
 pub mod draw;
 pub mod error;
 pub mod files;
+pub mod input;
 pub mod output;
 pub mod progress;
 pub mod range;

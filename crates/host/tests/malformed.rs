@@ -246,7 +246,7 @@ malformed! {
         "error: t.cwb: byte 20: ", ["x = 9 is outside the array"], Other;
     // --- files and machines
     unknown_extension: "t.txt", cwt("Refresh\n"), [],
-        "error: t.txt: unknown trace extension `.txt`", [".cwt", ".jsonl", ".cwb"], Other;
+        "error: t.txt: unknown input extension `.txt`", [".cwt", ".jsonl", ".cwb", ".json"], Other;
     machine_file_missing: "t.cwt", cwt("Refresh\n"), ["--machine", "m.json"],
         "error: m.json: cannot read the machine file", [], Other;
     set_hop_cycles_zero: "t.cwt", cwt("Refresh\n"), ["--set", "hop_cycles=0"],

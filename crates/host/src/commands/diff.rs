@@ -11,7 +11,7 @@
 use super::MachineArgs;
 use crate::error::CliError;
 use clap::Args;
-use cwisim_isa::{Encoding, FileReader, Opcode, TraceRead};
+use cwisim_isa::Opcode;
 use cwisim_xproc::{replay, Image, ImageSink, OpcodeCounts, Timing};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -19,10 +19,11 @@ use std::path::{Path, PathBuf};
 /// The arguments of `cwisim diff`.
 #[derive(Args, Clone, Debug, PartialEq)]
 pub struct DiffArgs {
-    /// The first trace or output (.cwt, .jsonl, .cwb, .npy).
+    /// The first trace or output (.cwt, .jsonl, .cwb, .npy), or a scene (a .json file or
+    /// an embedded name) drawn with the drawing options below.
     #[arg(value_name = "A")]
     pub a: PathBuf,
-    /// The second trace or output.
+    /// The second trace, output or scene.
     #[arg(value_name = "B")]
     pub b: PathBuf,
     /// Compare what two traces output (replayed) instead of their instructions.
@@ -38,6 +39,9 @@ pub struct DiffArgs {
     /// The machine model (for replaying traces).
     #[command(flatten)]
     pub machine: MachineArgs,
+    /// How to draw a scene (ignored for traces and outputs).
+    #[command(flatten, next_help_heading = "Drawing a scene")]
+    pub draw: crate::draw::DrawArgs,
 }
 
 fn is_npy(p: &Path) -> bool {
@@ -63,7 +67,7 @@ pub fn run(args: &DiffArgs, stdout: &mut dyn Write) -> Result<bool, CliError> {
         let b = load_output(&args.b, args)?;
         compare_outputs(&a, &b, args, stdout)
     } else {
-        compare_traces(&args.a, &args.b, stdout)
+        compare_traces(&args.a, &args.b, &args.draw, stdout)
     }
 }
 
@@ -84,8 +88,13 @@ fn counts_line(c: &OpcodeCounts) -> String {
     }
 }
 
-fn compare_traces(a: &Path, b: &Path, stdout: &mut dyn Write) -> Result<bool, CliError> {
-    let (mut ra, mut rb) = (FileReader::open(a)?, FileReader::open(b)?);
+fn compare_traces(
+    a: &Path,
+    b: &Path,
+    draw: &crate::draw::DrawArgs,
+    stdout: &mut dyn Write,
+) -> Result<bool, CliError> {
+    let (mut ra, mut rb) = (crate::input::open(a, draw)?, crate::input::open(b, draw)?);
     let (ha, hb) = (*ra.header(), *rb.header());
     let mut equal = true;
     if ha != hb {
@@ -148,16 +157,15 @@ fn load_output(path: &Path, args: &DiffArgs) -> Result<Image, CliError> {
     if is_npy(path) {
         return read_npy(path);
     }
-    Encoding::from_path(path)?;
     let machine = args.machine.load()?;
-    let mut reader = FileReader::open(path)?;
+    let mut reader = crate::input::open(path, &args.draw)?;
     let h = *reader.header();
     let mut sink = ImageSink::new(
         h.width as usize,
         h.channel_count(),
         ImageSink::DEFAULT_LIMIT_BYTES,
     );
-    replay::<f64>(&mut reader, &machine, Timing::Fast, &mut sink, &mut |_| {})?;
+    replay::<f64>(&mut *reader, &machine, Timing::Fast, &mut sink, &mut |_| {})?;
     Ok(sink.finish()?)
 }
 

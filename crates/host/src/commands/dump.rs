@@ -9,7 +9,7 @@ use crate::error::CliError;
 use crate::range::{parse_range, Range};
 use clap::Args;
 use cwisim_isa::text::{format_header, format_instruction};
-use cwisim_isa::{FileReader, Instruction, TraceRead};
+use cwisim_isa::Instruction;
 use cwisim_study::until::UntilLine;
 use cwisim_xproc::{replay_probed, NullSink, Probe};
 use std::collections::VecDeque;
@@ -19,8 +19,9 @@ use std::path::PathBuf;
 /// The arguments of `cwisim dump`.
 #[derive(Args, Clone, Debug, PartialEq)]
 pub struct DumpArgs {
-    /// The trace: .cwt, .jsonl or .cwb.
-    #[arg(value_name = "TRACE")]
+    /// The trace (.cwt, .jsonl, .cwb), or a scene (a .json file or an embedded name:
+    /// `cwisim scenes`) drawn with the drawing options below, as `render` draws it.
+    #[arg(value_name = "TRACE|SCENE")]
     pub trace: PathBuf,
     /// Only these scanlines: N, A-B (both included) or A- (to the end).
     #[arg(long, value_name = "RANGE", value_parser = parse_range)]
@@ -32,6 +33,9 @@ pub struct DumpArgs {
     /// The machine model (for the cycles).
     #[command(flatten)]
     pub machine: MachineArgs,
+    /// How to draw a scene (ignored for a trace).
+    #[command(flatten, next_help_heading = "Drawing a scene")]
+    pub draw: crate::draw::DrawArgs,
 }
 
 /// Prints each instruction when its token enters the array (the bus hands instructions
@@ -77,7 +81,7 @@ impl Probe for Printer<'_> {
 /// Runs `cwisim dump`.
 pub fn run(args: &DumpArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
     let machine = args.machine.load()?;
-    let mut file = FileReader::open(&args.trace)?;
+    let mut file = crate::input::open(&args.trace, &args.draw)?;
     let header = *file.header();
     let lines =
         Range::selection(args.lines, args.frames, u64::from(header.lines)).unwrap_or(Range::ALL);
@@ -94,7 +98,7 @@ pub fn run(args: &DumpArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
         current_line: None,
         error: None,
     };
-    let mut reader = UntilLine::new(&mut file, lines.last);
+    let mut reader = UntilLine::new(&mut *file, lines.last);
     replay_probed::<f64>(&mut reader, &machine, &mut printer, &mut NullSink)?;
     match printer.error {
         Some(e) => Err(CliError::Stdout(e)),

@@ -9,7 +9,7 @@ use super::MachineArgs;
 use crate::error::CliError;
 use clap::Args;
 use cwisim_isa::text::format_instruction;
-use cwisim_isa::{FileReader, Opcode, TraceRead};
+use cwisim_isa::Opcode;
 use cwisim_study::history::{pixel_history, state, values};
 use std::io::Write;
 use std::path::PathBuf;
@@ -17,14 +17,15 @@ use std::path::PathBuf;
 /// The arguments of `cwisim history`.
 #[derive(Args, Clone, Debug, PartialEq)]
 pub struct HistoryArgs {
-    /// The trace: .cwt, .jsonl or .cwb.
-    #[arg(value_name = "TRACE")]
+    /// The trace (.cwt, .jsonl, .cwb), or a scene (a .json file or an embedded name:
+    /// `cwisim scenes`) drawn with the drawing options below, as `render` draws it.
+    #[arg(value_name = "TRACE|SCENE")]
     pub trace: PathBuf,
     /// The processor (pixel column), from 0.
     #[arg(long, value_name = "X")]
     pub x: u32,
-    /// The scanline, from 0 (counted over the whole trace).
-    #[arg(long, value_name = "Y")]
+    /// The scanline, from 0 (counted over the whole trace). `--y` is its old name.
+    #[arg(long = "line", alias = "y", value_name = "Y")]
     pub y: u64,
     /// Also list the instructions whose token only passed through the processor.
     #[arg(long)]
@@ -32,12 +33,15 @@ pub struct HistoryArgs {
     /// The machine model (for the cycles).
     #[command(flatten)]
     pub machine: MachineArgs,
+    /// How to draw a scene (ignored for a trace).
+    #[command(flatten, next_help_heading = "Drawing a scene")]
+    pub draw: crate::draw::DrawArgs,
 }
 
 /// Runs `cwisim history`.
 pub fn run(args: &HistoryArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
     let machine = args.machine.load()?;
-    let mut file = FileReader::open(&args.trace)?;
+    let mut file = crate::input::open(&args.trace, &args.draw)?;
     let header = *file.header();
     if args.x >= header.width {
         return Err(CliError::Usage(format!(
@@ -47,11 +51,11 @@ pub fn run(args: &HistoryArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
             header.width - 1
         )));
     }
-    let visits = match pixel_history(&mut file, &machine, args.x as usize, args.y)? {
+    let visits = match pixel_history(&mut *file, &machine, args.x as usize, args.y)? {
         Ok(visits) => visits,
         Err(lines) => {
             return Err(CliError::Usage(format!(
-                "--y {}: {} outputs only {lines} scanline(s) (0..={})",
+                "--line {}: {} outputs only {lines} scanline(s) (0..={})",
                 args.y,
                 args.trace.display(),
                 lines.saturating_sub(1)

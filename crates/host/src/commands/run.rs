@@ -36,9 +36,11 @@ impl From<TimingArg> for Timing {
 /// The arguments of `cwisim run`.
 #[derive(Args, Clone, Debug, PartialEq)]
 pub struct RunArgs {
-    /// The trace: .cwt (text), .jsonl (JSON Lines) or .cwb (binary), chosen by extension.
-    /// Without it, the embedded demo trace (a shaded, anti-aliased disc) is replayed.
-    #[arg(value_name = "TRACE")]
+    /// The trace: .cwt (text), .jsonl (JSON Lines) or .cwb (binary), chosen by extension;
+    /// or a scene (a .json file or an embedded name), drawn with the drawing options below
+    /// and replayed as `cwisim emit`'s trace would be. Without it, the embedded demo trace
+    /// (a shaded, anti-aliased disc) is replayed.
+    #[arg(value_name = "TRACE|SCENE")]
     pub trace: Option<PathBuf>,
 
     /// Image outputs.
@@ -71,6 +73,9 @@ pub struct RunArgs {
     /// JSON (with one record per scanline).
     #[arg(long, value_name = "FILE")]
     pub stats_json: Option<PathBuf>,
+    /// How to draw a scene (ignored for a trace).
+    #[command(flatten, next_help_heading = "Drawing a scene")]
+    pub draw: crate::draw::DrawArgs,
 }
 
 /// What a successful replay produced.
@@ -94,7 +99,10 @@ pub fn run(
     check_paths(args)?;
     let machine = args.machine.load()?;
     let timing = Timing::from(args.timing);
-    let (mut reader, size) = open_trace(args.trace.as_deref())?;
+    let (mut reader, size) = match args.trace.as_deref() {
+        Some(path) => crate::input::open_sized(path, &args.draw)?,
+        None => open_trace(None)?,
+    };
     let header = *reader.header();
     args.image.check(header.channel_count())?;
     args.cost.check()?;

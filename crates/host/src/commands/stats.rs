@@ -14,18 +14,19 @@ use crate::files::{self, write_atomic};
 use crate::range::{parse_range, Range};
 use crate::report::{timing_name, unrefreshed_warning, TraceShape};
 use clap::Args;
-use cwisim_isa::{Encoding, Opcode, TraceHeader};
+use cwisim_isa::{Opcode, TraceHeader};
 use cwisim_study::plot::{issue_costs, render_stats_plot, StatsPlot};
 use cwisim_xproc::{LineStats, Machine, NullSink, OpcodeCounts, RunStats, Timing, Totals};
 use serde::Serialize;
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// The arguments of `cwisim stats`.
 #[derive(Args, Clone, Debug, PartialEq)]
 pub struct StatsArgs {
-    /// A trace (.cwt, .jsonl, .cwb), replayed; or a scene (.json), rendered first
-    /// through the renderer and settings the drawing options give.
+    /// A trace (.cwt, .jsonl, .cwb), replayed; or a scene (a .json file or an embedded
+    /// name: `cwisim scenes`), rendered first through the renderer and settings the
+    /// drawing options give.
     #[arg(value_name = "TRACE|SCENE")]
     pub input: PathBuf,
 
@@ -64,35 +65,7 @@ pub struct StatsArgs {
     pub draw: DrawArgs,
 }
 
-/// What the input is, by its extension.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Input {
-    Trace,
-    Scene,
-}
-
-impl Input {
-    fn of(path: &Path) -> Result<Input, CliError> {
-        let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
-        if ext == "json" {
-            Ok(Input::Scene)
-        } else if Encoding::from_path(path).is_ok() {
-            Ok(Input::Trace)
-        } else {
-            Err(CliError::Usage(format!(
-                "{}: unknown input extension `.{ext}`; expected a trace (.cwt, .jsonl, .cwb) or a scene (.json)",
-                path.display()
-            )))
-        }
-    }
-
-    fn name(self) -> &'static str {
-        match self {
-            Input::Trace => "trace",
-            Input::Scene => "scene",
-        }
-    }
-}
+use crate::input::InputKind as Input;
 
 /// The sums over the selected scanlines: the table's last line.
 #[derive(Clone, Debug, Default, PartialEq, Eq, Serialize)]

@@ -13,7 +13,6 @@ use super::MachineArgs;
 use crate::error::CliError;
 use crate::files::{same_file, write_atomic};
 use clap::Args;
-use cwisim_isa::{FileReader, TraceRead};
 use cwisim_study::vcd::{record_scanline, write_vcd};
 use std::path::PathBuf;
 
@@ -23,8 +22,9 @@ pub const MAX_DEFAULT_WINDOW: u32 = 64;
 /// The arguments of `cwisim vcd`.
 #[derive(Args, Clone, Debug, PartialEq)]
 pub struct VcdArgs {
-    /// The trace: .cwt, .jsonl or .cwb.
-    #[arg(value_name = "TRACE")]
+    /// The trace (.cwt, .jsonl, .cwb), or a scene (a .json file or an embedded name:
+    /// `cwisim scenes`) drawn with the drawing options below, as `render` draws it.
+    #[arg(value_name = "TRACE|SCENE")]
     pub trace: PathBuf,
 
     /// The scanline, from 0 (counted over the whole trace, as `cwisim run` outputs them).
@@ -48,6 +48,9 @@ pub struct VcdArgs {
     /// The machine model (for the cycles).
     #[command(flatten)]
     pub machine: MachineArgs,
+    /// How to draw a scene (ignored for a trace).
+    #[command(flatten, next_help_heading = "Drawing a scene")]
+    pub draw: crate::draw::DrawArgs,
 }
 
 /// Runs `cwisim vcd`.
@@ -59,10 +62,10 @@ pub fn run(args: &VcdArgs) -> Result<(), CliError> {
         )));
     }
     let machine = args.machine.load()?;
-    let mut file = FileReader::open(&args.trace)?;
+    let mut file = crate::input::open(&args.trace, &args.draw)?;
     let header = *file.header();
     let (from, to) = window(args, header.width)?;
-    let recorded = record_scanline(&mut file, &machine, args.line, from as usize, to as usize)?;
+    let recorded = record_scanline(&mut *file, &machine, args.line, from as usize, to as usize)?;
     let wave = match recorded {
         Ok(wave) => wave,
         Err(lines) => {

@@ -1,0 +1,73 @@
+//! What the study commands read: a trace file, or a scene drawn through a renderer with
+//! the drawing options of the command line (`DrawArgs`, the same flags and defaults as
+//! `render`). A scene's stream is emitted into memory and read back as a `.cwb` trace, so
+//! every command replays it exactly as it would replay `cwisim emit`'s file.
+
+use crate::draw::DrawArgs;
+use crate::error::CliError;
+use cwisim_isa::{Encoding, FileReader, TraceRead};
+use std::io::Cursor;
+use std::path::Path;
+
+/// What an input argument names.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum InputKind {
+    /// A trace file: `.cwt`, `.jsonl` or `.cwb`.
+    Trace,
+    /// A scene: a `.json` file or an embedded scene's name.
+    Scene,
+}
+
+impl InputKind {
+    /// By the extension: a trace encoding's is a trace; `.json`, or none (an embedded
+    /// scene's name), a scene; any other is refused, naming the ones it can read.
+    pub fn of(path: &Path) -> Result<InputKind, CliError> {
+        match path.extension().and_then(|e| e.to_str()) {
+            None => Ok(InputKind::Scene),
+            Some(e) if e.eq_ignore_ascii_case("json") => Ok(InputKind::Scene),
+            Some(_) if Encoding::from_path(path).is_ok() => Ok(InputKind::Trace),
+            Some(e) => Err(CliError::Usage(format!(
+                "{}: unknown input extension `.{e}`; expected a trace (.cwt, .jsonl, .cwb) or a scene (.json, or an embedded scene's name)",
+                path.display()
+            ))),
+        }
+    }
+
+    /// "trace" or "scene".
+    pub fn name(self) -> &'static str {
+        match self {
+            InputKind::Trace => "trace",
+            InputKind::Scene => "scene",
+        }
+    }
+}
+
+/// A reader on the input's instructions: the trace file, or the scene's stream as
+/// `draw` renders it.
+pub fn open(input: &Path, draw: &DrawArgs) -> Result<Box<dyn TraceRead>, CliError> {
+    open_sized(input, draw).map(|(reader, _)| reader)
+}
+
+/// [`open`], and the size in bytes of what the reader reads (for progress).
+pub fn open_sized(input: &Path, draw: &DrawArgs) -> Result<(Box<dyn TraceRead>, u64), CliError> {
+    match InputKind::of(input)? {
+        InputKind::Trace => {
+            let reader = FileReader::open(input)?;
+            let size = reader.size();
+            Ok((Box::new(reader), size))
+        }
+        InputKind::Scene => {
+            let drawn = draw.draw(Some(input))?;
+            let header = drawn.renderer.header();
+            let mut bytes = Vec::new();
+            {
+                let mut writer = Encoding::Binary
+                    .writer(&mut bytes, &header)
+                    .map_err(|e| CliError::Internal(format!("encoding a stream in memory: {e}")))?;
+                cwisim_render::emit(&*drawn.renderer, &mut *writer)?;
+            }
+            let size = bytes.len() as u64;
+            Ok((Encoding::Binary.reader(Cursor::new(bytes))?, size))
+        }
+    }
+}
