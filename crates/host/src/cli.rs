@@ -426,7 +426,7 @@ mod tests {
         let (code, _, err) = cli(&["machine", "--width", "0"]);
         assert_eq!(code, 2);
         assert!(
-            err.starts_with("error: --width/--lines/--channels: width 0"),
+            err.starts_with("error: --width/--height/--channels: width 0"),
             "{err}"
         );
     }

@@ -203,7 +203,7 @@ fn diff_exit_codes_and_reports() {
     // (the changed Eval1 comes after the one the Dis masks)
     let o = cwisim(
         &dir,
-        &["diff", v, "w.cwt", "--output", "--image", "err.png"],
+        &["diff", v, "w.cwt", "--outputs", "--image", "err.png"],
     );
     assert_eq!(o.status.code(), Some(1));
     let report = text(&o);
@@ -221,7 +221,7 @@ fn diff_exit_codes_and_reports() {
     assert_eq!(
         cwisim(
             &dir,
-            &["diff", v, "w.cwt", "--output", "--tolerance", "0.2"]
+            &["diff", v, "w.cwt", "--outputs", "--tolerance", "0.2"]
         )
         .status
         .code(),

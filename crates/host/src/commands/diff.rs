@@ -27,7 +27,8 @@ pub struct DiffArgs {
     #[arg(value_name = "B")]
     pub b: PathBuf,
     /// Compare what two traces output (replayed) instead of their instructions.
-    #[arg(long)]
+    /// `--output` is its old name.
+    #[arg(long = "outputs", alias = "output")]
     pub output: bool,
     /// Differences up to this much count as equal (outputs only).
     #[arg(long, value_name = "T", default_value_t = 0.0)]
@@ -59,8 +60,11 @@ pub fn run(args: &DiffArgs, stdout: &mut dyn Write) -> Result<bool, CliError> {
     let outputs = args.output || is_npy(&args.a) || is_npy(&args.b);
     if !outputs && args.image.is_some() {
         return Err(CliError::Usage(
-            "--image compares outputs: add --output, or give .npy files".into(),
+            "--image compares outputs: add --outputs, or give .npy files".into(),
         ));
+    }
+    if let Some(p) = &args.image {
+        crate::cost_args::check_extension("--image", p, "png")?;
     }
     if outputs {
         let a = load_output(&args.a, args)?;

@@ -18,8 +18,14 @@ pub struct MachineCmdArgs {
     #[arg(long, value_name = "W", default_value_t = 1024)]
     pub width: u32,
 
-    /// Scanlines per frame to derive the line period for.
-    #[arg(long, value_name = "H", default_value_t = 1024)]
+    /// Scanlines per frame (the display's height) to derive the line period for.
+    /// `--lines` is its old name.
+    #[arg(
+        long = "height",
+        alias = "lines",
+        value_name = "H",
+        default_value_t = 1024
+    )]
     pub lines: u32,
 
     /// Channels per intensity (1 grey, 3 RGB).
@@ -36,7 +42,7 @@ pub fn run(
 ) -> Result<(), CliError> {
     let machine = args.machine.load()?;
     let header = TraceHeader::new(args.width, args.lines, args.channels)
-        .map_err(|m| CliError::Usage(format!("--width/--lines/--channels: {m}")))?;
+        .map_err(|m| CliError::Usage(format!("--width/--height/--channels: {m}")))?;
     let line = timing_line(&machine, &header)?;
     let json = serde_json::to_string_pretty(&machine).map_err(|e| CliError::Stdout(e.into()))?;
     writeln!(stdout, "{json}").map_err(CliError::Stdout)?;

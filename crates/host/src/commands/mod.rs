@@ -40,8 +40,9 @@ impl ImageArgs {
         self.output.is_some() || self.npy.is_some()
     }
 
-    /// Refuses, before any work, a PNG path that names a NumPy file and a PNG of a
-    /// channel count PNG cannot hold.
+    /// Refuses, before any work, an output whose extension is not the format written
+    /// (`-o` writes PNG, `--npy` NumPy: `-o x.jpg` is an error, not PNG bytes in a .jpg)
+    /// and a PNG of a channel count PNG cannot hold.
     pub fn check(&self, channels: usize) -> Result<(), CliError> {
         if let Some(png) = &self.output {
             let ext = png.extension().and_then(|e| e.to_str()).unwrap_or("");
@@ -52,7 +53,11 @@ impl ImageArgs {
                     png.display()
                 )));
             }
+            crate::cost_args::check_extension("-o", png, "png")?;
             output::png_color(channels)?;
+        }
+        if let Some(npy) = &self.npy {
+            crate::cost_args::check_extension("--npy", npy, "npy")?;
         }
         Ok(())
     }

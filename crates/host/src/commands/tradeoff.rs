@@ -60,6 +60,12 @@ pub fn run(args: &TradeoffArgs, stdout: &mut dyn Write) -> Result<(), CliError> 
             ("--plot", args.plot.as_deref()),
         ],
     )?;
+    if let Some(p) = &args.plot {
+        crate::cost_args::check_extension("--plot", p, "png")?;
+    }
+    if let Some(p) = &args.csv {
+        crate::cost_args::check_extension("--csv", p, "csv")?;
+    }
     let machine = args.machine.load()?;
     let formats: Vec<Numeric> = if args.numeric.is_empty() {
         DEFAULT_FORMATS
