@@ -561,7 +561,7 @@ fn wide_arrays_need_a_window() {
     assert!(stdout.is_empty());
     assert_eq!(stderr.lines().count(), 1, "{stderr}");
     assert!(stderr.contains("100 processors wide"), "{stderr}");
-    assert!(stderr.contains("--from X0 --to X1"), "{stderr}");
+    assert!(stderr.contains("--x X0-X1"), "{stderr}");
     assert!(!dir.join("w.vcd").exists());
     // A window, or one bound (the other defaults to the array's end).
     cwisim_ok(
@@ -582,6 +582,29 @@ fn wide_arrays_need_a_window() {
         ],
     );
     assert_eq!(Dump::read(&dir.join("w.vcd")).scopes().len(), 1 + 10);
+    // the same windows as one range, --x (the old --from/--to are hidden aliases)
+    let before = std::fs::read(dir.join("w.vcd")).expect("vcd");
+    cwisim_ok(
+        &dir,
+        &[
+            "vcd", "wide.cwt", "--line", "0", "--x", "90-", "-o", "w.vcd",
+        ],
+    );
+    assert_eq!(std::fs::read(dir.join("w.vcd")).expect("vcd"), before);
+    cwisim_ok(
+        &dir,
+        &[
+            "vcd", "wide.cwt", "--line", "0", "--x", "58-92", "-o", "w.vcd",
+        ],
+    );
+    assert_eq!(Dump::read(&dir.join("w.vcd")).scopes().len(), 1 + 35);
+    let out = cwisim(
+        &dir,
+        &[
+            "vcd", "wide.cwt", "--line", "0", "--x", "1-2", "--from", "1", "-o", "w.vcd",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(2), "--x and --from conflict");
 }
 
 /// Runs `cwisim ARGS` expecting exit 2, one `error:` line containing `needle`, and no

@@ -12,6 +12,7 @@
 use super::MachineArgs;
 use crate::error::CliError;
 use crate::files::{same_file, write_atomic};
+use crate::range::{parse_range, Range};
 use clap::Args;
 use cwisim_study::vcd::{record_scanline, write_vcd};
 use std::path::PathBuf;
@@ -31,14 +32,18 @@ pub struct VcdArgs {
     #[arg(long, value_name = "Y")]
     pub line: u64,
 
-    /// First processor of the window (inclusive). Default: 0.
-    #[arg(long, value_name = "X0")]
+    /// The processors (pixel columns) to dump: N, A-B (both included) or A- (to the
+    /// last). Default: the whole array when it is at most 64 processors wide; a wider
+    /// one is refused: choose a window.
+    #[arg(long = "x", value_name = "X", value_parser = parse_range, conflicts_with_all = ["from", "to"])]
+    pub x: Option<Range>,
+
+    /// First processor of the window (old spelling of `--x X0-`).
+    #[arg(long, value_name = "X0", hide = true)]
     pub from: Option<u32>,
 
-    /// Last processor of the window (inclusive): the dump holds processors X0..=X1.
-    /// Default: the array's last processor. Without --from and --to, an array of at most
-    /// 64 processors is dumped whole and a wider one is refused: choose a window.
-    #[arg(long, value_name = "X1")]
+    /// Last processor of the window (old spelling of `--x …-X1`).
+    #[arg(long, value_name = "X1", hide = true)]
     pub to: Option<u32>,
 
     /// The VCD file to write (replaced only once the replay succeeded).
@@ -88,22 +93,28 @@ pub fn run(args: &VcdArgs) -> Result<(), CliError> {
 
 /// The window `(from, to)`, inclusive, checked against the array.
 fn window(args: &VcdArgs, width: u32) -> Result<(u32, u32), CliError> {
-    if args.from.is_none() && args.to.is_none() && width > MAX_DEFAULT_WINDOW {
-        return Err(CliError::Usage(format!(
-            "{} is {width} processors wide: choose at most {MAX_DEFAULT_WINDOW} with \
---from X0 --to X1 (or name a wider window explicitly)",
-            args.trace.display()
-        )));
-    }
-    let from = args.from.unwrap_or(0);
-    let to = args.to.unwrap_or(width.saturating_sub(1));
+    let last = width.saturating_sub(1);
+    let (from, to) = match args.x {
+        Some(r) => (
+            r.first.min(u64::from(u32::MAX)) as u32,
+            r.last.map_or(last, |l| l.min(u64::from(u32::MAX)) as u32),
+        ),
+        None => {
+            if args.from.is_none() && args.to.is_none() && width > MAX_DEFAULT_WINDOW {
+                return Err(CliError::Usage(format!(
+                    "{} is {width} processors wide: choose at most {MAX_DEFAULT_WINDOW} with \
+--x X0-X1 (or name a wider window explicitly)",
+                    args.trace.display()
+                )));
+            }
+            (args.from.unwrap_or(0), args.to.unwrap_or(last))
+        }
+    };
     if from > to || to >= width {
         return Err(CliError::Usage(format!(
-            "--from {from} --to {to}: the window is outside the array: {} has processors \
-0..={}; give --from X0 --to X1 with X0 <= X1 <= {}",
+            "--x {from}-{to}: the window is outside the array: {} has processors \
+0..={last}; give --x X0-X1 with X0 <= X1 <= {last}",
             args.trace.display(),
-            width.saturating_sub(1),
-            width.saturating_sub(1)
         )));
     }
     Ok((from, to))
