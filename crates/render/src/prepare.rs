@@ -53,6 +53,22 @@ pub struct PhongSurfaces {
     pub shader: PhongShader,
 }
 
+/// Refuses a screen scene with a negative intensity, naming the value's JSON path: the
+/// array adds light and drops negative contributions (`Acc_mode` off), so a negative
+/// polygon would be drawn as 0 — silently wrong. Every renderer of screen scenes calls it.
+pub fn no_negative_intensity(s: &ScreenScene) -> Result<(), RenderError> {
+    for (k, p) in s.polygons.iter().enumerate() {
+        for (v, i) in p.intensity.iter().enumerate() {
+            if let Some(bad) = i.iter().find(|c| **c < 0.0) {
+                return Err(RenderError::Usage(format!(
+                    "polygons[{k}].intensity[{v}]: intensity {bad:e} is negative; renderers draw light, intensities ≥ 0 (the array drops negative contributions)"
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
 impl PolygonScene {
     /// Makes `loaded` ready as `settings` say.
     pub fn new(loaded: LoadedScene, settings: &Settings) -> Result<PolygonScene, RenderError> {
@@ -88,7 +104,10 @@ impl PolygonScene {
                     "Phong shading needs a world scene (normals in 3D); a screen scene has only intensities: use --shading gouraud or flat".into(),
                 ))
             }
-            AnyScene::Screen(s) => prepared.screen = s,
+            AnyScene::Screen(s) => {
+                no_negative_intensity(&s)?;
+                prepared.screen = s
+            }
             AnyScene::World(_) if phong && settings.visibility != Visibility::Exact => {
                 return Err(RenderError::Usage(
                     "Phong shading is drawn on exact visible surfaces only: use --visibility exact (eval0 claims hold one value per pixel run, not a per-pixel shade)".into(),

@@ -67,7 +67,14 @@ impl RowPlane {
                     (e.i_bot[c] - e.i_top[c]) / dy - b_x[c] * (e.x_bot - e.x_top) / dy
                 };
                 let b_y = vector(channels, |c| 0.5 * (along(&t.left, c) + along(&t.right, c)));
-                (il, b_x, b_y)
+                // A gradient beyond f64 (a change of up to 1e308 across a band or a run
+                // narrower than the change's ratio to f64's range: a sliver 1e-12 px wide
+                // shading 0 → 1e300 across) is taken as 0: the row is then that narrow in
+                // that direction, so the constant `il` is off by at most the polygon's
+                // intensity range times the row's area, and no inf or NaN reaches an Eval.
+                let finite =
+                    |g: Vector| vector(channels, |c| if g[c].is_finite() { g[c] } else { 0.0 });
+                (il, finite(b_x), finite(b_y))
             }
         };
         RowPlane {

@@ -56,6 +56,7 @@ impl Triangles {
                         "Phong shading needs a world scene (normals in 3D); a screen scene has only intensities: use --shading gouraud or flat".into(),
                     ));
                 }
+                crate::prepare::no_negative_intensity(&s)?;
                 polygons = s.polygons.len() as u64;
                 (s.width, s.height, s.channels, screen_triangles(&s))
             }
