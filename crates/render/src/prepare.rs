@@ -69,6 +69,20 @@ pub fn no_negative_intensity(s: &ScreenScene) -> Result<(), RenderError> {
     Ok(())
 }
 
+/// What projection did, as the summary's `geometry` row says it.
+pub fn geometry_phrase(g: &ProjectStats) -> String {
+    format!(
+        "{} mesh(es), {} faces → {} triangles: {} back faces culled, {} drawn ({} back faces of two-sided meshes, {} edge-on dropped)",
+        g.meshes,
+        g.faces,
+        g.triangles,
+        g.culled,
+        g.triangles - g.culled - g.edge_on,
+        g.back_faces_drawn,
+        g.edge_on
+    )
+}
+
 impl PolygonScene {
     /// Makes `loaded` ready as `settings` say.
     pub fn new(loaded: LoadedScene, settings: &Settings) -> Result<PolygonScene, RenderError> {
@@ -152,19 +166,7 @@ impl PolygonScene {
     pub fn summary_rows(&self) -> Vec<(&'static str, String)> {
         let mut rows = Vec::new();
         if let Some(g) = &self.project {
-            rows.push((
-                "geometry",
-                format!(
-                    "{} mesh(es), {} faces → {} triangles: {} back faces culled, {} drawn ({} back faces of two-sided meshes, {} edge-on dropped)",
-                    g.meshes,
-                    g.faces,
-                    g.triangles,
-                    g.culled,
-                    g.triangles - g.culled - g.edge_on,
-                    g.back_faces_drawn,
-                    g.edge_on
-                ),
-            ));
+            rows.push(("geometry", geometry_phrase(g)));
         }
         if let (Some(Visibility::Exact), Some(v)) = (&self.visibility_mode, &self.visibility) {
             rows.push((

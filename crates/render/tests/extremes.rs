@@ -85,6 +85,24 @@ fn square(x0: f64, y0: f64, x1: f64, y1: f64) -> Vec<[f64; 2]> {
     vec![[x0, y0], [x1, y0], [x1, y1], [x0, y1]]
 }
 
+/// A sliver 1e-12 px wide across a 16×16 screen, shaded from 0 to `top` across its
+/// width.
+fn sliver(top: f64) -> ScreenScene {
+    screen(
+        16,
+        16,
+        vec![Polygon::new(
+            vec![
+                [1.0, 3.0],
+                [15.0, 9.0],
+                [15.0, 9.0 + 1e-12],
+                [1.0, 3.0 + 1e-12],
+            ],
+            vec![vec![0.0], vec![0.0], vec![top], vec![top]],
+        )],
+    )
+}
+
 fn cases() -> Vec<Case> {
     let draw = |name, scene| Case {
         name,
@@ -133,19 +151,7 @@ fn cases() -> Vec<Case> {
         ),
         draw(
             "sliver 1e-12 px wide, intensity 0 → 1 across its width",
-            screen(
-                16,
-                16,
-                vec![Polygon::new(
-                    vec![
-                        [1.0, 3.0],
-                        [15.0, 9.0],
-                        [15.0, 9.0 + 1e-12],
-                        [1.0, 3.0 + 1e-12],
-                    ],
-                    vec![vec![0.0], vec![0.0], vec![1.0], vec![1.0]],
-                )],
-            ),
+            sliver(1.0),
         ),
         draw(
             "polygons 1e6 px outside the screen",
@@ -297,19 +303,7 @@ fn cases() -> Vec<Case> {
         ),
         draw(
             "sliver 1e-12 px wide, intensity 0 → 1e300 across its width",
-            screen(
-                16,
-                16,
-                vec![Polygon::new(
-                    vec![
-                        [1.0, 3.0],
-                        [15.0, 9.0],
-                        [15.0, 9.0 + 1e-12],
-                        [1.0, 3.0 + 1e-12],
-                    ],
-                    vec![vec![0.0], vec![0.0], vec![1e300], vec![1e300]],
-                )],
-            ),
+            sliver(1e300),
         ),
         draw(
             "triangle of 1e-9 px², intensities 0, 1e300, 5e299",

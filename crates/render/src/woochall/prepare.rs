@@ -125,14 +125,8 @@ impl Triangles {
             Some(g) => vec![(
                 "geometry",
                 format!(
-                    "{} mesh(es), {} faces → {} triangles: {} back faces culled, {} drawn ({} back faces of two-sided meshes, {} edge-on dropped); no hidden-surface removal before sampling",
-                    g.meshes,
-                    g.faces,
-                    g.triangles,
-                    g.culled,
-                    g.triangles - g.culled - g.edge_on,
-                    g.back_faces_drawn,
-                    g.edge_on
+                    "{}; no hidden-surface removal before sampling",
+                    crate::prepare::geometry_phrase(g)
                 ),
             )],
             None => vec![(
