@@ -168,7 +168,7 @@ a scene file (.json, rendered first as by `render`: Gouraud, box filter, exact v
 opcode, bus (busy) and stall cycles, processor updates, and when each scanline was ready \
 against the display's deadline; negative slack is an overrun, marked LATE. Prints the table \
 (a column per opcode that occurs) and a totals line for the selected scanlines.\n\n\
---lines keeps some scanlines (N, A-B or A-, counted from 0 over the whole trace). --plot \
+--lines keeps some scanlines (N, A..B with B not included, A..=B or A.., counted from 0 over the whole trace). --plot \
 draws a PNG: one bar per scanline, its bus cycles stacked by opcode group (count × the \
 opcode's issue cost) with the stall cycles on top, the line period as a horizontal line, a \
 red marker on every overrun. --csv writes the table with a column for each of the 14 \
@@ -203,11 +203,12 @@ locked, masked, neg (1-bit), out (real: what N shifts out when this scanline's R
 0 before), token (32-bit: the instruction whose token is in N, z when none). With several \
 channels each real is one per channel: I_c0, I_c1, … Tokens of other scanlines passing \
 through are included.\n\n\
---from X0 --to X1 keep processors X0..=X1 (inclusive) and the file small; a missing --from is \
-0, a missing --to the last processor. Without either, an array of at most 64 processors is \
-dumped whole and a wider one is refused. The file is written only when the replay succeeded, \
-and is the same byte for byte on every run.\n\n\
-Example:\n  cwisim vcd traces/gouraud.cwt --line 1 --from 2 --to 8 -o line1.vcd",
+--x keeps a window of processors and the file small: N, A..B (B not included), A..=B or A.. \
+(to the last). Without it, an array of at most 512 processors is dumped whole and a wider one \
+is refused. The file is written only when the replay succeeded, and is the same byte for byte \
+on every run.\n\n\
+Examples:\n  cwisim vcd traces/gouraud.cwt --line 1 --x 2..=8 -o line1.vcd\n  \
+cwisim vcd pot --line 200 -o l.vcd",
         after_help = AFTER_HELP
     )]
     Vcd(vcd::VcdArgs),
@@ -228,7 +229,7 @@ Example:\n  cwisim diff a.cwt b.cwb --output\n  cwisim diff a.npy b.npy --image 
         long_about = "Print a trace (any encoding) in the text form, each instruction annotated with \
 its number, its scanline, the cycle the bus started issuing it and the cycle it entered \
 the array. --lines keeps only some scanlines.\n\n\
-Example:\n  cwisim dump trace.cwb --lines 10-12",
+Example:\n  cwisim dump trace.cwb --lines 10..13",
         after_help = AFTER_HELP
     )]
     Dump(dump::DumpArgs),

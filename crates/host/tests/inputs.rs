@@ -44,15 +44,21 @@ fn study_commands_read_a_scene_as_its_emitted_trace() {
             assert_eq!(scene, trace.replace("pot.cwt", "pot"), "{args:?}");
             assert!(!scene.is_empty());
         }
-        let mut vcd = vec![
-            "vcd", "pot", "--line", "60", "--from", "40", "--to", "60", "-o", "a.vcd",
-        ];
-        vcd.extend_from_slice(draw);
-        cwisim_ok(&dir, &vcd);
-        vcd[1] = "pot.cwt";
-        vcd[9] = "b.vcd";
-        cwisim_ok(&dir, &vcd);
-        assert_eq!(read(dir.join("a.vcd")), read(dir.join("b.vcd")));
+        // the whole array (the default window), and a window
+        for window in [&[][..], &["--x", "40..=60"]] {
+            let mut vcd = vec!["vcd", "pot", "--line", "60", "-o", "a.vcd"];
+            vcd.extend_from_slice(window);
+            vcd.extend_from_slice(draw);
+            cwisim_ok(&dir, &vcd);
+            vcd[1] = "pot.cwt";
+            vcd[5] = "b.vcd";
+            cwisim_ok(&dir, &vcd);
+            assert_eq!(
+                read(dir.join("a.vcd")),
+                read(dir.join("b.vcd")),
+                "{window:?}"
+            );
+        }
         let mut run = vec!["run", "pot", "-o", "a.png"];
         run.extend_from_slice(draw);
         cwisim_ok(&dir, &run);

@@ -279,11 +279,23 @@ fn lines_selects_exactly_the_range() {
     );
     let run = json(dir.join("run.json"));
     let all = run["stats"]["lines"].as_array().expect("lines");
-    // overrun.cwt has 4 scanlines per frame: --frames 0 is scanlines 0-3
+    // overrun.cwt has 4 scanlines per frame: --frames 0 is scanlines 0..4
     let by_frame = cwisim_ok(&dir, &overrun_args(&["--frames", "0"], &t, &m));
-    let by_lines = cwisim_ok(&dir, &overrun_args(&["--lines", "0-3"], &t, &m));
+    let by_lines = cwisim_ok(&dir, &overrun_args(&["--lines", "0..4"], &t, &m));
     assert_eq!(by_frame, by_lines);
-    for (range, want) in [("1-2", 1..3), ("3", 3..4), ("2-", 2..4), ("0-9", 0..4)] {
+    // the old spelling (both ends included) reads the same
+    let old = cwisim_ok(&dir, &overrun_args(&["--lines", "0-3"], &t, &m));
+    assert_eq!(old, by_lines);
+    // each range as typed, and as the JSON writes it back (always the new syntax)
+    for (range, written, want) in [
+        ("1..3", "1..3", 1..3),
+        ("1..=2", "1..3", 1..3),
+        ("1-2", "1..3", 1..3),
+        ("3", "3", 3..4),
+        ("2..", "2..", 2..4),
+        ("2-", "2..", 2..4),
+        ("0..10", "0..10", 0..4),
+    ] {
         let out = cwisim_ok(
             &dir,
             &overrun_args(
@@ -307,13 +319,13 @@ fn lines_selects_exactly_the_range() {
         assert_eq!(csv.lines().next(), Some(CSV_HEADER));
         let s = json(dir.join("s.json"));
         assert_eq!(s["lines"].as_array().unwrap()[..], all[want.clone()]);
-        assert_eq!(s["range"], range);
+        assert_eq!(s["range"], written, "--lines {range}");
         assert_eq!(s["selected"]["lines"], want.len());
         // the totals stay the run's
         assert_eq!(s["totals"], run["stats"]["totals"]);
     }
-    // 1-2 holds the late line, 2- does not
-    let out = cwisim_ok(&dir, &overrun_args(&["--lines", "2-"], &t, &m));
+    // 1..3 holds the late line, 2.. does not
+    let out = cwisim_ok(&dir, &overrun_args(&["--lines", "2.."], &t, &m));
     assert!(!out.contains("LATE"), "{out}");
     assert!(out.contains("  0 late"), "{out}");
 }
@@ -382,7 +394,7 @@ fn bad_input_exits_2_with_one_error_line() {
     )
     .expect("write");
     let cases: [(&[&str], &str); 10] = [
-        (&["stats", "t.cwt", "--lines", "5-2"], "5-2"),
+        (&["stats", "t.cwt", "--lines", "5..2"], "5..2"),
         (&["stats", "t.cwt", "--lines", "x"], "not a range"),
         (&["stats", "t.cwt", "--lines=-3"], "not a range"),
         (
@@ -390,8 +402,8 @@ fn bad_input_exits_2_with_one_error_line() {
             "error: t.txt: unknown input extension `.txt`",
         ),
         (
-            &["stats", "t.cwt", "--lines", "7-"],
-            "error: --lines 7- selects no scanline",
+            &["stats", "t.cwt", "--lines", "7.."],
+            "error: --lines 7.. selects no scanline",
         ),
         (
             &["stats", "t.cwt", "--plot", "p.svg"],

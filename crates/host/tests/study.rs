@@ -53,11 +53,11 @@ fn dump_annotates_every_instruction_and_reads_back_as_the_same_trace() {
     // --lines keeps only those scanlines
     let part = text(&cwisim(
         &dir,
-        &["dump", overrun.to_str().unwrap(), "--lines", "2-"],
+        &["dump", overrun.to_str().unwrap(), "--lines", "2.."],
     ));
     assert!(part.contains("# --- scanline 2") && part.contains("# --- scanline 3"));
     assert!(!part.contains("line 1 issue"), "{part}");
-    // --frames: overrun.cwt has 4 scanlines per frame, so frame 0 is scanlines 0-3 and
+    // --frames: overrun.cwt has 4 scanlines per frame, so frame 0 is scanlines 0..4 and
     // frame 1 does not exist
     let frame0 = text(&cwisim(
         &dir,
@@ -67,12 +67,12 @@ fn dump_annotates_every_instruction_and_reads_back_as_the_same_trace() {
         frame0,
         text(&cwisim(
             &dir,
-            &["dump", overrun.to_str().unwrap(), "--lines", "0-3"]
+            &["dump", overrun.to_str().unwrap(), "--lines", "0..4"]
         ))
     );
     let none = text(&cwisim(
         &dir,
-        &["dump", overrun.to_str().unwrap(), "--frames", "1-"],
+        &["dump", overrun.to_str().unwrap(), "--frames", "1.."],
     ));
     assert!(!none.contains("# ---"), "{none}");
     let both = cwisim(
@@ -87,7 +87,10 @@ fn dump_annotates_every_instruction_and_reads_back_as_the_same_trace() {
         ],
     );
     assert_eq!(both.status.code(), Some(2));
-    let bad = cwisim(&dir, &["dump", overrun.to_str().unwrap(), "--lines", "3-1"]);
+    let bad = cwisim(
+        &dir,
+        &["dump", overrun.to_str().unwrap(), "--lines", "3..1"],
+    );
     assert_eq!(bad.status.code(), Some(2));
 }
 

@@ -23,10 +23,10 @@ pub struct DumpArgs {
     /// `cwisim scenes`) drawn with the drawing options below, as `render` draws it.
     #[arg(value_name = "TRACE|SCENE")]
     pub trace: PathBuf,
-    /// Only these scanlines: N, A-B (both included) or A- (to the end).
+    /// Only these scanlines: N, A..B (B not included), A..=B or A.. (to the end).
     #[arg(long, value_name = "RANGE", value_parser = parse_range)]
     pub lines: Option<Range>,
-    /// Only the scanlines of these frames: N, A-B or A- (frames of the trace header's
+    /// Only the scanlines of these frames, in the same syntax (frames of the trace header's
     /// lines per frame).
     #[arg(long, value_name = "RANGE", value_parser = parse_range, conflicts_with = "lines")]
     pub frames: Option<Range>,

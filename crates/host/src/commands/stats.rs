@@ -30,10 +30,11 @@ pub struct StatsArgs {
     #[arg(value_name = "TRACE|SCENE")]
     pub input: PathBuf,
 
-    /// Only these scanlines (counted over the whole trace, from 0): N, A-B or A-.
+    /// Only these scanlines (counted over the whole trace, from 0): N, A..B (B not
+    /// included), A..=B or A.. (to the end).
     #[arg(long, value_name = "RANGE", value_parser = parse_range)]
     pub lines: Option<Range>,
-    /// Only the scanlines of these frames: N, A-B or A- (frames of the trace header's
+    /// Only the scanlines of these frames, in the same syntax (frames of the trace header's
     /// lines per frame).
     #[arg(long, value_name = "RANGE", value_parser = parse_range, conflicts_with = "lines")]
     pub frames: Option<Range>,

@@ -18,7 +18,10 @@ use cwisim_study::vcd::{record_scanline, write_vcd};
 use std::path::PathBuf;
 
 /// The widest array dumped whole when neither `--from` nor `--to` is given.
-pub const MAX_DEFAULT_WINDOW: u32 = 64;
+///
+/// 512 covers the embedded scenes at their default sizes (a busy scanline of the pot,
+/// 400 wide, is a 2.5 MB dump); wider arrays name a window.
+pub const MAX_DEFAULT_WINDOW: u32 = 512;
 
 /// The arguments of `cwisim vcd`.
 #[derive(Args, Clone, Debug, PartialEq)]
@@ -32,8 +35,8 @@ pub struct VcdArgs {
     #[arg(long, value_name = "Y")]
     pub line: u64,
 
-    /// The processors (pixel columns) to dump: N, A-B (both included) or A- (to the
-    /// last). Default: the whole array when it is at most 64 processors wide; a wider
+    /// The processors (pixel columns) to dump: N, A..B (B not included), A..=B or A..
+    /// (to the last). Default: the whole array when it is at most 512 processors wide; a wider
     /// one is refused: choose a window.
     #[arg(long = "x", value_name = "X", value_parser = parse_range, conflicts_with_all = ["from", "to"])]
     pub x: Option<Range>,
@@ -103,7 +106,7 @@ fn window(args: &VcdArgs, width: u32) -> Result<(u32, u32), CliError> {
             if args.from.is_none() && args.to.is_none() && width > MAX_DEFAULT_WINDOW {
                 return Err(CliError::Usage(format!(
                     "{} is {width} processors wide: choose at most {MAX_DEFAULT_WINDOW} with \
---x X0-X1 (or name a wider window explicitly)",
+--x X0..X1 (or name a wider window explicitly)",
                     args.trace.display()
                 )));
             }
@@ -112,8 +115,8 @@ fn window(args: &VcdArgs, width: u32) -> Result<(u32, u32), CliError> {
     };
     if from > to || to >= width {
         return Err(CliError::Usage(format!(
-            "--x {from}-{to}: the window is outside the array: {} has processors \
-0..={last}; give --x X0-X1 with X0 <= X1 <= {last}",
+            "--x {from}..={to}: the window is outside the array: {} has processors \
+0..={last}; give --x X0..X1 with X0 < X1 <= {width}",
             args.trace.display(),
         )));
     }
