@@ -57,7 +57,9 @@ NumPy float64, shape (scanlines, width, channels), C order, nothing clamped. Wit
 --npy no image is kept: the run only checks the trace and counts. Without TRACE, the \
 embedded demo trace is replayed: a Gouraud-shaded, anti-aliased disc, 96 × 64, grey.\n\n\
 Outputs are written only after the whole trace replayed without error; a malformed trace \
-leaves no file behind. --stats prints a summary to standard output; --stats-json writes the \
+leaves no file behind — unless --keep-partial is given: the image outputs then hold the \
+scanlines completed before the bad instruction, a warning says so, and the exit code is still \
+2. --stats prints a summary to standard output; --stats-json writes the \
 trace's dimensions, the machine, the timing model and the statistics (per scanline too) as \
 JSON. Otherwise a successful run prints nothing. Instructions after the last Refresh never \
 reach the output; a warning on standard error says so.\n\n\
@@ -241,7 +243,7 @@ Example:\n  cwisim dump trace.cwb --lines 10..13",
 values are copied bit-exactly, so any chain of conversions gives back the same trace. \
 Comments of a .cwt input are not kept (the output is the canonical form). IN and OUT must \
 be different files; OUT is replaced only once the whole input converted without error.\n\n\
-Example:\n  cwisim convert scene.cwt scene.cwb",
+Examples:\n  cwisim convert scene.cwt -o scene.cwb\n  cwisim convert scene.cwt scene.cwb",
         after_help = AFTER_HELP
     )]
     Convert(ConvertArgs),
@@ -375,7 +377,7 @@ mod tests {
             let (code, out, err) = cli(args);
             assert_eq!(code, 0, "{args:?}");
             assert!(out.contains("Usage: cwisim"), "{args:?}: {out}");
-            assert!(out.contains("Example:"), "{args:?}: {out}");
+            assert!(out.contains("Example"), "{args:?}: {out}");
             assert!(err.is_empty());
         }
         let (code, out, _) = cli(&["--version"]);

@@ -231,6 +231,15 @@ fn convert_round_trip_gives_back_the_canonical_text() {
     assert_eq!(read(dir.join("b.cwb")), read(dir.join("d.cwb")));
     cwisim_ok(&dir, &["convert", "d.cwb", "e.jsonl"]);
     assert_eq!(read(dir.join("a.jsonl")), read(dir.join("e.jsonl")));
+    // -o OUT, as every command names its output, is the same as OUT second
+    cwisim_ok(&dir, &["convert", "d.cwb", "-o", "f.jsonl"]);
+    assert_eq!(read(dir.join("a.jsonl")), read(dir.join("f.jsonl")));
+    for bad in [
+        &["convert", "d.cwb"][..],
+        &["convert", "d.cwb", "g.cwt", "-o", "h.cwt"],
+    ] {
+        assert_eq!(cwisim(&dir, bad).status.code(), Some(2), "{bad:?}");
+    }
     let leftovers: Vec<_> = std::fs::read_dir(&dir)
         .expect("dir")
         .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())

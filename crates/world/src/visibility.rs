@@ -4,9 +4,12 @@
 //!
 //! Each screen triangle `T` is cut down to the part of it that nothing hides:
 //!
-//! 1. **Candidates.** A sort-and-sweep over the triangles' screen bounding boxes (sorted
-//!    by left edge, an active list pruned by right edge) finds every pair whose boxes
-//!    overlap; only those are compared.
+//! 1. **Candidates.** The triangles' screen bounding boxes go into a uniform grid of
+//!    cells (about one triangle per cell; boxes covering more than 64 cells are kept
+//!    aside and checked against every triangle). For each triangle in turn, the triangles
+//!    whose boxes overlap its own are its candidate occluders; only those are compared.
+//!    Nothing holds more than one triangle's candidates and pieces at a time (see
+//!    "Depth complexity" below).
 //! 2. **Occluder pieces.** For a pair `S`, `T`, the overlap `proj(S) ∩ proj(T)` is `S`
 //!    clipped against `T`'s three edge half-planes (Sutherland–Hodgman). `1/depth` is an
 //!    affine function of the screen position on each triangle (see
@@ -51,6 +54,24 @@
 //!
 //! Output order is deterministic: by source index, then in `i_overlay`'s order.
 //!
+//! ## Depth complexity
+//!
+//! Memory is the index (one entry per triangle and cell it covers) plus one triangle's
+//! candidates and occluder pieces: it grows like the input, not like the number of
+//! occluding pairs (which grows with the square of the layers when surfaces are stacked:
+//! the pot as 16 coincident layers has 750 000 of them, and holding them all took 130 MB;
+//! 600 layers took more than 24 GB). A triangle's candidates are looked at in order of how
+//! much their boxes share with its own (copies of it in other layers first). A piece that
+//! holds all three of its vertices (a convex piece: all of it) hides it without a boolean,
+//! and the remaining candidates are skipped (`candidates_skipped`): a coincident copy with
+//! a lower index does that. Pieces equal to one already taken (coincident copies) are
+//! dropped before the boolean. Neither changes a fragment: both only leave out what could
+//! not change the difference.
+//!
+//! Time still grows faster than the layers — the booleans of nearly coincident layers
+//! have many crossing edges — measured in `docs/VISIBILITY.md`
+//! (`cargo run --release -p cwisim-world --example depth_complexity`).
+//!
 //! ## Precision
 //!
 //! `i_overlay` works on an integer grid. All its calls here share one grid: `i64`
@@ -74,6 +95,7 @@
 //! centroid, nearest first.
 
 use crate::face::ScreenTriangle;
+use arrayvec::ArrayVec;
 use cwisim_scene::Polygon;
 use cwisim_scene::Vector;
 use i_overlay::core::fill_rule::FillRule;
@@ -83,6 +105,8 @@ use i_overlay::core::solver::Solver;
 use i_overlay::float::overlay::{FloatOverlay, OverlayOptions};
 use i_overlay::i_float::adapter::FloatPointAdapter;
 use i_overlay::i_float::float::rect::FloatRect;
+use std::collections::HashMap;
+use std::hash::{Hash, Hasher};
 
 /// A screen point `[x, y]`.
 type Pt = [f64; 2];
@@ -130,6 +154,10 @@ pub struct VisibilityStats {
     pub hidden: u64,
     /// Fragments output.
     pub fragments: u64,
+    /// Candidate occluders (triangles whose screen boxes overlap) not examined because
+    /// the triangle was already wholly hidden by nearer ones: see "Depth complexity" in
+    /// the module docs.
+    pub candidates_skipped: u64,
     /// Horizontal cuts made to remove holes.
     pub hole_cuts: u64,
     /// Contours (outlines, holes, or what was left of one after removing spikes and
@@ -171,54 +199,59 @@ pub fn exact_fragments(
             .flat_map(|(t, _)| t.points),
     );
 
-    // occluders[t]: the pieces of other triangles that hide parts of triangle t
-    let mut occluders: Vec<Vec<Contour>> = vec![Vec::new(); tris.len()];
-    for (i, j) in overlapping_boxes(tris, &usable) {
-        let (ti, tj) = (&tris[i], &tris[j]);
-        let overlap = inside_triangle(&tj.points, ti);
-        if area(&overlap) <= PIECE_AREA {
-            continue;
-        }
-        // d > 0 where j is nearer than i
-        let d = |p: Pt| inv_depth(tj, &planes[j], p) - inv_depth(ti, &planes[i], p);
-        let dv: Vec<f64> = overlap.iter().map(|&p| d(p)).collect();
-        let coplanar = overlap.iter().zip(&dv).all(|(&p, &dp)| {
-            let scale = planes[i].at(p).abs().max(planes[j].at(p).abs());
-            dp.abs() <= COPLANAR * scale
-        });
-        if coplanar {
-            // the lower index (i) wins the whole overlap
-            occluders[j].push(positive(ti.points.to_vec()));
-            stats.occluding_pairs += 1;
-            continue;
-        }
-        for (front, back, sign) in [(j, i, 1.0), (i, j, -1.0)] {
-            let nearer = |p: Pt| sign * d(p);
-            if area(&clip(&overlap, nearer)) <= PIECE_AREA {
-                continue;
-            }
-            let points = tris[front].points;
-            let piece = if dv.iter().all(|&v| sign * v >= 0.0) {
-                points.to_vec()
-            } else {
-                clip(&points, nearer)
-            };
-            occluders[back].push(positive(piece));
-            stats.occluding_pairs += 1;
-        }
-    }
-
+    // Triangle by triangle, so that memory holds one triangle's occluders at a time
+    // whatever the depth complexity (see "Depth complexity" in the module docs).
+    let index = BoxIndex::new(tris, &usable);
+    let mut keys: Vec<(f64, usize)> = Vec::new();
+    let mut seen: HashMap<u64, usize> = HashMap::new();
+    let mut stamp = Vec::new();
+    let mut candidates = Vec::new();
+    let mut pieces: Vec<Contour> = Vec::new();
     let mut fragments = Vec::new();
     let mut contours = Vec::new();
     for (k, tri) in tris.iter().enumerate() {
         let before = fragments.len();
         if usable[k] {
-            let shapes = if occluders[k].is_empty() {
-                vec![vec![tri.points.to_vec()]]
+            index.candidates(k, &mut candidates, &mut stamp);
+            // the candidates whose boxes overlap the triangle's most first: the likeliest to
+            // hide all of it (copies of it in other layers, its neighbours of its own
+            // surface last)
+            keys.clear();
+            keys.extend(candidates.iter().map(|&c| (index.shared_area(c, k), c)));
+            keys.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+            candidates.clear();
+            candidates.extend(keys.iter().map(|&(_, c)| c));
+            seen.clear();
+            pieces.clear();
+            let mut covered = false;
+            for (n, &c) in candidates.iter().enumerate() {
+                let Some(piece) = piece_hiding(tris, &planes, c, k) else {
+                    continue;
+                };
+                stats.occluding_pairs += 1;
+                // one piece holding all of the triangle hides it: no boolean, and the
+                // remaining candidates cannot change that
+                if contains_triangle(&piece, &tri.points) {
+                    covered = true;
+                    stats.candidates_skipped += (candidates.len() - n - 1) as u64;
+                    break;
+                }
+                // a piece equal to one already taken adds nothing (coincident layers
+                // give many)
+                let first = *seen.entry(bits_hash(&piece)).or_insert(pieces.len());
+                if first == pieces.len() || !same_bits(&pieces[first], &piece) {
+                    pieces.push(piece);
+                }
+            }
+            let cut = if covered {
+                Some(Vec::new())
+            } else if pieces.is_empty() {
+                None
             } else {
                 let subject = vec![positive(tri.points.to_vec())];
-                overlay(&grid, &subject, &occluders[k], OverlayRule::Difference)
+                Some(overlay(&grid, &subject, &pieces, OverlayRule::Difference))
             };
+            let shapes = cut.unwrap_or_else(|| vec![vec![tri.points.to_vec()]]);
             contours.clear();
             for shape in shapes {
                 settle(&grid, shape, usize::MAX, &mut contours, &mut stats);
@@ -245,6 +278,49 @@ pub fn exact_fragments(
     }
     stats.fragments = fragments.len() as u64;
     (fragments, stats)
+}
+
+/// The piece of triangle `front` that hides part of triangle `back`, or `None` where it
+/// hides nothing (more than [`PIECE_AREA`]). The pair is looked at as `(i, j)`, `i < j`,
+/// whichever of the two is asked about, so both directions come from the same overlap,
+/// bit for bit.
+fn piece_hiding(
+    tris: &[ScreenTriangle],
+    planes: &[Plane],
+    front: usize,
+    back: usize,
+) -> Option<Contour> {
+    let (i, j) = (front.min(back), front.max(back));
+    let (ti, tj) = (&tris[i], &tris[j]);
+    let (mut overlap, mut spare) = (Small::new(), Small::new());
+    inside_triangle(&tj.points, ti, &mut overlap, &mut spare);
+    if area(&overlap) <= PIECE_AREA {
+        return None;
+    }
+    // d > 0 where j is nearer than i
+    let d = |p: Pt| inv_depth(tj, &planes[j], p) - inv_depth(ti, &planes[i], p);
+    let dv: ArrayVec<f64, SMALL> = overlap.iter().map(|&p| d(p)).collect();
+    let coplanar = overlap.iter().zip(&dv).all(|(&p, &dp)| {
+        let scale = planes[i].at(p).abs().max(planes[j].at(p).abs());
+        dp.abs() <= COPLANAR * scale
+    });
+    if coplanar {
+        // the lower index (i) wins the whole overlap
+        return (front == i).then(|| positive(ti.points.to_vec()));
+    }
+    let sign = if front == j { 1.0 } else { -1.0 };
+    let nearer = |p: Pt| sign * d(p);
+    clip_into(&overlap, nearer, &mut spare);
+    if area(&spare) <= PIECE_AREA {
+        return None;
+    }
+    let points = tris[front].points;
+    let piece = if dv.iter().all(|&v| sign * v >= 0.0) {
+        points.to_vec()
+    } else {
+        clip(&points, nearer).to_vec()
+    };
+    Some(positive(piece))
 }
 
 /// Front-to-back order for the array's `Eval0` visibility: the indices of `tris` sorted
@@ -331,6 +407,34 @@ fn inv_depth(t: &ScreenTriangle, plane: &Plane, p: Pt) -> f64 {
     }
 }
 
+/// A hash of a contour's coordinates, bit for bit.
+fn bits_hash(c: &[Pt]) -> u64 {
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    for p in c {
+        p[0].to_bits().hash(&mut h);
+        p[1].to_bits().hash(&mut h);
+    }
+    h.finish()
+}
+
+/// Whether two contours have the same coordinates, bit for bit.
+fn same_bits(a: &[Pt], b: &[Pt]) -> bool {
+    a.len() == b.len()
+        && a.iter()
+            .zip(b)
+            .all(|(p, q)| p[0].to_bits() == q[0].to_bits() && p[1].to_bits() == q[1].to_bits())
+}
+
+/// Whether the convex polygon `piece` (positively oriented) holds every vertex of the
+/// triangle `t` (on its boundary counts), so all of `t`.
+fn contains_triangle(piece: &[Pt], t: &[Pt; 3]) -> bool {
+    piece.len() >= 3
+        && (0..piece.len()).all(|e| {
+            let (a, b) = (piece[e], piece[(e + 1) % piece.len()]);
+            t.iter().all(|&p| cross(a, b, p) >= 0.0)
+        })
+}
+
 /// Twice the signed area of the triangle `a b c`.
 fn cross(a: Pt, b: Pt, c: Pt) -> f64 {
     (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1])
@@ -362,14 +466,36 @@ fn positive(mut v: Contour) -> Contour {
     v
 }
 
+/// A convex polygon of at most [`SMALL`] vertices: a triangle clipped by up to five
+/// half-planes, kept off the heap (there is one per candidate pair).
+type Small = ArrayVec<Pt, SMALL>;
+/// The most vertices of a [`Small`]: a triangle gains at most one per clip.
+const SMALL: usize = 8;
+
 /// The part of the convex polygon `poly` where `f ≥ 0`, `f` affine (Sutherland–Hodgman).
 /// A vertex where `f` is exactly 0 is kept and not duplicated. A cut point is
 /// interpolated from the lexicographically smaller end of its edge, so that polygons
 /// sharing an edge (and `f`'s values at its ends) get the same cut point, to the bit.
-fn clip(poly: &[Pt], f: impl Fn(Pt) -> f64) -> Contour {
+///
+/// `poly` is convex with fewer than [`SMALL`] vertices (a convex polygon gains at most one
+/// vertex); a longer one gives the empty polygon rather than overflow.
+fn clip(poly: &[Pt], f: impl Fn(Pt) -> f64) -> Small {
+    let mut out = Small::new();
+    clip_into(poly, f, &mut out);
+    out
+}
+
+/// [`clip`] into `out` (cleared first), without moving a [`Small`] around.
+fn clip_into(poly: &[Pt], f: impl Fn(Pt) -> f64, out: &mut Small) {
+    out.clear();
     let n = poly.len();
-    let mut out = Vec::with_capacity(n + 2);
-    let values: Vec<f64> = poly.iter().map(|&p| f(p)).collect();
+    if n >= SMALL {
+        return;
+    }
+    let mut values = [0.0; SMALL];
+    for (v, &p) in values.iter_mut().zip(poly) {
+        *v = f(p);
+    }
     for k in 0..n {
         let prev = (k + n - 1) % n;
         let (a, fa, b, fb) = (poly[prev], values[prev], poly[k], values[k]);
@@ -386,54 +512,189 @@ fn clip(poly: &[Pt], f: impl Fn(Pt) -> f64) -> Contour {
             out.push(b);
         }
     }
-    out
 }
 
-/// The convex polygon `poly` clipped to the triangle `t` (either orientation).
-fn inside_triangle(poly: &[Pt], t: &ScreenTriangle) -> Contour {
+/// The convex polygon `poly` clipped to the triangle `t` (either orientation), into
+/// `out`; `spare` is scratch space.
+fn inside_triangle(poly: &[Pt], t: &ScreenTriangle, out: &mut Small, spare: &mut Small) {
     let s = t.doubled_area().signum();
-    let mut v = poly.to_vec();
-    for k in 0..3 {
+    let edge = |k: usize| {
         let (a, b) = (t.points[k], t.points[(k + 1) % 3]);
-        v = clip(&v, |p| s * cross(a, b, p));
-        if v.is_empty() {
-            break;
-        }
+        move |p: Pt| s * cross(a, b, p)
+    };
+    // poly → spare → out → spare… ending in out after three clips
+    clip_into(poly, edge(0), out);
+    if out.is_empty() {
+        return;
     }
-    v
+    clip_into(out, edge(1), spare);
+    if spare.is_empty() {
+        out.clear();
+        return;
+    }
+    clip_into(spare, edge(2), out);
 }
 
-/// The pairs `(i, j)`, `i < j`, of usable triangles whose screen bounding boxes
-/// overlap (touching counts), by sort and sweep along x. Deterministic order.
-fn overlapping_boxes(tris: &[ScreenTriangle], usable: &[bool]) -> Vec<(usize, usize)> {
-    let boxes: Vec<[f64; 4]> = tris
-        .iter()
-        .map(|t| {
-            let xs = t.points.map(|p| p[0]);
-            let ys = t.points.map(|p| p[1]);
-            [
-                xs.iter().copied().fold(f64::INFINITY, f64::min),
-                ys.iter().copied().fold(f64::INFINITY, f64::min),
-                xs.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-                ys.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-            ]
-        })
-        .collect();
-    let mut order: Vec<usize> = (0..tris.len()).filter(|&k| usable[k]).collect();
-    order.sort_by(|&a, &b| boxes[a][0].total_cmp(&boxes[b][0]).then(a.cmp(&b)));
-    let mut active: Vec<usize> = Vec::new();
-    let mut pairs = Vec::new();
-    for &k in &order {
-        let b = boxes[k];
-        active.retain(|&a| boxes[a][2] >= b[0]);
-        for &a in &active {
-            if boxes[a][1] <= b[3] && b[1] <= boxes[a][3] {
-                pairs.push((a.min(k), a.max(k)));
+/// The usable triangles' screen bounding boxes in a uniform grid of cells, to find the
+/// triangles whose boxes overlap a given one's (touching counts) without listing every
+/// overlapping pair at once: memory is one entry per (triangle, cell it covers), the
+/// cells' lists packed in one array.
+struct BoxIndex {
+    /// Each triangle's box `[x0, y0, x1, y1]`.
+    boxes: Vec<[f64; 4]>,
+    /// The grid's lower corner and cell size.
+    origin: Pt,
+    cell: Pt,
+    /// Cells per side.
+    side: usize,
+    /// `starts[c]..starts[c + 1]` indexes `cells`' entries for cell `c` (row-major).
+    starts: Vec<usize>,
+    /// Triangle indices, cell by cell, ascending within a cell.
+    entries: Vec<u32>,
+    /// Triangles whose boxes cover more than [`BIG_BOX_CELLS`] cells: checked against
+    /// every triangle rather than entered in each cell.
+    big: Vec<u32>,
+    /// Usable triangles.
+    usable: Vec<bool>,
+}
+
+/// A box covering more cells than this is kept in [`BoxIndex::big`].
+const BIG_BOX_CELLS: usize = 64;
+
+impl BoxIndex {
+    fn new(tris: &[ScreenTriangle], usable: &[bool]) -> BoxIndex {
+        let boxes: Vec<[f64; 4]> = tris
+            .iter()
+            .map(|t| {
+                let xs = t.points.map(|p| p[0]);
+                let ys = t.points.map(|p| p[1]);
+                [
+                    xs.iter().copied().fold(f64::INFINITY, f64::min),
+                    ys.iter().copied().fold(f64::INFINITY, f64::min),
+                    xs.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+                    ys.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+                ]
+            })
+            .collect();
+        let used = || boxes.iter().zip(usable).filter(|(_, &u)| u).map(|(b, _)| b);
+        let count = used().count();
+        let mut lo = [f64::INFINITY; 2];
+        let mut hi = [f64::NEG_INFINITY; 2];
+        for b in used() {
+            lo = [lo[0].min(b[0]), lo[1].min(b[1])];
+            hi = [hi[0].max(b[2]), hi[1].max(b[3])];
+        }
+        // about one triangle per cell, at most 1024 × 1024 cells
+        let side = ((count as f64).sqrt().ceil() as usize).clamp(1, 1024);
+        let size = |a: f64, b: f64| {
+            let s = (b - a) / side as f64;
+            if s > 0.0 && s.is_finite() {
+                s
+            } else {
+                1.0
+            }
+        };
+        let mut index = BoxIndex {
+            origin: if count > 0 { lo } else { [0.0; 2] },
+            cell: if count > 0 {
+                [size(lo[0], hi[0]), size(lo[1], hi[1])]
+            } else {
+                [1.0; 2]
+            },
+            side,
+            starts: vec![0; side * side + 1],
+            entries: Vec::new(),
+            big: Vec::new(),
+            boxes,
+            usable: usable.to_vec(),
+        };
+        // two passes: count each cell's entries, then fill them in triangle order
+        let mut fill = vec![0usize; side * side];
+        for pass in 0..2 {
+            for k in 0..index.boxes.len() {
+                if !index.usable[k] {
+                    continue;
+                }
+                let ([x0, y0], [x1, y1]) = index.cells_of(&index.boxes[k]);
+                if (x1 - x0 + 1) * (y1 - y0 + 1) > BIG_BOX_CELLS {
+                    if pass == 0 {
+                        index.big.push(k as u32);
+                    }
+                    continue;
+                }
+                for y in y0..=y1 {
+                    for x in x0..=x1 {
+                        let c = y * side + x;
+                        if pass == 0 {
+                            index.starts[c + 1] += 1;
+                        } else {
+                            index.entries[index.starts[c] + fill[c]] = k as u32;
+                            fill[c] += 1;
+                        }
+                    }
+                }
+            }
+            if pass == 0 {
+                for c in 0..side * side {
+                    index.starts[c + 1] += index.starts[c];
+                }
+                index.entries = vec![0; index.starts[side * side]];
             }
         }
-        active.push(k);
+        index
     }
-    pairs
+
+    /// The first and last cell `[x, y]` a box covers (clamped to the grid).
+    fn cells_of(&self, b: &[f64; 4]) -> ([usize; 2], [usize; 2]) {
+        let at = |v: f64, axis: usize| {
+            let c = ((v - self.origin[axis]) / self.cell[axis]).floor();
+            c.clamp(0.0, (self.side - 1) as f64) as usize
+        };
+        ([at(b[0], 0), at(b[1], 1)], [at(b[2], 0), at(b[3], 1)])
+    }
+
+    /// The area the boxes of `a` and `b` share (0 where they only touch or miss).
+    fn shared_area(&self, a: usize, b: usize) -> f64 {
+        let (p, q) = (&self.boxes[a], &self.boxes[b]);
+        let w = p[2].min(q[2]) - p[0].max(q[0]);
+        let h = p[3].min(q[3]) - p[1].max(q[1]);
+        w.max(0.0) * h.max(0.0)
+    }
+
+    /// Whether the boxes of `a` and `b` overlap (touching counts).
+    fn overlap(&self, a: usize, b: usize) -> bool {
+        let (p, q) = (&self.boxes[a], &self.boxes[b]);
+        p[0] <= q[2] && q[0] <= p[2] && p[1] <= q[3] && q[1] <= p[3]
+    }
+
+    /// Into `out` (cleared first): the usable triangles other than `k` whose boxes
+    /// overlap `k`'s, in no particular order. `stamp` is scratch space kept between calls.
+    fn candidates(&self, k: usize, out: &mut Vec<usize>, stamp: &mut Vec<usize>) {
+        out.clear();
+        // stamp[c] == k + 1: c already looked at for k (no sort to drop repeats)
+        stamp.resize(self.boxes.len(), 0);
+        let mark = k + 1;
+        let mut take = |c: usize| {
+            if stamp[c] != mark {
+                stamp[c] = mark;
+                if c != k && self.overlap(c, k) {
+                    out.push(c);
+                }
+            }
+        };
+        let ([x0, y0], [x1, y1]) = self.cells_of(&self.boxes[k]);
+        for y in y0..=y1 {
+            for x in x0..=x1 {
+                let c = y * self.side + x;
+                for &e in &self.entries[self.starts[c]..self.starts[c + 1]] {
+                    take(e as usize);
+                }
+            }
+        }
+        for &e in &self.big {
+            take(e as usize);
+        }
+    }
 }
 
 // ---------------------------------------------------------------------------------------
@@ -607,18 +868,23 @@ mod tests {
     fn clip_keeps_the_nonnegative_side_without_duplicates() {
         let square = vec![[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]];
         let half = clip(&square, |p| 1.0 - p[0]);
-        assert_eq!(half, vec![[0.0, 0.0], [1.0, 0.0], [1.0, 2.0], [0.0, 2.0]]);
+        assert_eq!(
+            half.to_vec(),
+            vec![[0.0, 0.0], [1.0, 0.0], [1.0, 2.0], [0.0, 2.0]]
+        );
         assert_eq!(area(&half), 2.0);
         // through two vertices: no duplicated vertex
         let diag = clip(&square, |p| p[1] - p[0]);
-        assert_eq!(diag, vec![[0.0, 0.0], [2.0, 2.0], [0.0, 2.0]]);
+        assert_eq!(diag.to_vec(), vec![[0.0, 0.0], [2.0, 2.0], [0.0, 2.0]]);
         assert!(clip(&square, |p| -1.0 - p[0]).is_empty());
         // clipped to a triangle, either orientation
         let t = tri([[0.0, 0.0], [2.0, 0.0], [0.0, 2.0]], [1.0; 3]);
         let mut r = t;
         r.points.swap(1, 2);
         for t in [t, r] {
-            assert_eq!(area(&inside_triangle(&square, &t)), 2.0);
+            let (mut out, mut spare) = (Small::new(), Small::new());
+            inside_triangle(&square, &t, &mut out, &mut spare);
+            assert_eq!(area(&out), 2.0);
         }
     }
 
@@ -642,22 +908,24 @@ mod tests {
         assert!(tidy(flat).len() < 3);
     }
 
-    #[test]
-    fn sweep_finds_exactly_the_overlapping_boxes() {
-        let t = |x: f64, y: f64| tri([[x, y], [x + 2.0, y], [x, y + 2.0]], [1.0; 3]);
-        let tris = [
-            t(0.0, 0.0),
-            t(1.0, 1.0),
-            t(5.0, 0.0),
-            t(1.5, 10.0),
-            t(2.0, 2.0),
-        ];
-        let mut pairs = overlapping_boxes(&tris, &[true; 5]);
+    /// The pairs `(i, j)`, `i < j`, the box index finds, sorted.
+    fn indexed_pairs(tris: &[ScreenTriangle], usable: &[bool]) -> Vec<(usize, usize)> {
+        let index = BoxIndex::new(tris, usable);
+        let (mut out, mut stamp) = (Vec::new(), Vec::new());
+        let mut pairs = Vec::new();
+        for k in (0..tris.len()).filter(|&k| usable[k]) {
+            index.candidates(k, &mut out, &mut stamp);
+            pairs.extend(out.iter().filter(|&&c| c > k).map(|&c| (k, c)));
+        }
         pairs.sort();
-        // brute force
+        pairs
+    }
+
+    /// The pairs `(i, j)`, `i < j`, of usable triangles whose boxes overlap, by brute force.
+    fn brute_pairs(tris: &[ScreenTriangle], usable: &[bool]) -> Vec<(usize, usize)> {
         let mut expected = Vec::new();
-        for i in 0..5 {
-            for j in i + 1..5 {
+        for i in (0..tris.len()).filter(|&k| usable[k]) {
+            for j in (i + 1..tris.len()).filter(|&k| usable[k]) {
                 let (a, b) = (tris[i].points, tris[j].points);
                 let overlap = |k: usize| {
                     a.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min)
@@ -670,13 +938,65 @@ mod tests {
                 }
             }
         }
-        assert_eq!(pairs, expected);
-        assert_eq!(expected, vec![(0, 1), (0, 4), (1, 4)]);
+        expected
+    }
+
+    #[test]
+    fn the_box_index_finds_exactly_the_overlapping_boxes() {
+        let t = |x: f64, y: f64| tri([[x, y], [x + 2.0, y], [x, y + 2.0]], [1.0; 3]);
+        let tris = [
+            t(0.0, 0.0),
+            t(1.0, 1.0),
+            t(5.0, 0.0),
+            t(1.5, 10.0),
+            t(2.0, 2.0),
+        ];
+        let pairs = indexed_pairs(&tris, &[true; 5]);
+        assert_eq!(pairs, brute_pairs(&tris, &[true; 5]));
+        assert_eq!(pairs, vec![(0, 1), (0, 4), (1, 4)]);
         // unusable triangles take no part
-        assert_eq!(
-            overlapping_boxes(&tris, &[true, false, true, true, true]),
-            vec![(0, 4)]
-        );
+        let usable = [true, false, true, true, true];
+        assert_eq!(indexed_pairs(&tris, &usable), vec![(0, 4)]);
+    }
+
+    #[test]
+    fn the_box_index_agrees_with_brute_force_on_small_big_and_far_triangles() {
+        // a deterministic mix: small triangles, ones spanning many cells (the big list),
+        // far outliers that stretch the grid, touching boxes, some unusable
+        let mut state = 0x9E37_79B9_7F4A_7C15u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for round in 0..20 {
+            let n = 5 + round * 7;
+            let mut tris = Vec::new();
+            for k in 0..n {
+                let (x, y) = (next() * 100.0, next() * 100.0);
+                let size = match k % 5 {
+                    0 => 60.0 * next(),
+                    1 => 1e-3,
+                    _ => 6.0 * next() + 0.5,
+                };
+                let (x, y) = if k % 17 == 3 {
+                    (x * 1e6, -y * 1e6)
+                } else {
+                    (x, y)
+                };
+                tris.push(tri([[x, y], [x + size, y], [x, y + size]], [1.0; 3]));
+            }
+            // two boxes that only touch
+            tris.push(tri([[0.0, 0.0], [2.0, 0.0], [0.0, 2.0]], [1.0; 3]));
+            tris.push(tri([[2.0, 2.0], [4.0, 2.0], [2.0, 4.0]], [1.0; 3]));
+            let usable: Vec<bool> = (0..tris.len()).map(|k| k % 11 != 7).collect();
+            assert_eq!(
+                indexed_pairs(&tris, &usable),
+                brute_pairs(&tris, &usable),
+                "round {round}"
+            );
+        }
     }
 
     #[test]
@@ -713,7 +1033,9 @@ mod tests {
         let pb = [[2.0, 1.0], [12.0, 2.0], [3.0, 9.0]];
         let a = tri(pa, pa.map(z));
         let b = tri(pb, pb.map(z));
-        let overlap = area(&inside_triangle(&pb, &a));
+        let (mut out, mut spare) = (Small::new(), Small::new());
+        inside_triangle(&pb, &a, &mut out, &mut spare);
+        let overlap = area(&out);
         for (tris, winner) in [([a, b], 0), ([b, a], 0)] {
             let (frags, stats) = exact_fragments(&tris, 1);
             assert_eq!(stats.occluding_pairs, 1);

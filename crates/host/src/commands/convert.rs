@@ -12,14 +12,34 @@ pub struct ConvertArgs {
     /// The trace to read: .cwt, .jsonl or .cwb.
     #[arg(value_name = "IN")]
     pub input: PathBuf,
-    /// The trace to write: .cwt, .jsonl or .cwb (replaced if it exists).
-    #[arg(value_name = "OUT")]
-    pub output: PathBuf,
+    /// The trace to write: .cwt, .jsonl or .cwb (replaced if it exists). Given as
+    /// `-o OUT` like every command's output, or second, as `cwisim convert IN OUT`.
+    #[arg(
+        short = 'o',
+        long = "output",
+        value_name = "OUT",
+        required_unless_present = "out",
+        conflicts_with = "out"
+    )]
+    pub output: Option<PathBuf>,
+    /// The trace to write, as the second argument (the same as `-o OUT`).
+    #[arg(value_name = "OUT", hide = true)]
+    pub out: Option<PathBuf>,
+}
+
+impl ConvertArgs {
+    /// The trace to write, however it was given.
+    pub fn output(&self) -> Result<&Path, CliError> {
+        self.output
+            .as_deref()
+            .or(self.out.as_deref())
+            .ok_or_else(|| CliError::Usage("convert needs the trace to write: -o OUT".into()))
+    }
 }
 
 /// Runs `cwisim convert`. Returns the number of instructions copied.
 pub fn run(args: &ConvertArgs) -> Result<u64, CliError> {
-    convert(&args.input, &args.output)
+    convert(&args.input, args.output()?)
 }
 
 /// Copies every instruction of the trace `input` into a new trace `output`, each in the

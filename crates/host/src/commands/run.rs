@@ -10,7 +10,9 @@ use crate::report::{timing_name, unrefreshed_warning, write_summary, StatsReport
 use clap::{Args, ValueEnum};
 use cwisim_isa::{Encoding, FileReader, TraceRead};
 use cwisim_study::cost::{CostMap, CostReader};
-use cwisim_xproc::{replay_streaming, Image, ImageSink, NullSink, Numeric, RunStats, Timing};
+use cwisim_xproc::{
+    replay_streaming, Image, ImageSink, NullSink, Numeric, ReplayError, RunStats, Timing,
+};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -73,6 +75,13 @@ pub struct RunArgs {
     /// JSON (with one record per scanline).
     #[arg(long, value_name = "FILE")]
     pub stats_json: Option<PathBuf>,
+
+    /// When the trace turns out bad part way (a malformed line, a truncated file), still
+    /// write the image outputs (-o, --npy) with the scanlines completed before the bad
+    /// instruction, and say so; the error is reported and the exit code is 2 as without
+    /// it. Statistics and cost outputs are not written for a bad trace.
+    #[arg(long)]
+    pub keep_partial: bool,
     /// How to draw a scene (ignored for a trace).
     #[command(flatten, next_help_heading = "Drawing a scene")]
     pub draw: crate::draw::DrawArgs,
@@ -89,7 +98,8 @@ pub struct Replayed {
 
 /// Runs `cwisim run`: statistics go to `stdout` (with `--stats`), warnings to `stderr`.
 /// `progress` allows the progress bar (it still needs a terminal and a run of over a
-/// second). Nothing is written unless the whole trace replayed without error.
+/// second). Nothing is written unless the whole trace replayed without error, except with
+/// `--keep-partial` (the image of the scanlines completed before the error).
 pub fn run(
     args: &RunArgs,
     stdout: &mut dyn Write,
@@ -124,15 +134,56 @@ pub fn run(
         // per-scanline records only when asked for: otherwise memory stays flat however
         // long the trace
         let keep_lines = args.stats_json.is_some();
-        replay_file_streaming(
-            reader,
-            &machine,
-            timing,
-            &args.numeric,
-            want_image,
-            keep_lines,
-            &mut |bytes| bar.update(bytes),
-        )?
+        if args.keep_partial && want_image {
+            let mut sink = ImageSink::new(
+                header.width as usize,
+                header.channel_count(),
+                ImageSink::DEFAULT_LIMIT_BYTES,
+            );
+            let result = replay_streaming(
+                reader,
+                &machine,
+                timing,
+                &args.numeric,
+                keep_lines,
+                &mut sink,
+                &mut |bytes| bar.update(bytes),
+            );
+            match result {
+                Ok(stats) => Replayed {
+                    stats,
+                    image: Some(sink.finish()?),
+                },
+                Err(ReplayError::Trace(error)) => {
+                    drop(bar);
+                    let image = sink.finish()?;
+                    let note = if image.lines == 0 {
+                        "no scanline was completed before the error: no image written".to_string()
+                    } else {
+                        args.image.write(&image)?;
+                        format!(
+                            "the image is incomplete: it holds the {} scanline(s) completed \
+before the error (a frame has {})",
+                            image.lines, header.lines
+                        )
+                    };
+                    // A lost warning is no reason to hide the error.
+                    let _ = writeln!(stderr, "warning: --keep-partial: {note}");
+                    return Err(CliError::from(ReplayError::Trace(error)));
+                }
+                Err(other) => return Err(other.into()),
+            }
+        } else {
+            replay_file_streaming(
+                reader,
+                &machine,
+                timing,
+                &args.numeric,
+                want_image,
+                keep_lines,
+                &mut |bytes| bar.update(bytes),
+            )?
+        }
     };
     if let Some(image) = &replayed.image {
         args.image.write(image)?;
