@@ -60,13 +60,13 @@
 //! candidates and occluder pieces: it grows like the input, not like the number of
 //! occluding pairs (which grows with the square of the layers when surfaces are stacked:
 //! the pot as 16 coincident layers has 750 000 of them, and holding them all took 130 MB;
-//! 600 layers took more than 24 GB). A triangle's candidates are looked at in order of how
-//! much their boxes share with its own (copies of it in other layers first). A piece that
-//! holds all three of its vertices (a convex piece: all of it) hides it without a boolean,
-//! and the remaining candidates are skipped (`candidates_skipped`): a coincident copy with
-//! a lower index does that. Pieces equal to one already taken (coincident copies) are
-//! dropped before the boolean. Neither changes a fragment: both only leave out what could
-//! not change the difference.
+//! 600 layers took more than 24 GB). Three shortcuts leave out only what could not change
+//! a fragment: an exact copy of an earlier triangle (the same vertices and `1/depth`) is
+//! hidden at once, without looking at its candidates (`copies_hidden`: coincident layers
+//! are made of these); a piece that holds all three vertices of the triangle (a convex
+//! piece: all of it) hides it without a boolean, and its remaining candidates are skipped
+//! (`candidates_skipped`); a piece equal to one already taken is dropped before the
+//! boolean.
 //!
 //! Time still grows faster than the layers — the booleans of nearly coincident layers
 //! have many crossing edges — measured in `docs/VISIBILITY.md`
@@ -154,6 +154,10 @@ pub struct VisibilityStats {
     pub hidden: u64,
     /// Fragments output.
     pub fragments: u64,
+    /// Triangles hidden as exact copies of an earlier one (the same vertices and
+    /// `1/depth`: coplanar over all of it, and the lower index wins), without a look at
+    /// their candidates. Counted in `hidden` too.
+    pub copies_hidden: u64,
     /// Candidate occluders (triangles whose screen boxes overlap) not examined because
     /// the triangle was already wholly hidden by nearer ones: see "Depth complexity" in
     /// the module docs.
@@ -202,7 +206,13 @@ pub fn exact_fragments(
     // Triangle by triangle, so that memory holds one triangle's occluders at a time
     // whatever the depth complexity (see "Depth complexity" in the module docs).
     let index = BoxIndex::new(tris, &usable);
-    let mut keys: Vec<(f64, usize)> = Vec::new();
+    // the first usable triangle of each exact geometry
+    let mut copies: HashMap<[u64; 9], usize> = HashMap::new();
+    for (k, t) in tris.iter().enumerate() {
+        if usable[k] {
+            copies.entry(copy_key(t)).or_insert(k);
+        }
+    }
     let mut seen: HashMap<u64, usize> = HashMap::new();
     let mut stamp = Vec::new();
     let mut candidates = Vec::new();
@@ -212,15 +222,18 @@ pub fn exact_fragments(
     for (k, tri) in tris.iter().enumerate() {
         let before = fragments.len();
         if usable[k] {
+            // An exact copy of an earlier triangle (the same vertices and `1/depth`, in any
+            // order) is coplanar with it over all of it, and the lower index wins: hidden,
+            // without looking at anything else (coincident layers are made of these).
+            if let Some(&first) = copies.get(&copy_key(tri)) {
+                if first != k && area(&tri.points) > PIECE_AREA {
+                    stats.occluding_pairs += 1;
+                    stats.hidden += 1;
+                    stats.copies_hidden += 1;
+                    continue;
+                }
+            }
             index.candidates(k, &mut candidates, &mut stamp);
-            // the candidates whose boxes overlap the triangle's most first: the likeliest to
-            // hide all of it (copies of it in other layers, its neighbours of its own
-            // surface last)
-            keys.clear();
-            keys.extend(candidates.iter().map(|&c| (index.shared_area(c, k), c)));
-            keys.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
-            candidates.clear();
-            candidates.extend(keys.iter().map(|&(_, c)| c));
             seen.clear();
             pieces.clear();
             let mut covered = false;
@@ -405,6 +418,21 @@ fn inv_depth(t: &ScreenTriangle, plane: &Plane, p: Pt) -> f64 {
         Some(k) => t.inv_depth[k],
         None => plane.at(p),
     }
+}
+
+/// A triangle's vertices and `1/depth`, bit for bit, in a canonical order: equal for
+/// exact copies whatever their vertex order.
+fn copy_key(t: &ScreenTriangle) -> [u64; 9] {
+    let mut corners: [[u64; 3]; 3] = std::array::from_fn(|v| {
+        [
+            t.points[v][0].to_bits(),
+            t.points[v][1].to_bits(),
+            t.inv_depth[v].to_bits(),
+        ]
+    });
+    corners.sort_unstable();
+    let [a, b, c] = corners;
+    [a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2]]
 }
 
 /// A hash of a contour's coordinates, bit for bit.
@@ -651,14 +679,6 @@ impl BoxIndex {
             c.clamp(0.0, (self.side - 1) as f64) as usize
         };
         ([at(b[0], 0), at(b[1], 1)], [at(b[2], 0), at(b[3], 1)])
-    }
-
-    /// The area the boxes of `a` and `b` share (0 where they only touch or miss).
-    fn shared_area(&self, a: usize, b: usize) -> f64 {
-        let (p, q) = (&self.boxes[a], &self.boxes[b]);
-        let w = p[2].min(q[2]) - p[0].max(q[0]);
-        let h = p[3].min(q[3]) - p[1].max(q[1]);
-        w.max(0.0) * h.max(0.0)
     }
 
     /// Whether the boxes of `a` and `b` overlap (touching counts).
