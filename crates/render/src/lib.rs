@@ -42,6 +42,7 @@
 
 #![warn(missing_docs)]
 
+pub mod cp;
 pub mod error;
 pub mod phong;
 pub mod pipeline;
