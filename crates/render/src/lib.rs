@@ -24,6 +24,8 @@
 //!   shared corner grid), positions and weights, for every renderer that supersamples.
 //! * [`vanrij`] — van Rij's DO_FILL (`cwisim-ypipe`), the first renderer and the default.
 //! * [`woochall`] — Woo & Chall's point-sampled scanline visibility (`woo-chall`).
+//! * [`cp`] — Barkan & Gordon's critical-points scan conversion (`DETCR`, `MOVEUP`,
+//!   `POLINE`), usable alone; [`sbuffer`] — their one-scanline depth buffer (`sbuffer`).
 //!
 //! ```
 //! use cwisim_render::{registry, render, ArrayConfig, Settings, Source, Taps};
@@ -49,6 +51,7 @@ pub mod pipeline;
 pub mod prepare;
 pub mod registry;
 pub mod renderer;
+pub mod sbuffer;
 pub mod settings;
 pub mod source;
 pub mod span;

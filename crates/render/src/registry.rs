@@ -40,6 +40,12 @@ pub const REGISTRY: &[Entry] = &[
         build: crate::woochall::WooChall::build,
         supersampled: true,
     },
+    Entry {
+        name: "sbuffer",
+        about: crate::sbuffer::ABOUT,
+        build: crate::sbuffer::SBuffer::build,
+        supersampled: true,
+    },
 ];
 
 /// The registered names, in order.
