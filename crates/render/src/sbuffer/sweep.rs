@@ -74,10 +74,13 @@ impl<'a> Sweep<'a> {
         }
     }
 
-    /// Line `j` at `y`: the polygons starting there join the APT, every active polygon's
-    /// AET is made to meet the line (`POLINE`), `visit(k, polygon, aet)` is called for
-    /// each in APT order, and the polygons whose sweep is over leave the APT. `visit`
-    /// returns `false` to stop the walk early (the rest of the APT is still advanced).
+    /// Line `j` at `y`: the polygons starting there join the APT, and the APT is walked
+    /// in order — each polygon's AET made to meet the line (`POLINE`) and
+    /// `visit(k, polygon, aet)` called. `visit` returns `false` to stop the walk (the
+    /// front-to-back display once every pixel is set): the polygons not walked are not
+    /// advanced — CP catches up over several lines at their next `POLINE`, so the work
+    /// follows what is visible. Polygons whose sweep is over (or which end above the next
+    /// line) leave the APT.
     pub fn line(
         &mut self,
         j: usize,
@@ -93,18 +96,19 @@ impl<'a> Sweep<'a> {
             active: self.active.len() as u64,
             aet: 0,
         };
-        let mut walking = true;
         for &k in &self.active {
             let (p, s) = (&self.polys[k as usize], &mut self.states[k as usize]);
             s.poline(&p.cp, y, self.increment, &mut self.stats);
             counts.aet += s.aet().len() as u64;
-            if walking {
-                walking = visit(k, p, s.aet());
+            if !visit(k, p, s.aet()) {
+                break;
             }
         }
         let (polys, states) = (self.polys, &self.states);
-        self.active
-            .retain(|&k| !states[k as usize].finished(&polys[k as usize].cp));
+        self.active.retain(|&k| {
+            let p = &polys[k as usize];
+            !states[k as usize].finished(&p.cp) && p.cp.end_y() > y
+        });
         self.max_active = self.max_active.max(counts.active);
         self.max_aet = self.max_aet.max(counts.aet);
         counts
