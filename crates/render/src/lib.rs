@@ -25,7 +25,8 @@
 //! * [`vanrij`] — van Rij's DO_FILL (`cwisim-ypipe`), the first renderer and the default.
 //! * [`woochall`] — Woo & Chall's point-sampled scanline visibility (`woo-chall`).
 //! * [`cp`] — Barkan & Gordon's critical-points scan conversion (`DETCR`, `MOVEUP`,
-//!   `POLINE`), usable alone; [`sbuffer`] — their one-scanline depth buffer (`sbuffer`).
+//!   `POLINE`), usable alone; [`sbuffer`] — their one-scanline depth buffer (`sbuffer`);
+//!   [`bsp`] — BSP trees displayed in scanline order (`bsp`).
 //!
 //! ```
 //! use cwisim_render::{registry, render, ArrayConfig, Settings, Source, Taps};
@@ -44,6 +45,7 @@
 
 #![warn(missing_docs)]
 
+pub mod bsp;
 pub mod cp;
 pub mod error;
 pub mod phong;

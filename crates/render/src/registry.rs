@@ -46,6 +46,12 @@ pub const REGISTRY: &[Entry] = &[
         build: crate::sbuffer::SBuffer::build,
         supersampled: true,
     },
+    Entry {
+        name: "bsp",
+        about: crate::bsp::ABOUT,
+        build: crate::bsp::Bsp::build,
+        supersampled: true,
+    },
 ];
 
 /// The registered names, in order.

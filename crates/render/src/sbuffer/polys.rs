@@ -103,6 +103,8 @@ pub struct Polys {
     pub triangles: Option<Vec<ScreenTriangle>>,
     /// With Phong shading: the lighting.
     pub shader: Option<PhongShader>,
+    /// World scenes: the camera's eye, in the world.
+    pub eye: Option<[f64; 3]>,
     /// What projection did (world scenes).
     pub project: Option<ProjectStats>,
     /// Polygons with no area on the screen, dropped (`c = 0` or no plane).
@@ -118,7 +120,7 @@ impl Polys {
     pub fn new(loaded: LoadedScene, shading: Shading) -> Result<Polys, RenderError> {
         let start = Instant::now();
         let kind = loaded.scene.kind();
-        let (mut project, mut shader, mut triangles) = (None, None, None);
+        let (mut project, mut shader, mut triangles, mut eye) = (None, None, None, None);
         let mut polys = Vec::new();
         let mut degenerate = 0;
         let (width, height, channels) = match loaded.scene {
@@ -184,6 +186,7 @@ impl Polys {
                     shader = Some(PhongShader::new(&w));
                 }
                 triangles = Some(tris);
+                eye = Some(w.spec.camera.eye);
                 (w.width(), w.height(), w.channels() as u8)
             }
         };
@@ -199,6 +202,7 @@ impl Polys {
             polys,
             triangles,
             shader,
+            eye,
             project,
             degenerate,
             load_time: loaded.load_time,
