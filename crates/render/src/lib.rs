@@ -47,6 +47,7 @@
 
 pub mod bsp;
 pub mod cp;
+pub mod cpbench;
 pub mod error;
 pub mod phong;
 pub mod pipeline;
