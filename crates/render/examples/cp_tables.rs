@@ -61,9 +61,9 @@ fn main() {
         ..Settings::default()
     };
     println!(
-        "| family | n | c per polygon | MOVEUP steps | AET inserts | AET deletes | plain ET edges | vanrij trapezia | sbuffer instructions | sbuffer busy cycles | vanrij instructions | vanrij busy cycles | sbuffer host ms | vanrij host ms |"
+        "| family | n | c per polygon | MOVEUP steps | AET inserts | INSERT scans | AET deletes | plain ET edges | vanrij trapezia | sbuffer instructions | sbuffer busy cycles | vanrij instructions | vanrij busy cycles | sbuffer host ms | vanrij host ms |"
     );
-    println!("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
+    println!("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
     for family in Family::ALL {
         let mut n = step;
         while n <= 10 * step {
@@ -81,10 +81,11 @@ fn main() {
             let get = |r: &Rendered, k: &str| r.counters.get(k).unwrap_or(0);
             let busy = |r: &Rendered| r.stats.lines.iter().map(|l| l.busy_cycles).sum::<u64>();
             println!(
-                "| {family} | {n} | {:.2} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.1} | {:.1} |",
+                "| {family} | {n} | {:.2} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.1} | {:.1} |",
                 counts.critical_points as f64 / f64::from(polygons),
                 get(&s, "moveup_steps"),
                 get(&s, "aet_inserts"),
+                get(&s, "aet_insert_scans"),
                 get(&s, "aet_deletes"),
                 plain_edges(&scene),
                 get(&v, "trapezia"),

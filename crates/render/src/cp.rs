@@ -225,6 +225,9 @@ pub struct CpStats {
     pub moveups: u64,
     /// Elements inserted into AETs.
     pub inserts: u64,
+    /// AET elements `INSERT` passes over to find its place, as the paper's linked list
+    /// is searched from its head: what makes CP's time `O(c²)`.
+    pub insert_scans: u64,
     /// Elements deleted from AETs (sections that turned down, or sections abandoned
     /// before their first scanline).
     pub deletes: u64,
@@ -242,6 +245,7 @@ impl CpStats {
         self.moveup_steps += o.moveup_steps;
         self.moveups += o.moveups;
         self.inserts += o.inserts;
+        self.insert_scans += o.insert_scans;
         self.deletes += o.deletes;
         self.recomputes += o.recomputes;
         self.increments += o.increments;
@@ -331,6 +335,7 @@ impl CpState {
                     let at = self.aet.partition_point(|e| (e.xc, e.slp) <= (k.xc, k.slp));
                     self.aet.insert(at, k);
                     stats.inserts += 1;
+                    stats.insert_scans += at as u64;
                 }
             }
             self.ic += 1;

@@ -670,6 +670,7 @@ impl Scan<'_> {
                 .with("max_aet", sweep.max_aet)
                 .with("moveup_steps", sweep.stats.moveup_steps)
                 .with("aet_inserts", sweep.stats.inserts)
+                .with("aet_insert_scans", sweep.stats.insert_scans)
                 .with("aet_deletes", sweep.stats.deletes)
                 .with("cp_recomputes", sweep.stats.recomputes)
                 .with("cp_increments", sweep.stats.increments),
@@ -727,7 +728,7 @@ pub(crate) fn cp_rows(c: &Counters) -> Vec<(&'static str, String)> {
         (
             "CP",
             format!(
-                "{} polygons, {} vertices, {} critical points; APT at most {}, AETs at most {} elements on a line; {} MOVEUP steps, {} inserts, {} deletes; intersections {} recomputed, {} incremented",
+                "{} polygons, {} vertices, {} critical points; APT at most {}, AETs at most {} elements on a line; {} MOVEUP steps, {} inserts (past {} elements), {} deletes; intersections {} recomputed, {} incremented",
                 get("polygons"),
                 get("vertices"),
                 get("critical_points"),
@@ -735,6 +736,7 @@ pub(crate) fn cp_rows(c: &Counters) -> Vec<(&'static str, String)> {
                 get("max_aet"),
                 get("moveup_steps"),
                 get("aet_inserts"),
+                get("aet_insert_scans"),
                 get("aet_deletes"),
                 get("cp_recomputes"),
                 get("cp_increments"),
