@@ -39,6 +39,9 @@ pub enum View {
     Along(DVec3),
 }
 
+/// How many pieces of a list are tried as its node's splitter (the fewest splits wins).
+pub const CANDIDATES: usize = 8;
+
 /// A plane `n·p + d = 0`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Plane {
@@ -171,7 +174,9 @@ fn split(plane: &Plane, p: &Piece, eps: f64, channels: usize) -> (Piece, Piece) 
 impl Tree {
     /// The tree of `pieces` (triangles or convex polygons with at least three world
     /// points; pieces without a plane are kept in the node of the first plane they meet
-    /// as coplanar). `eps`: the distance within which a vertex counts as on a plane.
+    /// as coplanar). Each node's splitter is, of the first [`CANDIDATES`] pieces of its
+    /// list, the one that splits fewest of the others (ties: the most even sides, then
+    /// the first). `eps`: the distance within which a vertex counts as on a plane.
     pub fn build(pieces: Vec<Piece>, eps: f64, channels: usize) -> Tree {
         let mut tree = Tree {
             pieces,
@@ -189,12 +194,27 @@ impl Tree {
         let all: Vec<u32> = (0..tree.pieces.len() as u32).collect();
         let mut work = vec![(all, Slot::Root, 1u64)];
         while let Some((list, slot, depth)) = work.pop() {
-            // the splitter: the first piece with a plane
-            let Some((at, plane)) = list
+            // the splitter: of the first CANDIDATES pieces with a plane, the one that
+            // splits fewest (then balances best; then the first)
+            let candidates: Vec<(usize, Plane)> = list
                 .iter()
                 .enumerate()
-                .find_map(|(i, &k)| Plane::of(&tree.pieces[k as usize]).map(|p| (i, p)))
-            else {
+                .filter_map(|(i, &k)| Plane::of(&tree.pieces[k as usize]).map(|p| (i, p)))
+                .take(CANDIDATES)
+                .collect();
+            let best = candidates.iter().min_by_key(|(_, plane)| {
+                let (mut splits, mut front, mut back) = (0u64, 0i64, 0i64);
+                for &k in &list {
+                    match classify(plane, &tree.pieces[k as usize], eps) {
+                        Side::On => {}
+                        Side::Front => front += 1,
+                        Side::Back => back += 1,
+                        Side::Both => splits += 1,
+                    }
+                }
+                (splits, (front - back).unsigned_abs())
+            });
+            let Some(&(at, plane)) = best else {
                 // no plane among them: they cover nothing; keep them in a leaf
                 let node = tree.nodes.len();
                 tree.nodes.push(Node {
