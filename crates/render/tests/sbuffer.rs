@@ -341,3 +341,25 @@ fn supersampling_and_the_papers_increment_draw_too() {
     let (_, c) = embedded("pot", &p, "sbuffer");
     assert!(c.get("cp_increments").unwrap() > 0);
 }
+
+#[test]
+fn supersampled_it_equals_woo_chall_shading_every_sample() {
+    // woo-chall's samples, winners and weights with a shading call at every sample
+    // (P = 1): the same image, bit for bit, on flat world scenes
+    for (scene, samples) in [("pot", 3), ("still-life", 2)] {
+        let s = Settings {
+            samples,
+            ..one_sample(Shading::Flat)
+        };
+        let (sb, _) = embedded(scene, &s, "sbuffer");
+        let (woo, _) = embedded(
+            scene,
+            &Settings {
+                shade_p: Some(1.0),
+                ..s
+            },
+            "woo-chall",
+        );
+        assert_eq!(sb, woo, "{scene} at {samples}×{samples}");
+    }
+}
