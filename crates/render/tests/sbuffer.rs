@@ -363,3 +363,46 @@ fn supersampled_it_equals_woo_chall_shading_every_sample() {
         assert_eq!(sb, woo, "{scene} at {samples}×{samples}");
     }
 }
+
+#[test]
+fn the_overdraw_stream_is_snapshot_tested() {
+    // three squares listed back to front, each nearer than the last: the second and the
+    // third undo part of what came before (Acc_mode, negated Eval1, Acc_mode) and draw
+    let polygons = (0..3)
+        .map(|k| {
+            let o = f64::from(k);
+            Polygon::uniform(
+                vec![[o, o], [o + 4.0, o], [o + 4.0, o + 4.0], [o, o + 4.0]],
+                &[0.25 * f64::from(k + 1)],
+            )
+            .with_depth(vec![3.0 - o; 4])
+        })
+        .collect();
+    let scene = ScreenScene {
+        width: 8,
+        height: 7,
+        channels: 1,
+        polygons,
+    };
+    let od = Settings {
+        sbuffer: SbufferMode::Overdraw,
+        ..one_sample(Shading::Flat)
+    };
+    let r = build(
+        "sbuffer",
+        LoadedScene::built("three", AnyScene::Screen(scene)),
+        &od,
+    );
+    let mut bytes = Vec::new();
+    {
+        let mut w = cwisim_isa::Encoding::Text
+            .writer(&mut bytes, &r.header())
+            .unwrap();
+        let c = emit(&*r, &mut *w).unwrap();
+        assert_eq!(c.get("pixels_overwritten"), Some(2 * 3 * 3));
+    }
+    insta::assert_snapshot!(
+        "overdraw_three_squares_cwt",
+        String::from_utf8(bytes).unwrap()
+    );
+}
