@@ -767,3 +767,65 @@ pub(crate) fn cp_rows(c: &Counters) -> Vec<(&'static str, String)> {
         ),
     ]
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_unset_list_takes_what_a_span_covers() {
+        let mut l = UnsetList::default();
+        l.reset(10);
+        let mut taken = Vec::new();
+        assert_eq!(l.take(2, 4, &mut taken), 1);
+        assert_eq!(taken, [(2, 4)]);
+        assert_eq!(l.runs(), [(0, 2), (4, 10)]);
+        // a span across the hole takes both sides of it
+        l.take(1, 6, &mut taken);
+        assert_eq!(taken, [(1, 2), (4, 6)]);
+        assert_eq!(l.runs(), [(0, 1), (6, 10)]);
+        l.take(0, 10, &mut taken);
+        assert!(l.is_empty());
+        assert_eq!(l.take(3, 5, &mut taken), 0);
+        assert!(taken.is_empty());
+    }
+
+    #[test]
+    fn an_undo_skips_what_the_array_dropped() {
+        // a two-channel run: channel 1 drifts below 0 at its last two pixels (the array
+        // dropped those values), channel 0 stays positive
+        let mut line = DepthLine::default();
+        line.reset(4);
+        let vals = [[0.5, 0.3], [0.4, 0.1], [0.3, -1e-17], [0.2, -0.1]];
+        for (k, v) in vals.iter().enumerate() {
+            line.owner[k] = 0;
+            line.val[k] = cwisim_scene::vector(2, |c| v[c]);
+            line.grad[k] = cwisim_scene::vector(2, |c| [-0.1, -0.2][c]);
+        }
+        let (mut list, mut counts) = (Vec::new(), RowCounts::default());
+        let mut out = Out {
+            list: &mut list,
+            counts: &mut counts,
+        };
+        undo_run(&mut out, &line, 0, 4, false, 2);
+        assert_eq!(counts.undo_runs, 2);
+        assert_eq!(
+            list,
+            [
+                Instruction::eval2(
+                    0,
+                    2,
+                    Intensity::new(&[-0.5, -0.3]),
+                    Intensity::new(&[0.1, 0.2])
+                ),
+                // channel 1 undone no further: 0 plus 0
+                Instruction::eval2(
+                    2,
+                    2,
+                    Intensity::new(&[-0.3, 0.0]),
+                    Intensity::new(&[0.1, 0.0])
+                ),
+            ]
+        );
+    }
+}
