@@ -17,9 +17,9 @@
 //! * `--samples L` (with `--grid`): one host depth line per sub-scanline of the shared
 //!   sampler ([`crate::subsample`]); pixels from samples as `woo-chall` makes them.
 //!
-//! [`polys`] makes the polygons from any scene, [`sweep`] is the PT/APT loop shared with
-//! `bsp`. `docs/RENDERERS.md` says how it reads the paper; `docs/ERRATA.md` what it
-//! corrects.
+//! [`polys`] makes the polygons from any scene, [`sweep`] is the PT/APT loop and
+//! [`fill`] the scan engine (FILL's rules, a row's emission), both shared with `bsp`.
+//! `docs/RENDERERS.md` says how it reads the paper; `docs/ERRATA.md` what it corrects.
 
 pub mod fill;
 pub mod polys;
