@@ -47,16 +47,11 @@ impl<'a> Sweep<'a> {
         increment: Increment,
     ) -> Sweep<'a> {
         let mut starts = vec![Vec::new(); lines];
-        let last = if lines == 0 {
-            f64::NEG_INFINITY
-        } else {
-            y(lines - 1)
-        };
         for (k, p) in polys.iter().enumerate() {
             let Some(y0) = p.cp.start_y() else { continue };
             let j = first_line(y0);
-            // above the image, or wholly below its first line: never met
-            if j >= lines || p.cp.end_y() <= y(j) || y0 > last {
+            // past the last line, or ending before its first: never met
+            if j >= lines || p.cp.end_y() <= y(j) {
                 continue;
             }
             starts[j].push(k as u32);
