@@ -9,7 +9,7 @@
 //!   element follows its monotonic section upwards (`MOVEUP`, along horizontal edges
 //!   too) or is deleted where the section turns down; the sections starting at new
 //!   critical points are inserted in `x` order (ties by inverse slope).
-//! * [`CpState::spans`] — FILL's pairs: the pixels whose centre `x` satisfies
+//! * [`CpState::pairs`] — FILL's pairs: the pixels whose centre `x` satisfies
 //!   `K1.XC ≤ x < K2.XC`.
 //!
 //! **Pixel centres.** The paper samples at integer scanlines `y = H`, pixels `I` with

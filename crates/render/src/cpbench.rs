@@ -10,7 +10,7 @@
 //!
 //! Every polygon is simple by construction, has a constant depth (drawn at random, so
 //! the S-buffer sees them in no particular order) and one grey intensity. The same seed
-//! gives the same scene. [`detcr`](crate::cp::detcr) reports the actual counts.
+//! gives the same scene. [`detcr`] reports the actual counts.
 
 use crate::cp::detcr;
 use cwisim_scene::{Polygon, ScreenScene};
