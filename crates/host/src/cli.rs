@@ -115,7 +115,11 @@ Example:\n  cwisim emit fig25 -o fig25.cwt --shading flat --aa box",
     #[command(
         long_about = "List the scenes built into cwisim, with what each shows; with NAME, print that \
 scene's JSON file, to copy and edit.\n\n\
-Example:\n  cwisim scenes\n  cwisim scenes pot > my-pot.json",
+`cwisim scenes generate cp-bench` generates Barkan & Gordon's benchmark (docs/REPRODUCTION.md): \
+--family convex|few|many, --polygons N, --vertices A..B, --seed S, --size WxH; what DETCR \
+counts goes to stderr.\n\n\
+Example:\n  cwisim scenes\n  cwisim scenes pot > my-pot.json\n  \
+cwisim scenes generate cp-bench --family few --polygons 1000 --vertices 100..=1000 --seed 1 -o few.json",
         after_help = AFTER_HELP
     )]
     Scenes(scenes::ScenesArgs),
@@ -319,7 +323,7 @@ fn dispatch(
         Command::Convert(args) => convert::run(args).map(|_| 0),
         Command::Machine(args) => machine::run(args, stdout, stderr).map(|()| 0),
         Command::Render(args) => scene::run_render(args, stdout, progress).map(|()| 0),
-        Command::Scenes(args) => scenes::run(args, stdout).map(|()| 0),
+        Command::Scenes(args) => scenes::run(args, stdout, stderr).map(|()| 0),
         Command::Renderers(args) => renderers::run(args, stdout).map(|()| 0),
         Command::Tradeoff(args) => tradeoff::run(args, stdout).map(|()| 0),
         Command::Fit(args) => fit::run(args, stdout).map(|()| 0),

@@ -1,11 +1,14 @@
 //! How a scene is drawn, as the command line says it: `--renderer`, `--shading`, `--aa`,
 //! `--visibility`, `--eval0-tolerance`, `--size`, the supersampling renderers' `--samples`,
-//! `--grid`, `--merge-subscanlines`, `--shade-p`, `--shade-contrast`, `--seed` — one flattened group shared by
+//! `--grid`, `--merge-subscanlines`, `--shade-p`, `--shade-contrast`, `--seed`, and Barkan &
+//! Gordon's `--cp-increment`, `--sbuffer`, `--order`, `--unset` — one flattened group shared by
 //! `render`, `emit`, `stats` and `fit`, converted into `cwisim-render`'s plain
 //! [`Settings`].
 
 use crate::error::CliError;
 use clap::{Args, ValueEnum};
+use cwisim_render::cp::Increment;
+use cwisim_render::settings::{BspOrder, SbufferMode, Unset};
 use cwisim_render::subsample::Grid;
 use cwisim_render::{registry, LoadedScene, Renderer, Settings, Size, Source};
 use cwisim_scene::{Antialias, Shading};
@@ -68,6 +71,86 @@ pub enum GridArg {
     /// trapezoid weights; samples on a pixel's edge are shared with the neighbour, so
     /// each pixel costs (l−1)² new samples. Needs --samples 2 or more.
     Corner,
+}
+
+/// `--cp-increment`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum IncrementArg {
+    /// Recompute each edge's intersection at every scanline: exact as a plain edge list.
+    #[default]
+    Direct,
+    /// The paper's XX += SL along an edge: drifts, and flips a pixel where a crossing
+    /// falls on a sample (docs/ERRATA.md, B1).
+    Paper,
+}
+
+/// `--sbuffer`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum SbufferArg {
+    /// Depth on the host; each scanline's visible runs sent.
+    #[default]
+    Host,
+    /// Study mode (f64, one sample): every run sent as FILL sets it, overwrites undone by
+    /// negated draws under Acc_mode.
+    Overdraw,
+}
+
+/// `--order`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum OrderArg {
+    /// Painter's, into a host colour line; overdraw reported.
+    BackToFront,
+    /// Near to far, each pixel set once.
+    #[default]
+    FrontToBack,
+}
+
+/// `--unset`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum UnsetArg {
+    /// Gordon & Chen's run-length list of unset pixels on the host: only newly set runs
+    /// sent; a scanline's walk stops when the list is empty.
+    #[default]
+    Host,
+    /// Every active span sent as Eval0: the array's lock bits are the list, the first
+    /// claim wins (flat shading, one sample per pixel).
+    Eval0,
+}
+
+impl From<IncrementArg> for Increment {
+    fn from(g: IncrementArg) -> Increment {
+        match g {
+            IncrementArg::Direct => Increment::Direct,
+            IncrementArg::Paper => Increment::Paper,
+        }
+    }
+}
+
+impl From<SbufferArg> for SbufferMode {
+    fn from(g: SbufferArg) -> SbufferMode {
+        match g {
+            SbufferArg::Host => SbufferMode::Host,
+            SbufferArg::Overdraw => SbufferMode::Overdraw,
+        }
+    }
+}
+
+impl From<OrderArg> for BspOrder {
+    fn from(g: OrderArg) -> BspOrder {
+        match g {
+            OrderArg::BackToFront => BspOrder::BackToFront,
+            OrderArg::FrontToBack => BspOrder::FrontToBack,
+        }
+    }
+}
+
+impl From<UnsetArg> for Unset {
+    fn from(g: UnsetArg) -> Unset {
+        match g {
+            UnsetArg::Host => Unset::Host,
+            UnsetArg::Eval0 => Unset::Eval0,
+        }
+    }
 }
 
 impl From<GridArg> for Grid {
@@ -178,6 +261,19 @@ pub struct DrawArgs {
     /// gives the same stream.
     #[arg(long, value_name = "S", default_value_t = 0)]
     pub seed: u64,
+    /// Barkan & Gordon's renderers (sbuffer, bsp): how critical-points scan conversion
+    /// updates an edge's intersection from one scanline to the next.
+    #[arg(long, value_enum, default_value_t = IncrementArg::Direct, help_heading = "Scanline principle (sbuffer, bsp)")]
+    pub cp_increment: IncrementArg,
+    /// What the S-buffer sends the array.
+    #[arg(long, value_enum, default_value_t = SbufferArg::Host, help_heading = "Scanline principle (sbuffer, bsp)")]
+    pub sbuffer: SbufferArg,
+    /// The BSP tree's traversal order.
+    #[arg(long, value_enum, default_value_t = OrderArg::FrontToBack, help_heading = "Scanline principle (sbuffer, bsp)")]
+    pub order: OrderArg,
+    /// Front to back: where the list of unset pixels lives.
+    #[arg(long, value_enum, default_value_t = UnsetArg::Host, help_heading = "Scanline principle (sbuffer, bsp)")]
+    pub unset: UnsetArg,
 }
 
 impl Default for DrawArgs {
@@ -197,6 +293,10 @@ impl Default for DrawArgs {
             shade_p: None,
             shade_contrast: 0.1,
             seed: 0,
+            cp_increment: IncrementArg::Direct,
+            sbuffer: SbufferArg::Host,
+            order: OrderArg::FrontToBack,
+            unset: UnsetArg::Host,
         }
     }
 }
@@ -230,6 +330,10 @@ impl DrawArgs {
             shade_p: self.shade_p,
             shade_contrast: self.shade_contrast,
             seed: self.seed,
+            cp_increment: self.cp_increment.into(),
+            sbuffer: self.sbuffer.into(),
+            bsp_order: self.order.into(),
+            unset: self.unset.into(),
         }
     }
 

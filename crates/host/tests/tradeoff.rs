@@ -74,15 +74,18 @@ fn tradeoff_measures_against_the_exact_image_and_marks_the_pareto_front() {
     );
     assert!(out.contains("pareto"), "{out}");
     let (header, rows) = read_csv(&dir.join("t.csv"));
-    // a screen scene: vanrij's (shading × aa, and box-centre with Gouraud) × formats, then woo-chall's shading ×
-    // samples × formats
-    assert_eq!(rows.len(), (2 * 2 + 1) * 3 + 2 * 4 * 3);
-    assert_eq!(
-        rows.iter()
-            .filter(|r| r.get(&header, "renderer") == "woo-chall")
-            .count(),
-        2 * 4 * 3
-    );
+    // a screen scene: vanrij's (shading × aa, and box-centre with Gouraud) × formats, then
+    // each supersampling renderer's (woo-chall, sbuffer, bsp) shading × samples × formats
+    assert_eq!(rows.len(), (2 * 2 + 1) * 3 + 3 * (2 * 4 * 3));
+    for supersampled in ["woo-chall", "sbuffer", "bsp"] {
+        assert_eq!(
+            rows.iter()
+                .filter(|r| r.get(&header, "renderer") == supersampled)
+                .count(),
+            2 * 4 * 3,
+            "{supersampled}"
+        );
+    }
     // the exact box filter and the report's: the same instructions and cycles, errors of
     // rounding against the report's approximation
     let gouraud_f64 = |aa: &str| {

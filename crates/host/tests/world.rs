@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{cwisim, cwisim_ok, scratch};
+use common::{cwisim, cwisim_ok, scratch, text};
 use std::path::{Path, PathBuf};
 
 fn npy(path: &Path) -> (Vec<u64>, Vec<f64>) {
@@ -233,4 +233,60 @@ fn parallel_bands_give_the_serial_output_byte_for_byte() {
         assert_eq!(outputs[0], outputs[1], "{mode:?}");
         assert_eq!(outputs[0], outputs[2], "{mode:?}");
     }
+}
+
+#[test]
+fn scenes_generate_cp_bench_writes_a_scene_the_scanline_renderers_draw() {
+    let dir = scratch("cp_bench");
+    let args = [
+        "scenes",
+        "generate",
+        "cp-bench",
+        "--family",
+        "many",
+        "--polygons",
+        "20",
+        "--vertices",
+        "10..30",
+        "--seed",
+        "4",
+        "--size",
+        "64x48",
+    ];
+    let out = cwisim(&dir, &args);
+    assert!(out.status.success());
+    let (stdout, stderr) = text(&out);
+    assert!(stderr.contains("cp-bench many: 20 polygons"), "{stderr}");
+    // the same seed, the same scene
+    assert_eq!(text(&cwisim(&dir, &args)).0, stdout);
+    std::fs::write(dir.join("bench.json"), &stdout).unwrap();
+    for renderer in ["sbuffer", "bsp", "vanrij"] {
+        let summary = cwisim_ok(
+            &dir,
+            &[
+                "render",
+                "bench.json",
+                "--renderer",
+                renderer,
+                "--samples",
+                "1",
+            ],
+        );
+        assert!(summary.contains("scene"), "{summary}");
+    }
+    // bad input: exit 2, one line
+    let out = cwisim(
+        &dir,
+        &[
+            "scenes",
+            "generate",
+            "cp-bench",
+            "--family",
+            "few",
+            "--vertices",
+            "9..2",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out).1.contains("empty"));
 }

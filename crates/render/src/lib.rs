@@ -24,6 +24,9 @@
 //!   shared corner grid), positions and weights, for every renderer that supersamples.
 //! * [`vanrij`] — van Rij's DO_FILL (`cwisim-ypipe`), the first renderer and the default.
 //! * [`woochall`] — Woo & Chall's point-sampled scanline visibility (`woo-chall`).
+//! * [`cp`] — Barkan & Gordon's critical-points scan conversion (`DETCR`, `MOVEUP`,
+//!   `POLINE`), usable alone; [`sbuffer`] — their one-scanline depth buffer (`sbuffer`);
+//!   [`bsp`] — BSP trees displayed in scanline order (`bsp`).
 //!
 //! ```
 //! use cwisim_render::{registry, render, ArrayConfig, Settings, Source, Taps};
@@ -42,12 +45,16 @@
 
 #![warn(missing_docs)]
 
+pub mod bsp;
+pub mod cp;
+pub mod cpbench;
 pub mod error;
 pub mod phong;
 pub mod pipeline;
 pub mod prepare;
 pub mod registry;
 pub mod renderer;
+pub mod sbuffer;
 pub mod settings;
 pub mod source;
 pub mod span;

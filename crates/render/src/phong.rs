@@ -103,7 +103,7 @@ impl<'a> PhongFrame<'a> {
 
 /// The point of triangle `t` (on the screen) nearest to `p`: `p` itself when inside,
 /// else the nearest point of its edges.
-fn nearest_in(t: &ScreenTriangle, p: [f64; 2]) -> [f64; 2] {
+pub fn nearest_in(t: &ScreenTriangle, p: [f64; 2]) -> [f64; 2] {
     if t.barycentric(p)
         .is_some_and(|b| b.iter().all(|&w| w >= 0.0))
     {

@@ -72,6 +72,9 @@ pub fn render(
         0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
         n => n,
     };
+    renderer
+        .check_numeric(&array.numeric)
+        .map_err(RenderError::Usage)?;
     let header = renderer.header();
     let keep = renderer.needs_previous_frame() && renderer.frames() > 1;
     let frame_image = keep.then(|| Rc::new(RefCell::new(empty_image(&header))));

@@ -40,6 +40,18 @@ pub const REGISTRY: &[Entry] = &[
         build: crate::woochall::WooChall::build,
         supersampled: true,
     },
+    Entry {
+        name: "sbuffer",
+        about: crate::sbuffer::ABOUT,
+        build: crate::sbuffer::SBuffer::build,
+        supersampled: true,
+    },
+    Entry {
+        name: "bsp",
+        about: crate::bsp::ABOUT,
+        build: crate::bsp::Bsp::build,
+        supersampled: true,
+    },
 ];
 
 /// The registered names, in order.

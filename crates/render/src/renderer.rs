@@ -13,6 +13,7 @@
 
 use crate::error::RenderError;
 use cwisim_isa::{TraceHeader, TraceWrite};
+use cwisim_xproc::numeric::Numeric;
 use cwisim_xproc::{Image, RunStats};
 use serde::ser::SerializeMap;
 use std::io;
@@ -69,6 +70,13 @@ pub trait Renderer: Sync {
     /// What it drew, for `--stats-json`: deterministic (no times, no paths).
     fn scene_json(&self) -> serde_json::Value {
         serde_json::Value::Null
+    }
+
+    /// Refuses a numeric format its stream is not meant for, saying why (a study mode
+    /// that relies on exact cancellation in `f64`, say). `render` asks before anything is
+    /// sent; the default accepts every format.
+    fn check_numeric(&self, _numeric: &Numeric) -> Result<(), String> {
+        Ok(())
     }
 }
 

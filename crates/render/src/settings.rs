@@ -1,6 +1,7 @@
 //! How to draw: the settings every renderer reads, in plain types (the command line's
 //! argument groups convert into them; nothing here knows about clap).
 
+use crate::cp::Increment;
 use crate::subsample::Grid;
 use cwisim_scene::{Antialias, Shading};
 use cwisim_world::Visibility;
@@ -75,7 +76,87 @@ pub struct Settings {
     pub shade_contrast: f64,
     /// Seed of every random choice a renderer makes.
     pub seed: u64,
+    /// Barkan & Gordon: how CP updates an edge's intersection from line to line.
+    pub cp_increment: Increment,
+    /// Barkan & Gordon's S-buffer: what it sends the array.
+    pub sbuffer: SbufferMode,
+    /// Barkan & Gordon's BSP display: the traversal order.
+    pub bsp_order: BspOrder,
+    /// Barkan & Gordon's BSP display, front to back: who keeps the unset pixels.
+    pub unset: Unset,
 }
+
+/// `--sbuffer`: what the S-buffer sends the array.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum SbufferMode {
+    /// The depth line stays on the host; each scanline's visible runs are sent.
+    #[default]
+    Host,
+    /// Study mode: every pixel sent as FILL sets it, an overwritten run undone by a
+    /// negated draw (`Acc_mode`), so the array's work follows the pixels set.
+    Overdraw,
+}
+
+/// `--order`: the BSP traversal.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum BspOrder {
+    /// Painter's: far to near, into a host colour line.
+    BackToFront,
+    /// Near to far, each pixel set once (Gordon & Chen).
+    #[default]
+    FrontToBack,
+}
+
+/// `--unset`: front to back, where the list of unset pixels lives.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Unset {
+    /// Gordon & Chen's run-length list on the host: only newly set runs are sent.
+    #[default]
+    Host,
+    /// The array's lock bits: every active span sent as `Eval0`, the first claim wins.
+    Eval0,
+}
+
+macro_rules! spelled {
+    ($t:ty, $what:literal, $($v:ident => $s:literal),+) => {
+        impl $t {
+            /// Every value, in order.
+            pub const ALL: &'static [$t] = &[$(<$t>::$v),+];
+
+            /// Its one spelling.
+            pub fn name(self) -> &'static str {
+                match self {
+                    $(<$t>::$v => $s),+
+                }
+            }
+        }
+
+        impl fmt::Display for $t {
+            fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                f.write_str(self.name())
+            }
+        }
+
+        impl FromStr for $t {
+            type Err = String;
+
+            fn from_str(s: &str) -> Result<Self, String> {
+                <$t>::ALL
+                    .iter()
+                    .copied()
+                    .find(|v| v.name().eq_ignore_ascii_case(s))
+                    .ok_or_else(|| {
+                        let names: Vec<&str> = <$t>::ALL.iter().map(|v| v.name()).collect();
+                        format!("unknown {} `{s}`; expected {}", $what, names.join(" or "))
+                    })
+            }
+        }
+    };
+}
+
+spelled!(SbufferMode, "S-buffer mode", Host => "host", Overdraw => "overdraw");
+spelled!(BspOrder, "BSP order", BackToFront => "back-to-front", FrontToBack => "front-to-back");
+spelled!(Unset, "unset-pixel list", Host => "host", Eval0 => "eval0");
 
 impl Default for Settings {
     fn default() -> Self {
@@ -93,6 +174,10 @@ impl Default for Settings {
             shade_p: None,
             shade_contrast: 0.1,
             seed: 0,
+            cp_increment: Increment::Direct,
+            sbuffer: SbufferMode::Host,
+            bsp_order: BspOrder::FrontToBack,
+            unset: Unset::Host,
         }
     }
 }
@@ -147,6 +232,23 @@ mod tests {
         assert!("640".parse::<Size>().unwrap_err().contains("WIDTHxHEIGHT"));
         assert!("0x4".parse::<Size>().unwrap_err().contains("at least"));
         assert!("-3x4".parse::<Size>().is_err());
+    }
+
+    #[test]
+    fn barkan_gordon_modes_parse_and_print() {
+        for m in SbufferMode::ALL {
+            assert_eq!(m.to_string().parse::<SbufferMode>(), Ok(*m));
+        }
+        for o in BspOrder::ALL {
+            assert_eq!(o.to_string().parse::<BspOrder>(), Ok(*o));
+        }
+        for u in Unset::ALL {
+            assert_eq!(u.to_string().parse::<Unset>(), Ok(*u));
+        }
+        assert_eq!(
+            "sideways".parse::<BspOrder>().unwrap_err(),
+            "unknown BSP order `sideways`; expected back-to-front or front-to-back"
+        );
     }
 
     #[test]

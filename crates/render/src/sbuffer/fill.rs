@@ -1,0 +1,831 @@
+//! The scan engine shared by `sbuffer` and `bsp`: one line of samples filled polygon by
+//! polygon (FILL, by a [`Rule`]), then the row sent to the array.
+//!
+//! * [`Rule::Nearer`] — the S-buffer: a sample set where the polygon is nearer than the
+//!   depth line says (strictly: on a tie the polygon met first keeps it).
+//! * [`Rule::Paint`] — painter's: every sample of every span set, the last one stays.
+//! * [`Rule::Unset`] — Gordon & Chen's front-to-back display: a run-length list of the
+//!   unset samples ([`UnsetList`]); a span sets only what the list still holds, and the
+//!   line's walk stops when the list is empty.
+//! * [`Rule::Claim`] — front to back through the array's lock bits: every span sent as
+//!   `Eval0`, the first claim wins; the host mirrors the locks only to count what the
+//!   array suppresses.
+//!
+//! At one sample per pixel, Gouraud values follow the host's adder chain along each span
+//! (`v += dI` from the span's first pixel), and a run starting at pixel `a` is sent with
+//! the chain's value at `a`: the array, adding the same `dI`, holds exactly the host's
+//! values, whichever run of the span ends up visible.
+
+use super::polys::{Poly, Polys};
+use super::sweep::{edge_value, span_gradient, LineCounts, Sweep};
+use crate::cp::{columns_in, Increment};
+use crate::renderer::Counters;
+use crate::span::{fit_span, SpanStats};
+use crate::subsample::{Grid, Sampler};
+use crate::woochall::emit::{emit_row, EmitRule, Subline};
+use crate::woochall::lists::NONE;
+use cwisim_isa::{Instruction, Intensity, Opcode, TraceWrite};
+use cwisim_scene::{Shading, Vector};
+use std::io;
+use std::ops::Range;
+
+/// How FILL sets samples.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Rule {
+    /// Where the polygon is nearer (the S-buffer).
+    Nearer,
+    /// Always (painter's, back to front).
+    Paint,
+    /// Where still unset (front to back, Gordon & Chen's list on the host).
+    Unset,
+    /// Every span as `Eval0` (front to back, the array's locks as the list).
+    Claim,
+}
+
+/// Gordon & Chen's run-length list of the unset samples of a line: disjoint `[a, b)`
+/// intervals in order.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct UnsetList {
+    runs: Vec<(usize, usize)>,
+}
+
+impl UnsetList {
+    /// Every sample of `0..n` unset.
+    pub fn reset(&mut self, n: usize) {
+        self.runs.clear();
+        if n > 0 {
+            self.runs.push((0, n));
+        }
+    }
+
+    /// Whether every sample is set.
+    pub fn is_empty(&self) -> bool {
+        self.runs.is_empty()
+    }
+
+    /// The runs, in order.
+    pub fn runs(&self) -> &[(usize, usize)] {
+        &self.runs
+    }
+
+    /// The merge of a span `[first, end)` with the list: the unset runs it covers, taken
+    /// off the list, in order (into `taken`, cleared first). Returns the list entries it
+    /// visited.
+    pub fn take(&mut self, first: usize, end: usize, taken: &mut Vec<(usize, usize)>) -> u64 {
+        taken.clear();
+        let start = self.runs.partition_point(|r| r.1 <= first);
+        let mut k = start;
+        let mut keep: Vec<(usize, usize)> = Vec::new();
+        while k < self.runs.len() && self.runs[k].0 < end {
+            let (a, b) = self.runs[k];
+            let (s, e) = (a.max(first), b.min(end));
+            if s < e {
+                taken.push((s, e));
+            }
+            if a < s {
+                keep.push((a, s));
+            }
+            if e < b {
+                keep.push((e, b));
+            }
+            k += 1;
+        }
+        let visited = (k - start) as u64;
+        self.runs.splice(start..k, keep);
+        visited
+    }
+}
+
+/// One sample column of the depth line: its depth key, owner and value.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct DepthLine {
+    pub(crate) key: Vec<f64>,
+    pub(crate) owner: Vec<u32>,
+    /// The owner's span (numbered along the line).
+    pub(crate) span: Vec<u32>,
+    /// The value the host's adder chain gives there (Gouraud), or the flat value.
+    pub(crate) val: Vec<Vector>,
+    /// The gradient of the owner's span (Gouraud; 0 for flat).
+    pub(crate) grad: Vec<Vector>,
+}
+
+impl DepthLine {
+    fn reset(&mut self, columns: usize) {
+        self.key.clear();
+        self.key.resize(columns, f64::INFINITY);
+        self.owner.clear();
+        self.owner.resize(columns, NONE);
+        self.span.clear();
+        self.span.resize(columns, NONE);
+        self.val.clear();
+        self.val.resize(columns, Vector::default());
+        self.grad.clear();
+        self.grad.resize(columns, Vector::default());
+    }
+}
+
+/// What a frame counted, per row and in all.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct RowCounts {
+    pub(crate) pixels_set: u64,
+    pub(crate) pixels_overwritten: u64,
+    pub(crate) visible_runs: u64,
+    pub(crate) undo_runs: u64,
+    pub(crate) acc_mode: u64,
+    pub(crate) spans: u64,
+    pub(crate) polygons_walked: u64,
+    pub(crate) walks_stopped: u64,
+    pub(crate) list_visits: u64,
+    pub(crate) eval0: u64,
+    pub(crate) suppressed_claims: u64,
+    pub(crate) eval1: u64,
+    pub(crate) eval2: u64,
+    pub(crate) eval3: u64,
+    pub(crate) fit_candidates: u64,
+    pub(crate) instructions: u64,
+}
+
+impl RowCounts {
+    pub(crate) fn add(&mut self, o: &RowCounts) {
+        self.pixels_set += o.pixels_set;
+        self.pixels_overwritten += o.pixels_overwritten;
+        self.visible_runs += o.visible_runs;
+        self.undo_runs += o.undo_runs;
+        self.acc_mode += o.acc_mode;
+        self.spans += o.spans;
+        self.polygons_walked += o.polygons_walked;
+        self.walks_stopped += o.walks_stopped;
+        self.list_visits += o.list_visits;
+        self.eval0 += o.eval0;
+        self.suppressed_claims += o.suppressed_claims;
+        self.eval1 += o.eval1;
+        self.eval2 += o.eval2;
+        self.eval3 += o.eval3;
+        self.fit_candidates += o.fit_candidates;
+        self.instructions += o.instructions;
+    }
+
+    fn spans_fitted(&mut self, s: &SpanStats) {
+        self.eval1 += s.eval1;
+        self.eval2 += s.eval2;
+        self.eval3 += s.eval3;
+        self.fit_candidates += s.candidates;
+        self.instructions += s.pieces();
+    }
+
+    pub(crate) fn counters(&self) -> Counters {
+        Counters::default()
+            .with("polygons_walked", self.polygons_walked)
+            .with("walks_stopped", self.walks_stopped)
+            .with("unset_list_visits", self.list_visits)
+            .with("spans", self.spans)
+            .with("pixels_set", self.pixels_set)
+            .with("pixels_overwritten", self.pixels_overwritten)
+            .with("visible_runs", self.visible_runs)
+            .with("undo_runs", self.undo_runs)
+            .with("acc_mode", self.acc_mode)
+            .with("eval0", self.eval0)
+            .with("suppressed_claims", self.suppressed_claims)
+            .with("eval1", self.eval1)
+            .with("eval2", self.eval2)
+            .with("eval3", self.eval3)
+            .with("fit_candidates", self.fit_candidates)
+            .with("instructions", self.instructions)
+    }
+}
+
+/// Writes into a row's instruction list, counting.
+pub(crate) struct Out<'a> {
+    pub(crate) list: &'a mut Vec<Instruction>,
+    pub(crate) counts: &'a mut RowCounts,
+}
+
+impl Out<'_> {
+    pub(crate) fn push(&mut self, i: Instruction) {
+        match i.op {
+            Opcode::Eval0 => self.counts.eval0 += 1,
+            Opcode::Eval1 => self.counts.eval1 += 1,
+            Opcode::Eval2 => self.counts.eval2 += 1,
+            Opcode::Eval3 => self.counts.eval3 += 1,
+            Opcode::AccMode => self.counts.acc_mode += 1,
+            _ => {}
+        }
+        self.counts.instructions += 1;
+        self.list.push(i);
+    }
+}
+
+/// Whether every channel of a value and its gradient is 0 (nothing to add).
+fn is_zero(v: &Vector, d: &Vector, channels: usize) -> bool {
+    (0..channels).all(|c| v[c] == 0.0 && d[c] == 0.0)
+}
+
+/// Sends a run `[x, x + len)` whose first value is `v` and gradient `d`: `Eval1` when the
+/// gradient is 0 in every channel (flat), else `Eval2`. Nothing for an all-zero run.
+pub(crate) fn draw_run(
+    out: &mut Out<'_>,
+    x: u32,
+    len: u32,
+    v: &Vector,
+    d: &Vector,
+    flat: bool,
+    channels: usize,
+) {
+    if len == 0 || is_zero(v, d, channels) {
+        return;
+    }
+    let i = Intensity::new(&v[..channels]);
+    if flat {
+        out.push(Instruction::eval1(x, len, i));
+    } else {
+        out.push(Instruction::eval2(
+            x,
+            len,
+            i,
+            Intensity::new(&d[..channels]),
+        ));
+    }
+}
+
+/// The negated draws that cancel what the array accumulated from columns `[a, b)` of the
+/// line (one owner's span): per channel, a value the array dropped (negative, `Acc_mode`
+/// off) is not undone, so the run is split where the channels' signs change and a
+/// dropped channel is sent as 0.
+fn undo_run(out: &mut Out<'_>, line: &DepthLine, a: usize, b: usize, flat: bool, ch: usize) {
+    let neg = |k: usize| -> [bool; cwisim_isa::MAX_CHANNELS] {
+        std::array::from_fn(|c| c < ch && line.val[k][c] < 0.0)
+    };
+    let mut u = a;
+    while u < b {
+        let sign = neg(u);
+        let mut w = u + 1;
+        while w < b && neg(w) == sign {
+            w += 1;
+        }
+        let v = cwisim_scene::vector(ch, |c| if sign[c] { 0.0 } else { -line.val[u][c] });
+        let d = cwisim_scene::vector(ch, |c| if sign[c] { 0.0 } else { -line.grad[u][c] });
+        let before = out.counts.instructions;
+        draw_run(out, u as u32, (w - u) as u32, &v, &d, flat, ch);
+        if out.counts.instructions > before {
+            out.counts.undo_runs += 1;
+        }
+        u = w;
+    }
+}
+
+/// What a scan is and how it sends its rows.
+pub(crate) struct Scan<'a> {
+    /// The scene's polygons (Phong's lighting, the image's size).
+    pub(crate) scene: &'a Polys,
+    /// The polygons scanned (the scene's, or a BSP tree's pieces).
+    pub(crate) list: &'a [Poly],
+    /// Their priority on the APT (`None`: by index).
+    pub(crate) rank: Option<Vec<u32>>,
+    pub(crate) sampler: Sampler,
+    pub(crate) shading: Shading,
+    pub(crate) increment: Increment,
+    pub(crate) rule: Rule,
+    /// `Rule::Nearer` at one sample: send each run as it is set, undoing overwrites.
+    pub(crate) overdraw: bool,
+    pub(crate) merge: bool,
+    pub(crate) shade_tolerance: f64,
+}
+
+impl Scan<'_> {
+    /// Whether each row is one line of samples at the pixel centres.
+    pub(crate) fn one_sample(&self) -> bool {
+        self.sampler.l == 1 && self.sampler.grid == Grid::Centre
+    }
+
+    /// FILLs one line `y` of samples into `line`. With `out` (one sample per pixel),
+    /// runs are sent as they are set: the overdraw study, newly set runs of the unset
+    /// list, and `Eval0` claims.
+    #[allow(clippy::too_many_arguments)]
+    fn fill_line(
+        &self,
+        sweep: &mut Sweep<'_>,
+        j: usize,
+        y: f64,
+        line: &mut DepthLine,
+        unset: &mut UnsetList,
+        mut out: Option<&mut Out<'_>>,
+        counts: &mut RowCounts,
+    ) -> LineCounts {
+        let s = &self.sampler;
+        let ch = self.scene.channel_count();
+        let columns = s.columns();
+        line.reset(columns);
+        unset.reset(columns);
+        let flat = self.shading == Shading::Flat;
+        let mut span_id = 0u32;
+        let mut set = Vec::new();
+        let mut taken = Vec::new();
+        let rule = self.rule;
+        sweep.line(j, y, |k, p: &Poly, aet| {
+            counts.polygons_walked += 1;
+            for pair in aet.chunks_exact(2) {
+                let (a, b) = (&pair[0], &pair[1]);
+                let (first, end) = columns_in(
+                    a.xc,
+                    b.xc,
+                    columns,
+                    |c| s.column_x(c),
+                    |x| s.index_at_or_after(x),
+                );
+                span_id += 1;
+                if first >= end {
+                    continue;
+                }
+                counts.spans += 1;
+                if rule == Rule::Claim {
+                    // the array keeps the list: claim the whole span, count what its
+                    // locks will suppress
+                    for c in first..end {
+                        if line.owner[c] == NONE {
+                            line.owner[c] = k;
+                            line.span[c] = span_id;
+                            line.val[c] = p.flat;
+                            counts.pixels_set += 1;
+                        } else {
+                            counts.suppressed_claims += 1;
+                        }
+                    }
+                    if let Some(out) = out.as_deref_mut() {
+                        out.push(Instruction::eval0(
+                            first as u32,
+                            (end - first) as u32,
+                            Intensity::new(&p.flat[..ch]),
+                        ));
+                    }
+                    continue;
+                }
+                let (mut v, d) = if flat || self.shading == Shading::Phong {
+                    (p.flat, Vector::default())
+                } else {
+                    let il = edge_value(p, a, y, ch);
+                    let ir = edge_value(p, b, y, ch);
+                    let d = span_gradient(&il, &ir, a.xc, b.xc, ch);
+                    let dx = s.column_x(first) - a.xc;
+                    // the chain steps one sample column: 1 pixel at one sample, else
+                    // 1/l (centre grid) or 1/(l − 1) (corner grid)
+                    let per = f64::from(s.step_count());
+                    let step = cwisim_scene::vector(ch, |c| d[c] / per);
+                    (cwisim_scene::vector(ch, |c| il[c] + dx * d[c]), step)
+                };
+                set.clear();
+                match rule {
+                    Rule::Nearer => {
+                        for c in first..end {
+                            let key = p.key(s.column_x(c), y);
+                            set.push(key < line.key[c]);
+                            if key < line.key[c] {
+                                line.key[c] = key;
+                            }
+                        }
+                    }
+                    Rule::Paint => set.resize(end - first, true),
+                    Rule::Unset => {
+                        set.resize(end - first, false);
+                        counts.list_visits += unset.take(first, end, &mut taken);
+                        for &(u, w) in &taken {
+                            set[u - first..w - first].iter_mut().for_each(|x| *x = true);
+                        }
+                    }
+                    Rule::Claim => unreachable!("handled above"),
+                }
+                // runs of samples set, in order
+                let mut c = first;
+                while c < end {
+                    if !set[c - first] {
+                        for x in v.iter_mut().zip(&d) {
+                            *x.0 += x.1;
+                        }
+                        c += 1;
+                        continue;
+                    }
+                    let start = c;
+                    let v0 = v;
+                    while c < end && set[c - first] {
+                        c += 1;
+                    }
+                    if let Some(out) = out.as_deref_mut() {
+                        // undo each earlier owner's part of the run, then draw it
+                        let mut undo = Vec::new();
+                        let mut u = start;
+                        while u < c {
+                            let (o, sp) = (line.owner[u], line.span[u]);
+                            let mut w = u + 1;
+                            while w < c && line.owner[w] == o && line.span[w] == sp {
+                                w += 1;
+                            }
+                            if o != NONE {
+                                let mut o = Out {
+                                    list: &mut undo,
+                                    counts: out.counts,
+                                };
+                                undo_run(&mut o, line, u, w, flat, ch);
+                            }
+                            u = w;
+                        }
+                        if !undo.is_empty() {
+                            out.push(Instruction::acc_mode());
+                            out.list.append(&mut undo);
+                            out.push(Instruction::acc_mode());
+                        }
+                        draw_run(out, start as u32, (c - start) as u32, &v0, &d, flat, ch);
+                    }
+                    let mut w = v0;
+                    for x in start..c {
+                        counts.pixels_set += 1;
+                        if line.owner[x] != NONE {
+                            counts.pixels_overwritten += 1;
+                        }
+                        line.owner[x] = k;
+                        line.span[x] = span_id;
+                        line.val[x] = w;
+                        line.grad[x] = d;
+                        for q in w.iter_mut().zip(&d) {
+                            *q.0 += q.1;
+                        }
+                    }
+                    v = w;
+                }
+            }
+            // Gordon & Chen: the walk stops once every sample is set
+            let more = !(rule == Rule::Unset && unset.is_empty());
+            if !more {
+                counts.walks_stopped += 1;
+            }
+            more
+        })
+    }
+
+    /// The visible runs of a one-sample line, sent.
+    fn send_visible(&self, line: &DepthLine, row: u32, out: &mut Out<'_>) -> io::Result<()> {
+        let ch = self.scene.channel_count();
+        let flat = self.shading == Shading::Flat;
+        let mut x = 0;
+        let n = line.owner.len();
+        let mut targets = Vec::new();
+        while x < n {
+            let (o, sp) = (line.owner[x], line.span[x]);
+            let mut e = x + 1;
+            while e < n && line.owner[e] == o && line.span[e] == sp {
+                e += 1;
+            }
+            if o != NONE {
+                out.counts.visible_runs += 1;
+                if self.shading == Shading::Phong {
+                    let p = &self.list[o as usize];
+                    targets.clear();
+                    let y = f64::from(row) + 0.5;
+                    for c in x..e {
+                        let v = self.scene.phong(p, c as f64 + 0.5, y).unwrap_or_default();
+                        targets.extend_from_slice(&v[..ch]);
+                    }
+                    let mut pieces = Vec::new();
+                    let s = fit_span(x as u32, &targets, ch, self.shade_tolerance, &mut pieces)?;
+                    out.list.extend(pieces);
+                    out.counts.spans_fitted(&s);
+                } else {
+                    draw_run(
+                        out,
+                        x as u32,
+                        (e - x) as u32,
+                        &line.val[x],
+                        &line.grad[x],
+                        flat,
+                        ch,
+                    );
+                }
+            }
+            x = e;
+        }
+        Ok(())
+    }
+
+    /// The visible runs of a line, counted only.
+    fn count_visible(line: &DepthLine) -> u64 {
+        let mut runs = 0;
+        let mut x = 0;
+        while x < line.owner.len() {
+            let (o, sp) = (line.owner[x], line.span[x]);
+            let mut e = x + 1;
+            while e < line.owner.len() && line.owner[e] == o && line.span[e] == sp {
+                e += 1;
+            }
+            runs += u64::from(o != NONE);
+            x = e;
+        }
+        runs
+    }
+
+    /// A sub-scanline's samples as `woo-chall`'s emitter takes them: winners and colours.
+    fn subline_of(&self, line: &DepthLine, y: f64, sub: &mut Subline) {
+        sub.winners.clone_from(&line.owner);
+        sub.rgb.clear();
+        for (c, &o) in line.owner.iter().enumerate() {
+            sub.rgb.push(match o {
+                NONE => Vector::default(),
+                _ if self.shading == Shading::Phong => self
+                    .scene
+                    .phong(&self.list[o as usize], self.sampler.column_x(c), y)
+                    .unwrap_or_default(),
+                _ => line.val[c],
+            });
+        }
+    }
+
+    /// Runs the whole frame in scan order.
+    pub(crate) fn run(&self) -> io::Result<SFrame> {
+        let s = &self.sampler;
+        let height = self.scene.height;
+        let mut sweep = Sweep::new(
+            self.list,
+            s.sublines(),
+            |j| s.subline_y(j),
+            |y| first_at_or_after(s, y),
+            self.rank.clone(),
+            self.increment,
+        );
+        let ch = self.scene.channel_count();
+        let mut line = DepthLine::default();
+        let mut unset = UnsetList::default();
+        let mut rows = Vec::with_capacity(height as usize);
+        let mut row_counts = Vec::with_capacity(height as usize);
+        let mut figures = Vec::with_capacity(height as usize);
+        let l = s.l as usize;
+        let mut sublines: Vec<Subline> = vec![Subline::default(); l];
+        // which rules send runs while they fill
+        let sends_while_filling = match self.rule {
+            Rule::Nearer => self.overdraw,
+            Rule::Unset | Rule::Claim => true,
+            Rule::Paint => false,
+        };
+        for row in 0..height {
+            let mut list = Vec::new();
+            let mut counts = RowCounts::default();
+            let cp_before = sweep.stats;
+            let (mut active, mut aet) = (0u64, 0u64);
+            if self.one_sample() {
+                let y = f64::from(row) + 0.5;
+                let mut sent = RowCounts::default();
+                let lc = {
+                    let mut out = Out {
+                        list: &mut list,
+                        counts: &mut sent,
+                    };
+                    self.fill_line(
+                        &mut sweep,
+                        row as usize,
+                        y,
+                        &mut line,
+                        &mut unset,
+                        sends_while_filling.then_some(&mut out),
+                        &mut counts,
+                    )
+                };
+                (active, aet) = (lc.active, lc.aet);
+                counts.add(&sent);
+                if sends_while_filling {
+                    counts.visible_runs += Scan::count_visible(&line);
+                } else {
+                    let mut visible = RowCounts::default();
+                    self.send_visible(
+                        &line,
+                        row,
+                        &mut Out {
+                            list: &mut list,
+                            counts: &mut visible,
+                        },
+                    )?;
+                    counts.add(&visible);
+                }
+                list.push(Instruction::refresh());
+                counts.instructions += 1;
+            } else {
+                let (first, _) = s.of_pixel(row);
+                let carried = s.grid == Grid::Corner && row > 0;
+                if carried {
+                    sublines.swap(0, l - 1);
+                }
+                for (o, sub) in sublines.iter_mut().enumerate().skip(usize::from(carried)) {
+                    let j = first + o;
+                    let y = s.subline_y(j);
+                    let lc =
+                        self.fill_line(&mut sweep, j, y, &mut line, &mut unset, None, &mut counts);
+                    active = active.max(lc.active);
+                    aet = aet.max(lc.aet);
+                    self.subline_of(&line, y, sub);
+                    counts.visible_runs += Scan::count_visible(&line);
+                }
+                let refs: Vec<&Subline> = sublines.iter().collect();
+                let rule = EmitRule {
+                    merge: self.merge,
+                    tolerance: (self.shading == Shading::Phong).then_some(self.shade_tolerance),
+                    channels: ch,
+                };
+                let c = emit_row(s, &refs, &rule, &mut list)?;
+                counts.eval1 += c.edge_pixels + c.runs.eval1;
+                counts.eval2 += c.runs.eval2;
+                counts.eval3 += c.runs.eval3;
+                counts.fit_candidates += c.runs.candidates;
+                counts.instructions += c.instructions;
+            }
+            let cp = sweep.stats;
+            figures.push(serde_json::json!({
+                "row": row,
+                "active_polygons": active,
+                "aet_elements": aet,
+                "moveup_steps": cp.moveup_steps - cp_before.moveup_steps,
+                "aet_inserts": cp.inserts - cp_before.inserts,
+                "aet_deletes": cp.deletes - cp_before.deletes,
+                "polygons_walked": counts.polygons_walked,
+                "pixels_set": counts.pixels_set,
+                "pixels_overwritten": counts.pixels_overwritten,
+                "visible_runs": counts.visible_runs,
+                "suppressed_claims": counts.suppressed_claims,
+                "instructions": counts.instructions,
+            }));
+            rows.push(list);
+            row_counts.push(counts);
+        }
+        let critical = self
+            .list
+            .iter()
+            .map(|p| p.cp.critical_points().len() as u64)
+            .sum();
+        Ok(SFrame {
+            rows,
+            row_counts,
+            figures: serde_json::Value::from(figures),
+            frame: Counters::default()
+                .with("polygons", self.list.len() as u64)
+                .with(
+                    "vertices",
+                    self.list.iter().map(|p| p.cp.len() as u64).sum(),
+                )
+                .with("critical_points", critical)
+                .with("max_active_polygons", sweep.max_active)
+                .with("max_aet", sweep.max_aet)
+                .with("moveup_steps", sweep.stats.moveup_steps)
+                .with("aet_inserts", sweep.stats.inserts)
+                .with("aet_insert_scans", sweep.stats.insert_scans)
+                .with("aet_deletes", sweep.stats.deletes)
+                .with("cp_recomputes", sweep.stats.recomputes)
+                .with("cp_increments", sweep.stats.increments),
+        })
+    }
+}
+
+/// The first sub-scanline at or below `y` (`sublines()` when none): the arithmetic
+/// candidate, checked against the sampler's own positions.
+pub(crate) fn first_at_or_after(s: &Sampler, y: f64) -> usize {
+    let n = s.sublines();
+    columns_in(
+        y,
+        f64::INFINITY,
+        n,
+        |j| s.subline_y(j),
+        |v| s.index_at_or_after(v),
+    )
+    .0
+}
+
+/// One frame: its rows' instructions, ready to send.
+pub(crate) struct SFrame {
+    pub(crate) rows: Vec<Vec<Instruction>>,
+    pub(crate) row_counts: Vec<RowCounts>,
+    pub(crate) figures: serde_json::Value,
+    pub(crate) frame: Counters,
+}
+
+impl crate::renderer::FramePlan for SFrame {
+    fn counters(&self) -> Counters {
+        self.frame.clone()
+    }
+
+    fn row_figures(&self) -> Option<serde_json::Value> {
+        Some(self.figures.clone())
+    }
+
+    fn emit_rows(&self, rows: Range<u32>, sink: &mut dyn TraceWrite) -> io::Result<Counters> {
+        let mut total = RowCounts::default();
+        for r in rows {
+            for i in &self.rows[r as usize] {
+                sink.write(i)?;
+            }
+            total.add(&self.row_counts[r as usize]);
+        }
+        Ok(total.counters())
+    }
+}
+
+/// The summary rows every scanline-principle renderer shares: CP's work and the pixels.
+pub(crate) fn cp_rows(c: &Counters) -> Vec<(&'static str, String)> {
+    let get = |n: &str| c.get(n).unwrap_or(0);
+    vec![
+        (
+            "CP",
+            format!(
+                "{} polygons, {} vertices, {} critical points; APT at most {}, AETs at most {} elements on a line; {} MOVEUP steps, {} inserts (past {} elements), {} deletes; intersections {} recomputed, {} incremented",
+                get("polygons"),
+                get("vertices"),
+                get("critical_points"),
+                get("max_active_polygons"),
+                get("max_aet"),
+                get("moveup_steps"),
+                get("aet_inserts"),
+                get("aet_insert_scans"),
+                get("aet_deletes"),
+                get("cp_recomputes"),
+                get("cp_increments"),
+            ),
+        ),
+        (
+            "pixels",
+            format!(
+                "{} spans, {} samples set, {} of them overwritten; {} visible runs",
+                get("spans"),
+                get("pixels_set"),
+                get("pixels_overwritten"),
+                get("visible_runs"),
+            ),
+        ),
+        (
+            "emitted",
+            format!(
+                "{} instructions: Eval0 {}, Eval1 {}, Eval2 {}, Eval3 {}; {} undo runs, {} Acc_mode",
+                get("instructions"),
+                get("eval0"),
+                get("eval1"),
+                get("eval2"),
+                get("eval3"),
+                get("undo_runs"),
+                get("acc_mode"),
+            ),
+        ),
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_unset_list_takes_what_a_span_covers() {
+        let mut l = UnsetList::default();
+        l.reset(10);
+        let mut taken = Vec::new();
+        assert_eq!(l.take(2, 4, &mut taken), 1);
+        assert_eq!(taken, [(2, 4)]);
+        assert_eq!(l.runs(), [(0, 2), (4, 10)]);
+        // a span across the hole takes both sides of it
+        l.take(1, 6, &mut taken);
+        assert_eq!(taken, [(1, 2), (4, 6)]);
+        assert_eq!(l.runs(), [(0, 1), (6, 10)]);
+        l.take(0, 10, &mut taken);
+        assert!(l.is_empty());
+        assert_eq!(l.take(3, 5, &mut taken), 0);
+        assert!(taken.is_empty());
+    }
+
+    #[test]
+    fn an_undo_skips_what_the_array_dropped() {
+        // a two-channel run: channel 1 drifts below 0 at its last two pixels (the array
+        // dropped those values), channel 0 stays positive
+        let mut line = DepthLine::default();
+        line.reset(4);
+        let vals = [[0.5, 0.3], [0.4, 0.1], [0.3, -1e-17], [0.2, -0.1]];
+        for (k, v) in vals.iter().enumerate() {
+            line.owner[k] = 0;
+            line.val[k] = cwisim_scene::vector(2, |c| v[c]);
+            line.grad[k] = cwisim_scene::vector(2, |c| [-0.1, -0.2][c]);
+        }
+        let (mut list, mut counts) = (Vec::new(), RowCounts::default());
+        let mut out = Out {
+            list: &mut list,
+            counts: &mut counts,
+        };
+        undo_run(&mut out, &line, 0, 4, false, 2);
+        assert_eq!(counts.undo_runs, 2);
+        assert_eq!(
+            list,
+            [
+                Instruction::eval2(
+                    0,
+                    2,
+                    Intensity::new(&[-0.5, -0.3]),
+                    Intensity::new(&[0.1, 0.2])
+                ),
+                // channel 1 undone no further: 0 plus 0
+                Instruction::eval2(
+                    2,
+                    2,
+                    Intensity::new(&[-0.3, 0.0]),
+                    Intensity::new(&[0.1, 0.0])
+                ),
+            ]
+        );
+    }
+}

@@ -1,0 +1,291 @@
+//! Polygons for the scanline principle, from any scene: each with its CP data (vertices,
+//! critical points), its intensities, and a depth plane. Shared by `sbuffer` and `bsp`.
+//!
+//! * A **screen scene**'s polygons are taken as they are (no triangulation: CP converts
+//!   any simple polygon). Their `depth`, when the scene carries it, is the polygon's plane
+//!   (`Polygon::depth_at`'s: through vertex 0 and the best-conditioned fan triangle),
+//!   smaller nearer; without depth a later polygon lies in front of an earlier one
+//!   (painting order), as for `woo-chall`.
+//! * A **world scene** is projected and lit (per vertex for Gouraud, per face for flat;
+//!   Phong keeps the world corners and normals and lights per pixel) with back faces
+//!   culled, and no hidden-surface removal: each triangle is a polygon, its key the plane
+//!   of `−1/depth` over the screen (affine in screen space, so exact to interpolate).
+
+use crate::cp::CpPolygon;
+use crate::error::RenderError;
+use crate::source::{LoadedScene, Source};
+use cwisim_isa::TraceHeader;
+use cwisim_scene::{Polygon, Shading, Vector};
+use cwisim_world::face::ScreenTriangle;
+use cwisim_world::shade::PhongShader;
+use cwisim_world::{AnyScene, ProjectStats};
+use std::time::{Duration, Instant};
+
+/// One polygon, ready to scan-convert by CP.
+#[derive(Clone, Debug)]
+pub struct Poly {
+    /// Vertices and critical points.
+    pub cp: CpPolygon,
+    /// The intensity at each vertex (Gouraud interpolates along edges, then across).
+    pub intensity: Vec<Vector>,
+    /// The flat intensity: the vertices' mean (a lit face's value, exactly).
+    pub flat: Vector,
+    /// The depth key `a·x + b·y + c` (smaller nearer).
+    pub plane: [f64; 3],
+    /// The screen polygon or world triangle it comes from.
+    pub source: u32,
+}
+
+impl Poly {
+    /// The depth key at `(x, y)`: smaller is nearer.
+    pub fn key(&self, x: f64, y: f64) -> f64 {
+        let [a, b, c] = self.plane;
+        a * x + b * y + c
+    }
+}
+
+/// The plane `k = a·x + b·y + c` through three points `(x, y, k)`; `None` when they are
+/// collinear on the screen.
+fn plane3(p: [[f64; 2]; 3], k: [f64; 3]) -> Option<[f64; 3]> {
+    let (ux, uy, uk) = (p[1][0] - p[0][0], p[1][1] - p[0][1], k[1] - k[0]);
+    let (vx, vy, vk) = (p[2][0] - p[0][0], p[2][1] - p[0][1], k[2] - k[0]);
+    let det = ux * vy - uy * vx;
+    if det == 0.0 {
+        return None;
+    }
+    let a = (uk * vy - uy * vk) / det;
+    let b = (ux * vk - uk * vx) / det;
+    let c = k[0] - a * p[0][0] - b * p[0][1];
+    [a, b, c].iter().all(|v| v.is_finite()).then_some([a, b, c])
+}
+
+/// A screen polygon's depth plane: through vertex 0 and the fan triangle `(0, j, j+1)`
+/// of largest area, as `Polygon::depth_at` takes it.
+fn polygon_plane(p: &Polygon, depth: &[f64]) -> Option<[f64; 3]> {
+    let v = &p.vertices;
+    let a = v[0];
+    let cross =
+        |b: [f64; 2], c: [f64; 2]| (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+    let j = (1..v.len().saturating_sub(1)).max_by(|&i, &k| {
+        cross(v[i], v[i + 1])
+            .abs()
+            .total_cmp(&cross(v[k], v[k + 1]).abs())
+    })?;
+    plane3([a, v[j], v[j + 1]], [depth[0], depth[j], depth[j + 1]])
+}
+
+/// The mean of the vertex intensities, as the first value plus the mean difference from
+/// it (a polygon whose vertices agree keeps their value exactly) — `vanrij`'s flat value.
+fn mean(intensity: &[Vector], channels: usize) -> Vector {
+    let n = intensity.len().max(1) as f64;
+    cwisim_scene::vector(channels, |c| match intensity.first() {
+        Some(first) => first[c] + intensity.iter().map(|v| v[c] - first[c]).sum::<f64>() / n,
+        None => 0.0,
+    })
+}
+
+/// The polygons of a scene, and what making them did.
+pub struct Polys {
+    /// Where the scene came from.
+    pub source: Source,
+    /// `"screen"` or `"world"`.
+    pub kind: &'static str,
+    /// Image width, pixels.
+    pub width: u32,
+    /// Image height, pixels.
+    pub height: u32,
+    /// Channels.
+    pub channels: u8,
+    header: TraceHeader,
+    /// The polygons, in the scene's order.
+    pub polys: Vec<Poly>,
+    /// World scenes: the projected triangles (`Poly::source` indexes them).
+    pub triangles: Option<Vec<ScreenTriangle>>,
+    /// With Phong shading: the lighting.
+    pub shader: Option<PhongShader>,
+    /// World scenes: the camera's eye, in the world.
+    pub eye: Option<[f64; 3]>,
+    /// What projection did (world scenes).
+    pub project: Option<ProjectStats>,
+    /// Polygons with no area on the screen, dropped (`c = 0` or no plane).
+    pub degenerate: u64,
+    /// Wall time of reading the scene.
+    pub load_time: Duration,
+    /// Wall time of projection and lighting, or of preparing the polygons.
+    pub transform_time: Duration,
+}
+
+impl Polys {
+    /// The polygons of `loaded`, lit for `shading`.
+    pub fn new(loaded: LoadedScene, shading: Shading) -> Result<Polys, RenderError> {
+        let start = Instant::now();
+        let kind = loaded.scene.kind();
+        let (mut project, mut shader, mut triangles, mut eye) = (None, None, None, None);
+        let mut polys = Vec::new();
+        let mut degenerate = 0;
+        let (width, height, channels) = match loaded.scene {
+            AnyScene::Screen(s) => {
+                match shading {
+                    Shading::Phong => return Err(RenderError::Usage(
+                        "Phong shading needs a world scene (normals in 3D); a screen scene has only intensities: use --shading gouraud or flat".into(),
+                    )),
+                    Shading::Hidden => return Err(hidden()),
+                    _ => {}
+                }
+                crate::prepare::no_negative_intensity(&s)?;
+                let ch = s.channel_count();
+                for (k, p) in s.polygons.iter().enumerate() {
+                    let cp = CpPolygon::new(&p.vertices);
+                    let plane = match &p.depth {
+                        Some(d) => polygon_plane(p, d),
+                        None => Some([0.0, 0.0, -(k as f64)]),
+                    };
+                    let (Some(plane), Some(_)) = (plane, cp.start_y()) else {
+                        degenerate += 1;
+                        continue;
+                    };
+                    let intensity: Vec<Vector> = p
+                        .intensity
+                        .iter()
+                        .map(|v| cwisim_scene::vector(ch, |c| v[c]))
+                        .collect();
+                    polys.push(Poly {
+                        cp,
+                        flat: mean(&intensity, ch),
+                        intensity,
+                        plane,
+                        source: k as u32,
+                    });
+                }
+                (s.width, s.height, s.channels)
+            }
+            AnyScene::World(w) => {
+                if shading == Shading::Hidden {
+                    return Err(hidden());
+                }
+                let (tris, stats) = cwisim_world::project::project(&w, shading)?;
+                let ch = w.channels();
+                for (k, t) in tris.iter().enumerate() {
+                    let cp = CpPolygon::new(&t.points);
+                    let plane = plane3(t.points, t.inv_depth.map(|d| -d));
+                    let (Some(plane), Some(_)) = (plane, cp.start_y()) else {
+                        degenerate += 1;
+                        continue;
+                    };
+                    let intensity = t.intensity.to_vec();
+                    polys.push(Poly {
+                        cp,
+                        flat: mean(&intensity, ch),
+                        intensity,
+                        plane,
+                        source: k as u32,
+                    });
+                }
+                project = Some(stats);
+                if shading == Shading::Phong {
+                    shader = Some(PhongShader::new(&w));
+                }
+                triangles = Some(tris);
+                eye = Some(w.spec.camera.eye);
+                (w.width(), w.height(), w.channels() as u8)
+            }
+        };
+        let header = TraceHeader::new(width, height, channels)
+            .map_err(|e| RenderError::Usage(format!("the scene does not fit the array: {e}")))?;
+        Ok(Polys {
+            source: loaded.source,
+            kind,
+            width,
+            height,
+            channels,
+            header,
+            polys,
+            triangles,
+            shader,
+            eye,
+            project,
+            degenerate,
+            load_time: loaded.load_time,
+            transform_time: start.elapsed(),
+        })
+    }
+
+    /// The array it draws into.
+    pub fn header(&self) -> TraceHeader {
+        self.header
+    }
+
+    /// Channels, as a count.
+    pub fn channel_count(&self) -> usize {
+        usize::from(self.channels)
+    }
+
+    /// With Phong shading: the lit colour of polygon `p` at `(x, y)` (negative terms
+    /// dropped), at the point of its triangle nearest `(x, y)`.
+    pub fn phong(&self, p: &Poly, x: f64, y: f64) -> Option<Vector> {
+        let (shader, tris) = (self.shader.as_ref()?, self.triangles.as_ref()?);
+        let t = &tris[p.source as usize];
+        let mut v = shader
+            .at(t, crate::phong::nearest_in(t, [x, y]))
+            .unwrap_or_default();
+        for c in v.iter_mut() {
+            *c = c.max(0.0);
+        }
+        Some(v)
+    }
+
+    /// The summary's geometry row.
+    pub fn summary_rows(&self) -> Vec<(&'static str, String)> {
+        let polygons = self.polys.len() as u64 + self.degenerate;
+        match &self.project {
+            Some(g) => vec![(
+                "geometry",
+                format!(
+                    "{}; no hidden-surface removal before scan conversion",
+                    crate::prepare::geometry_phrase(g)
+                ),
+            )],
+            None => vec![(
+                "geometry",
+                format!(
+                    "{polygons} polygon(s), {} with no area dropped; {} vertices",
+                    self.degenerate,
+                    self.polys.iter().map(|p| p.cp.len()).sum::<usize>()
+                ),
+            )],
+        }
+    }
+
+    /// The scene part of `--stats-json`.
+    pub fn scene_json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "name": self.source.name(),
+            "kind": self.kind,
+            "polygons": self.polys.len(),
+            "degenerate": self.degenerate,
+            "project": self.project,
+        })
+    }
+}
+
+fn hidden() -> RenderError {
+    RenderError::Usage(
+        "--shading hidden (edges of the visible triangles) is drawn by woo-chall only: use --shading flat, gouraud or phong".into(),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn planes_pass_through_their_points() {
+        let p = [[0.0, 0.0], [4.0, 1.0], [1.0, 3.0]];
+        let k = [1.0, 2.0, -0.5];
+        let [a, b, c] = plane3(p, k).unwrap();
+        for (q, v) in p.iter().zip(k) {
+            assert!((a * q[0] + b * q[1] + c - v).abs() < 1e-12);
+        }
+        assert!(plane3([[0.0, 0.0], [1.0, 1.0], [2.0, 2.0]], k).is_none());
+    }
+}
