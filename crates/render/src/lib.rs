@@ -24,6 +24,8 @@
 //!   shared corner grid), positions and weights, for every renderer that supersamples.
 //! * [`vanrij`] — van Rij's DO_FILL (`cwisim-ypipe`), the first renderer and the default.
 //! * [`woochall`] — Woo & Chall's point-sampled scanline visibility (`woo-chall`).
+//! * [`nishita`] — Nishita, Kaneda & Nakamae's Bézier patches scan-converted directly
+//!   (`nishita`): subpatches per band, Bézier clipping at every row line.
 //!
 //! ```
 //! use cwisim_render::{registry, render, ArrayConfig, Settings, Source, Taps};
@@ -43,6 +45,7 @@
 #![warn(missing_docs)]
 
 pub mod error;
+pub mod nishita;
 pub mod phong;
 pub mod pipeline;
 pub mod prepare;

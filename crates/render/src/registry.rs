@@ -40,6 +40,12 @@ pub const REGISTRY: &[Entry] = &[
         build: crate::woochall::WooChall::build,
         supersampled: true,
     },
+    Entry {
+        name: "nishita",
+        about: crate::nishita::ABOUT,
+        build: crate::nishita::Nishita::build,
+        supersampled: false,
+    },
 ];
 
 /// The registered names, in order.
