@@ -144,7 +144,7 @@ impl Settings {
         let t = self.root_tolerance;
         if !(cwisim_world::clip::MIN_TOLERANCE..=MAX_ROOT_TOLERANCE).contains(&t) {
             return Err(format!(
-                "--tolerance must be a number between {:e} and {MAX_ROOT_TOLERANCE} (of the patch parameter), found {t}",
+                "--root-tolerance must be a number between {:e} and {MAX_ROOT_TOLERANCE} (of the patch parameter), found {t}",
                 cwisim_world::clip::MIN_TOLERANCE
             ));
         }

@@ -63,6 +63,8 @@ pub struct Piece {
     pub world: [DVec3; 3],
     /// The patch's normals there (`None` where it has none).
     pub normals: [Option<DVec3>; 3],
+    /// The patch's parameters `(u, v)` at its corners.
+    pub uv: [(f64, f64); 3],
     /// The patch it is part of (index in the mesh).
     pub patch: u32,
     /// How its cell faces the eye.
@@ -443,74 +445,11 @@ pub fn band_pieces(
     stats: &mut BandStats,
 ) {
     let start = std::time::Instant::now();
-    let (ytop, ybottom) = (f64::from(top), f64::from(top + rows));
-    let mut cells: Vec<Cell> = Vec::new();
-    for (k, p) in patches.iter().enumerate() {
-        let c = Cell::root(k as u32, p);
-        if meets(view, &c, ytop, ybottom) {
-            cells.push(c);
-        } else {
-            stats.culled += 1;
-        }
-    }
+    let (cells, level, facings) = subpatches(view, patches, top, rows, params, stats);
+    stats.subpatch_ns += start.elapsed().as_nanos() as u64;
     if cells.is_empty() {
-        stats.subpatch_ns += start.elapsed().as_nanos() as u64;
         return;
     }
-    let mut level = 0;
-    let mut facings: Vec<Option<Facing>> = vec![None; cells.len()];
-    loop {
-        let mut done = true;
-        for (c, f) in cells.iter().zip(facings.iter_mut()) {
-            let flat = flatness(view, c);
-            if flat > params.flatness {
-                done = false;
-                break;
-            }
-            if flat > 0.25 * params.flatness {
-                let fc = facing(&c.points, view.camera.eye);
-                *f = Some(fc);
-                if fc == Facing::Twisted {
-                    done = false;
-                    break;
-                }
-            }
-        }
-        if done {
-            break;
-        }
-        if level == MAX_LEVEL {
-            stats.capped += 1;
-            break;
-        }
-        let mut next = Vec::with_capacity(cells.len() * 4);
-        for c in &cells {
-            for child in c.split() {
-                if meets(view, &child, ytop, ybottom) {
-                    next.push(child);
-                } else {
-                    stats.culled += 1;
-                }
-            }
-        }
-        cells = next;
-        facings = vec![None; cells.len()];
-        level += 1;
-    }
-    stats.levels += u64::from(level);
-    let facings: Vec<Facing> = cells
-        .iter()
-        .zip(facings)
-        .map(|(c, f)| f.unwrap_or_else(|| facing(&c.points, view.camera.eye)))
-        .collect();
-    for f in &facings {
-        match f {
-            Facing::Front => stats.front += 1,
-            Facing::Back => stats.back += 1,
-            Facing::Twisted => stats.twisted += 1,
-        }
-    }
-    stats.subpatch_ns += start.elapsed().as_nanos() as u64;
 
     // roots: one record per distinct edge
     let start = std::time::Instant::now();
@@ -589,14 +528,13 @@ pub fn band_pieces(
             for [a, b, cc] in tris {
                 let vs = [poly[a], poly[b], poly[cc]];
                 let patch = &patches[c.patch as usize];
-                let normals = vs.map(|v| {
-                    let (u, w) = c.patch_uv(v.uv.0, v.uv.1);
-                    patch.normal(u, w)
-                });
+                let uv = vs.map(|v| c.patch_uv(v.uv.0, v.uv.1));
+                let normals = uv.map(|(u, w)| patch.normal(u, w));
                 out.push(Piece {
                     screen: vs.map(|v| v.screen),
                     world: vs.map(|v| v.world),
                     normals,
+                    uv,
                     patch: c.patch,
                     facing: *f,
                     row: top + k / params.subscan,
@@ -606,6 +544,87 @@ pub fn band_pieces(
         }
     }
     stats.pieces_ns += start.elapsed().as_nanos() as u64;
+}
+
+/// The subpatches of `patches` that meet the band of rows `top .. top + rows`: the
+/// quadtree cells of the band's level (the smallest that makes every kept cell flat,
+/// twisted ones to a quarter of the flatness, at most [`MAX_LEVEL`]), the level, and
+/// how each cell faces the eye.
+pub fn subpatches(
+    view: &View,
+    patches: &[Patch],
+    top: u32,
+    rows: u32,
+    params: &Params,
+    stats: &mut BandStats,
+) -> (Vec<Cell>, u32, Vec<Facing>) {
+    let (ytop, ybottom) = (f64::from(top), f64::from(top + rows));
+    let mut cells: Vec<Cell> = Vec::new();
+    for (k, p) in patches.iter().enumerate() {
+        let c = Cell::root(k as u32, p);
+        if meets(view, &c, ytop, ybottom) {
+            cells.push(c);
+        } else {
+            stats.culled += 1;
+        }
+    }
+    if cells.is_empty() {
+        return (cells, 0, Vec::new());
+    }
+    let mut level = 0;
+    let mut facings: Vec<Option<Facing>> = vec![None; cells.len()];
+    loop {
+        let mut done = true;
+        for (c, f) in cells.iter().zip(facings.iter_mut()) {
+            let flat = flatness(view, c);
+            if flat > params.flatness {
+                done = false;
+                break;
+            }
+            if flat > 0.25 * params.flatness {
+                let fc = facing(&c.points, view.camera.eye);
+                *f = Some(fc);
+                if fc == Facing::Twisted {
+                    done = false;
+                    break;
+                }
+            }
+        }
+        if done {
+            break;
+        }
+        if level == MAX_LEVEL {
+            stats.capped += 1;
+            break;
+        }
+        let mut next = Vec::with_capacity(cells.len() * 4);
+        for c in &cells {
+            for child in c.split() {
+                if meets(view, &child, ytop, ybottom) {
+                    next.push(child);
+                } else {
+                    stats.culled += 1;
+                }
+            }
+        }
+        cells = next;
+        facings = vec![None; cells.len()];
+        level += 1;
+    }
+    stats.levels += u64::from(level);
+    let facings: Vec<Facing> = cells
+        .iter()
+        .zip(facings)
+        .map(|(c, f)| f.unwrap_or_else(|| facing(&c.points, view.camera.eye)))
+        .collect();
+    for f in &facings {
+        match f {
+            Facing::Front => stats.front += 1,
+            Facing::Back => stats.back += 1,
+            Facing::Twisted => stats.twisted += 1,
+        }
+    }
+    (cells, level, facings)
 }
 
 fn cross(o: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {

@@ -68,6 +68,10 @@ const HISTOGRAM_NAMES: [&str; HISTOGRAM] = [
     "roots_15_or_more_iterations",
 ];
 
+/// Where a piece comes from: mesh, patch, and the patch parameters `(u, v)` at its
+/// corners.
+pub type Origin = (u32, u32, [(f64, f64); 3]);
+
 /// What drawing the patches made, before visibility.
 #[derive(Clone, Debug, Default)]
 pub struct Pieces {
@@ -76,6 +80,8 @@ pub struct Pieces {
     pub triangles: Vec<ScreenTriangle>,
     /// For each triangle: how its subpatch faces the eye.
     pub facing: Vec<Facing>,
+    /// For each triangle: its mesh, patch and the patch parameters at its corners.
+    pub origin: Vec<Origin>,
     /// What the bands did.
     pub stats: BandStats,
     /// Bands.
@@ -159,6 +165,7 @@ pub fn pieces(w: &WorldScene, settings: &Settings) -> Result<Pieces, RenderError
                 if let Some(t) = triangle(p, *k as u32, m, &camera, &lighting) {
                     out.triangles.push(t);
                     out.facing.push(p.facing);
+                    out.origin.push((*k as u32, p.patch, p.uv));
                 }
             }
             out.bands += 1;
