@@ -91,7 +91,7 @@ fn an_unknown_renderer_is_one_line_naming_the_known_ones() {
         let (stdout, stderr) = text(&out);
         assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
         assert_eq!(
-            stderr, "error: unknown renderer `nishitaa`; known: vanrij, woo-chall\n",
+            stderr, "error: unknown renderer `nishitaa`; known: vanrij, woo-chall, nishita\n",
             "{args:?}"
         );
         assert!(stdout.is_empty(), "{args:?}: {stdout}");

@@ -211,7 +211,7 @@ mod tests {
                 root_tolerance: bad,
                 ..Settings::default()
             };
-            assert!(s.check().unwrap_err().contains("--tolerance"));
+            assert!(s.check().unwrap_err().contains("--root-tolerance"));
         }
         for bad in [0.0, -1.0, f64::INFINITY, f64::NAN] {
             let s = Settings {

@@ -236,14 +236,6 @@ impl Nishita {
     /// The renderer of `loaded` under `settings`.
     pub fn new(loaded: LoadedScene, settings: &Settings) -> Result<Nishita, RenderError> {
         settings.check().map_err(RenderError::Usage)?;
-        match settings.shading {
-            Shading::Gouraud | Shading::Phong => {}
-            other => {
-                return Err(RenderError::Usage(format!(
-                    "--renderer nishita shades its patches smoothly: --shading gouraud or phong (found {other})"
-                )))
-            }
-        }
         let AnyScene::World(w) = &loaded.scene else {
             // no patches: the polygons as vanrij draws them
             let scene = PolygonScene::new(loaded, settings)?;
@@ -257,6 +249,14 @@ impl Nishita {
                 visibility_time: Duration::ZERO,
             });
         };
+        match settings.shading {
+            Shading::Gouraud | Shading::Phong => {}
+            other => {
+                return Err(RenderError::Usage(format!(
+                    "--renderer nishita shades its patches smoothly: --shading gouraud or phong (found {other})"
+                )))
+            }
+        }
         let phong = settings.shading == Shading::Phong;
         if phong && settings.visibility != Visibility::Exact {
             return Err(RenderError::Usage(
@@ -373,8 +373,8 @@ impl Nishita {
             .with("wasted_iterations", c.wasted)
             .with("touching", c.touching)
             .with("clip_splits", c.splits)
-            .with("pieces", s.polygons)
-            .with("pieces_split", s.split_polygons)
+            .with("straight_pieces", s.polygons)
+            .with("straight_pieces_split", s.split_polygons)
             .with("piece_triangles", self.triangles);
         for (name, n) in HISTOGRAM_NAMES.iter().zip(c.histogram) {
             out.add(name, n);
