@@ -134,7 +134,11 @@ pub fn grid(
         axes.tessellations.iter().map(|&n| Some(n)).collect()
     };
     for &renderer in renderers {
-        if renderer.patches && axes.world {
+        if renderer.patches && !axes.world {
+            // no patches to draw: its rows would be vanrij's
+            continue;
+        }
+        if renderer.patches {
             // patches drawn directly: no tessellation, exact visibility, smooth shading;
             // the root tolerance is its axis
             for tolerance in ROOT_TOLERANCE_AXIS {
