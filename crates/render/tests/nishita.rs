@@ -301,11 +301,18 @@ fn image_of(name: &str, loaded: LoadedScene, settings: &Settings, threads: usize
 fn the_silhouette_matches_a_fine_tessellation() {
     let size = 160;
     let n = image_of("nishita", white_teapot(size), &Settings::default(), 1);
-    let fine = Settings {
-        tessellate: Some(32),
-        ..Settings::default()
+    // the tessellation is the source's (`Source::load_for` applies `--tessellate`; a
+    // scene built in code is tessellated here)
+    let fine = match white_teapot(size).scene {
+        AnyScene::World(w) => w.with_tessellation(32).unwrap(),
+        AnyScene::Screen(_) => unreachable!(),
     };
-    let v = image_of("vanrij", white_teapot(size), &fine, 1);
+    let v = image_of(
+        "vanrij",
+        LoadedScene::built("white-teapot-32", AnyScene::World(fine)),
+        &Settings::default(),
+        1,
+    );
     let (mut worst, mut total) = (0.0f64, 0.0f64);
     for (a, b) in n.iter().zip(&v) {
         worst = worst.max((a - b).abs());
@@ -313,10 +320,11 @@ fn the_silhouette_matches_a_fine_tessellation() {
     }
     let area: f64 = n.iter().sum();
     eprintln!("coverage: worst pixel {worst:.4}, total |Δ| {total:.3} px² of {area:.1} px²");
-    // per pixel: the chord error of either side (flatness 0.5 px for nishita, the
-    // 32 × 32 tessellation's chords far below it) over a pixel-long piece of outline
-    assert!(worst <= 0.5, "{worst}");
-    assert!(total <= 0.01 * area, "{total} of {area}");
+    // per pixel: the chord error of either side along a pixel of outline (flatness
+    // 0.5 px bounds nishita's pieces; the 32 × 32 tessellation's chords are of the same
+    // order here); in all, a thin band along the outline
+    assert!(worst <= 0.1, "{worst}");
+    assert!(total <= 1e-3 * area, "{total} of {area}");
 }
 
 #[test]

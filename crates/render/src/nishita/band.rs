@@ -102,6 +102,12 @@ pub struct BandStats {
     pub fans: u64,
     /// Triangles.
     pub triangles: u64,
+    /// Silhouette points placed on row lines (two per polygon cut into its front and
+    /// back part).
+    pub silhouette_points: u64,
+    /// Polygons of twisted cells with a silhouette crossing one row line only (it leaves
+    /// through a cell edge): not cut.
+    pub silhouettes_unsplit: u64,
     /// Host time, subpatch generation (ns).
     pub subpatch_ns: u64,
     /// Host time, roots (ns).
@@ -126,6 +132,8 @@ impl BandStats {
         self.split_polygons += o.split_polygons;
         self.fans += o.fans;
         self.triangles += o.triangles;
+        self.silhouette_points += o.silhouette_points;
+        self.silhouettes_unsplit += o.silhouettes_unsplit;
         self.subpatch_ns += o.subpatch_ns;
         self.roots_ns += o.roots_ns;
         self.pieces_ns += o.pieces_ns;
@@ -430,6 +438,11 @@ struct PolyVertex {
     screen: [f64; 2],
     world: DVec3,
     uv: (f64, f64),
+    /// It ends a run of the cell's boundary inside the strip (the polygon then crosses
+    /// the cell along a row line to the next vertex).
+    exit: bool,
+    /// It starts such a run.
+    entry: bool,
 }
 
 /// The pieces of one mesh's patches in the band of rows `top .. top + rows`.
@@ -489,7 +502,7 @@ pub fn band_pieces(
             let mut exits = 0;
             for (e, (key, reversed)) in keys.iter().enumerate() {
                 let list = &records[key].strips[k as usize];
-                let mut push = |v: &EdgeVertex, is_exit: bool| {
+                let mut push = |v: &EdgeVertex, is_exit: bool, is_entry: bool| {
                     let t = if *reversed { 1.0 - v.t } else { v.t };
                     if is_exit {
                         exits += 1;
@@ -498,6 +511,8 @@ pub fn band_pieces(
                         screen: v.screen,
                         world: v.world,
                         uv: boundary_uv(e, t),
+                        exit: is_exit,
+                        entry: is_entry,
                     };
                     if poly.last().is_some_and(|l| l.screen == pv.screen) {
                         return;
@@ -506,11 +521,11 @@ pub fn band_pieces(
                 };
                 if *reversed {
                     for v in list.iter().rev() {
-                        push(v, v.entry);
+                        push(v, v.entry, v.exit);
                     }
                 } else {
                     for v in list {
-                        push(v, v.exit);
+                        push(v, v.exit, v.entry);
                     }
                 }
             }
@@ -524,10 +539,42 @@ pub fn band_pieces(
             if exits > 2 {
                 stats.split_polygons += 1;
             }
-            let tris = triangulate(&poly, &mut stats.fans);
+            let patch = &patches[c.patch as usize];
+            let split = if *f == Facing::Twisted {
+                silhouette_split(&poly, c, patch, view, stats)
+            } else {
+                None
+            };
+            let parts = match split {
+                Some((a, b)) => vec![a, b],
+                None => vec![std::mem::take(&mut poly)],
+            };
+            for part in &parts {
+                if part.len() < 3 {
+                    continue;
+                }
+                emit_part(part, c, patch, *f, top + k / params.subscan, out, stats);
+            }
+        }
+    }
+    stats.pieces_ns += start.elapsed().as_nanos() as u64;
+}
+
+/// The triangles of one straight-sided polygon of a cell.
+fn emit_part(
+    poly: &[PolyVertex],
+    c: &Cell,
+    patch: &Patch,
+    facing: Facing,
+    row: u32,
+    out: &mut Vec<Piece>,
+    stats: &mut BandStats,
+) {
+    {
+        {
+            let tris = triangulate(poly, &mut stats.fans);
             for [a, b, cc] in tris {
                 let vs = [poly[a], poly[b], poly[cc]];
-                let patch = &patches[c.patch as usize];
                 let uv = vs.map(|v| c.patch_uv(v.uv.0, v.uv.1));
                 let normals = uv.map(|(u, w)| patch.normal(u, w));
                 out.push(Piece {
@@ -536,14 +583,101 @@ pub fn band_pieces(
                     normals,
                     uv,
                     patch: c.patch,
-                    facing: *f,
-                    row: top + k / params.subscan,
+                    facing,
+                    row,
                 });
                 stats.triangles += 1;
             }
         }
     }
-    stats.pieces_ns += start.elapsed().as_nanos() as u64;
+}
+
+/// §6's silhouette points: where the polygon of a twisted cell crosses the cell along a
+/// row line (from a root where the boundary leaves the strip to the next where it
+/// enters) between corners whose normals face opposite ways (the view component
+/// `N·(E − S)` changes sign), the point where it vanishes, found by bisection along the
+/// parameter chord between the two roots and placed on the row line at its projected
+/// `x`. When both of the polygon's crossings (its top and bottom) hold one, the polygon
+/// is cut along the chord between them into its front and its back part, each simple on
+/// the screen: the outline then runs through the silhouette points. `None` otherwise
+/// (counted in `silhouettes_unsplit` when only one crossing held a sign change).
+fn silhouette_split(
+    poly: &[PolyVertex],
+    c: &Cell,
+    patch: &Patch,
+    view: &View,
+    stats: &mut BandStats,
+) -> Option<(Vec<PolyVertex>, Vec<PolyVertex>)> {
+    let n = poly.len();
+    let eye = view.camera.eye;
+    let toward = |uv: (f64, f64)| -> f64 {
+        let (u, v) = c.patch_uv(uv.0, uv.1);
+        patch
+            .normal(u, v)
+            .map_or(0.0, |nrm| nrm.dot(eye - patch.point(u, v)))
+    };
+    let lerp =
+        |a: (f64, f64), b: (f64, f64), t: f64| (a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1));
+    let mut crossings = 0;
+    let mut found: Vec<(usize, PolyVertex)> = Vec::new();
+    for i in 0..n {
+        let (a, b) = (poly[i], poly[(i + 1) % n]);
+        if !(a.exit && b.entry && a.screen[1] == b.screen[1]) {
+            continue;
+        }
+        crossings += 1;
+        let (ha, hb) = (toward(a.uv), toward(b.uv));
+        if ha * hb >= 0.0 {
+            continue;
+        }
+        let (mut lo, mut hi) = (0.0, 1.0);
+        for _ in 0..52 {
+            let m = 0.5 * (lo + hi);
+            if (toward(lerp(a.uv, b.uv, m)) < 0.0) == (ha < 0.0) {
+                lo = m;
+            } else {
+                hi = m;
+            }
+        }
+        let uv = lerp(a.uv, b.uv, 0.5 * (lo + hi));
+        let (u, v) = c.patch_uv(uv.0, uv.1);
+        let p = patch.point(u, v);
+        found.push((
+            i,
+            PolyVertex {
+                screen: [view.project(p)[0], a.screen[1]],
+                world: p,
+                uv,
+                exit: false,
+                entry: false,
+            },
+        ));
+    }
+    if found.len() == 2 && crossings == 2 {
+        let ((i1, s1), (i2, s2)) = (found[0], found[1]);
+        let walk = |from: usize, to: usize| {
+            let mut v = Vec::new();
+            let mut k = from % n;
+            loop {
+                v.push(poly[k]);
+                if k == to {
+                    break;
+                }
+                k = (k + 1) % n;
+            }
+            v
+        };
+        let mut front = walk(i1 + 1, i2);
+        front.extend([s2, s1]);
+        let mut back = walk(i2 + 1, i1);
+        back.extend([s1, s2]);
+        stats.silhouette_points += 2;
+        return Some((front, back));
+    }
+    if !found.is_empty() {
+        stats.silhouettes_unsplit += 1;
+    }
+    None
 }
 
 /// The subpatches of `patches` that meet the band of rows `top .. top + rows`: the

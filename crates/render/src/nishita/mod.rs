@@ -375,6 +375,8 @@ impl Nishita {
             .with("clip_splits", c.splits)
             .with("straight_pieces", s.polygons)
             .with("straight_pieces_split", s.split_polygons)
+            .with("silhouette_points", s.silhouette_points)
+            .with("silhouettes_unsplit", s.silhouettes_unsplit)
             .with("piece_triangles", self.triangles);
         for (name, n) in HISTOGRAM_NAMES.iter().zip(c.histogram) {
             out.add(name, n);
@@ -488,8 +490,8 @@ impl Renderer for Nishita {
             rows.push((
                 "pieces",
                 format!(
-                    "{} straight-sided pieces ({} crossing their strip more than twice), {} triangles",
-                    s.polygons, s.split_polygons, self.triangles
+                    "{} straight-sided pieces ({} crossing their strip more than twice), {} triangles; {} silhouette points on row lines ({} twisted pieces with a silhouette leaving through a subpatch edge, not cut)",
+                    s.polygons, s.split_polygons, self.triangles, s.silhouette_points, s.silhouettes_unsplit
                 ),
             ));
             let total =
