@@ -825,3 +825,138 @@ fn triangulate(poly: &[PolyVertex], fans: &mut u64) -> Vec<[usize; 3]> {
     out.retain(|&[a, b, c]| cross(p(a), p(b), p(c)) != 0.0);
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A small deterministic generator (xorshift64*).
+    struct Rng(u64);
+    impl Rng {
+        fn next(&mut self) -> f64 {
+            self.0 ^= self.0 >> 12;
+            self.0 ^= self.0 << 25;
+            self.0 ^= self.0 >> 27;
+            (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64
+        }
+        fn point(&mut self) -> DVec3 {
+            DVec3::new(
+                self.next() * 7.0 - 3.0,
+                self.next() * 5.0,
+                self.next() * 3.0 - 9.0,
+            )
+        }
+    }
+
+    fn bits(c: &[DVec3]) -> Vec<u64> {
+        c.iter()
+            .flat_map(|p| p.to_array().map(f64::to_bits))
+            .collect()
+    }
+
+    #[test]
+    fn half_of_the_reverse_is_the_reverse_of_half_bit_for_bit() {
+        let mut rng = Rng(17);
+        for _ in 0..1000 {
+            let c = [rng.point(), rng.point(), rng.point(), rng.point()];
+            let r = [c[3], c[2], c[1], c[0]];
+            let (a, b) = half(c);
+            let (ra, rb) = half(r);
+            let rev = |x: [DVec3; 4]| [x[3], x[2], x[1], x[0]];
+            assert_eq!(bits(&rev(b)), bits(&ra));
+            assert_eq!(bits(&rev(a)), bits(&rb));
+            // and the canonical direction is one curve either way
+            assert_eq!(key(&canonical(c).0), key(&canonical(r).0));
+        }
+    }
+
+    #[test]
+    fn neighbouring_cells_share_their_edges_bit_for_bit() {
+        let mut rng = Rng(5);
+        let mut pts = [[DVec3::ZERO; 4]; 4];
+        for row in pts.iter_mut() {
+            for p in row.iter_mut() {
+                *p = rng.point();
+            }
+        }
+        let patch = Patch::new(pts);
+        // two levels: 16 cells, every neighbour pair across parents too
+        let mut cells = vec![Cell::root(0, &patch)];
+        for _ in 0..2 {
+            cells = cells.iter().flat_map(|c| c.split()).collect();
+        }
+        let at = |i: u32, j: u32| cells.iter().find(|c| c.index == (i, j)).unwrap();
+        let mut pairs = 0;
+        for i in 0..4 {
+            for j in 0..4 {
+                let c = at(i, j);
+                let [bottom, right, top, _] = c.boundary();
+                if i + 1 < 4 {
+                    // u = 1 of (i, j) is u = 0 of (i + 1, j), traversed the other way
+                    let n = at(i + 1, j).boundary()[3];
+                    assert_eq!(bits(&right), bits(&[n[3], n[2], n[1], n[0]]));
+                    pairs += 1;
+                }
+                if j + 1 < 4 {
+                    let n = at(i, j + 1).boundary()[0];
+                    assert_eq!(bits(&top), bits(&[n[3], n[2], n[1], n[0]]));
+                    pairs += 1;
+                }
+                let _ = bottom;
+            }
+        }
+        assert_eq!(pairs, 24);
+    }
+
+    #[test]
+    fn ear_clipping_tiles_convex_and_concave_polygons() {
+        let v = |x: f64, y: f64| PolyVertex {
+            screen: [x, y],
+            world: DVec3::ZERO,
+            uv: (0.0, 0.0),
+            exit: false,
+            entry: false,
+        };
+        let area = |p: &[PolyVertex]| {
+            let n = p.len();
+            0.5 * (0..n)
+                .map(|i| cross([0.0, 0.0], p[i].screen, p[(i + 1) % n].screen))
+                .sum::<f64>()
+                .abs()
+        };
+        for poly in [
+            vec![v(0.0, 0.0), v(4.0, 0.0), v(4.0, 1.0), v(0.0, 1.0)],
+            // concave (an L), and with a collinear vertex
+            vec![
+                v(0.0, 0.0),
+                v(2.0, 0.0),
+                v(4.0, 0.0),
+                v(4.0, 1.0),
+                v(1.0, 1.0),
+                v(1.0, 3.0),
+                v(0.0, 3.0),
+            ],
+            // clockwise
+            vec![
+                v(0.0, 0.0),
+                v(0.0, 1.0),
+                v(3.0, 1.0),
+                v(2.0, 0.5),
+                v(3.0, 0.0),
+            ],
+        ] {
+            let mut fans = 0;
+            let tris = triangulate(&poly, &mut fans);
+            let sum: f64 = tris
+                .iter()
+                .map(|&[a, b, c]| 0.5 * cross(poly[a].screen, poly[b].screen, poly[c].screen).abs())
+                .sum();
+            assert!(
+                (sum - area(&poly)).abs() < 1e-12,
+                "{sum} vs {}",
+                area(&poly)
+            );
+            assert_eq!(fans, 0);
+        }
+    }
+}
