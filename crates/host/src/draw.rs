@@ -274,6 +274,42 @@ pub struct DrawArgs {
     /// Front to back: where the list of unset pixels lives.
     #[arg(long, value_enum, default_value_t = UnsetArg::Host, help_heading = "Scanline principle (sbuffer, bsp)")]
     pub unset: UnsetArg,
+    /// Bézier clipping's tolerance, in the patch parameter u or v (the paper's 1e-3 keeps a
+    /// patch 1000 pixels across within about a pixel). Spelled --root-tolerance because
+    /// `cwisim diff` has a --tolerance of its own.
+    #[arg(
+        long,
+        value_name = "T",
+        default_value_t = 1e-3,
+        help_heading = "Bézier patches (nishita)"
+    )]
+    pub root_tolerance: f64,
+    /// How far (pixels) a subpatch's projected control points may stray from the bilinear
+    /// interpolation of its projected corners (a quarter of it for subpatches that may
+    /// hold a silhouette).
+    #[arg(
+        long,
+        value_name = "PX",
+        default_value_t = 0.5,
+        help_heading = "Bézier patches (nishita)"
+    )]
+    pub flatness: f64,
+    /// Pixel rows per band of subpatches (the paper: three or four).
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 4,
+        help_heading = "Bézier patches (nishita)"
+    )]
+    pub band: u32,
+    /// Sub-scanlines per pixel row: roots at every 1/K of a row, straight pieces between.
+    #[arg(
+        long,
+        value_name = "K",
+        default_value_t = 1,
+        help_heading = "Bézier patches (nishita)"
+    )]
+    pub subscan: u32,
 }
 
 impl Default for DrawArgs {
@@ -297,6 +333,10 @@ impl Default for DrawArgs {
             sbuffer: SbufferArg::Host,
             order: OrderArg::FrontToBack,
             unset: UnsetArg::Host,
+            root_tolerance: 1e-3,
+            flatness: 0.5,
+            band: 4,
+            subscan: 1,
         }
     }
 }
@@ -334,6 +374,10 @@ impl DrawArgs {
             sbuffer: self.sbuffer.into(),
             bsp_order: self.order.into(),
             unset: self.unset.into(),
+            root_tolerance: self.root_tolerance,
+            flatness: self.flatness,
+            band: self.band,
+            subscan: self.subscan,
         }
     }
 

@@ -91,7 +91,8 @@ fn an_unknown_renderer_is_one_line_naming_the_known_ones() {
         let (stdout, stderr) = text(&out);
         assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
         assert_eq!(
-            stderr, "error: unknown renderer `nishitaa`; known: vanrij, woo-chall, sbuffer, bsp\n",
+            stderr,
+            "error: unknown renderer `nishitaa`; known: vanrij, woo-chall, sbuffer, bsp, nishita\n",
             "{args:?}"
         );
         assert!(stdout.is_empty(), "{args:?}: {stdout}");
@@ -119,4 +120,66 @@ fn stats_on_a_scene_takes_the_drawing_options() {
     let out = cwisim(&dir, &["stats", fig25, "--renderer", "nishitaa"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(text(&out).1.contains("unknown renderer `nishitaa`"));
+}
+
+#[test]
+fn nishita_draws_the_teapot_with_its_summary_and_refuses_bad_settings() {
+    let dir = scratch("renderers-nishita");
+    let out = cwisim_ok(
+        &dir,
+        &[
+            "render",
+            "teapot",
+            "--renderer",
+            "nishita",
+            "--size",
+            "96x96",
+            "--root-tolerance",
+            "1e-5",
+            "--band",
+            "3",
+            "--subscan",
+            "2",
+            "-o",
+            "n.png",
+        ],
+    );
+    for label in ["subpatches", "roots", "iterations", "pieces", "host time"] {
+        assert!(
+            out.lines().any(|l| l.starts_with(label)),
+            "no {label} row: {out}"
+        );
+    }
+    assert!(out.contains("average iterations per root"), "{out}");
+    assert!(
+        out.contains("bands of 3 rows, 2 sub-scanline(s) per row"),
+        "{out}"
+    );
+    assert!(dir.join("n.png").exists());
+    for (flag, value, says) in [
+        ("--root-tolerance", "0", "--root-tolerance"),
+        ("--flatness", "0", "--flatness"),
+        ("--band", "0", "--band"),
+        ("--subscan", "100", "--subscan"),
+        ("--shading", "flat", "--shading gouraud or phong"),
+    ] {
+        let out = cwisim(
+            &dir,
+            &[
+                "render",
+                "teapot",
+                "--renderer",
+                "nishita",
+                flag,
+                value,
+                "-o",
+                "x.png",
+            ],
+        );
+        let (_, stderr) = text(&out);
+        assert_eq!(out.status.code(), Some(2), "{flag} {value}: {stderr}");
+        assert!(stderr.contains(says), "{flag} {value}: {stderr}");
+        assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    }
+    assert!(!dir.join("x.png").exists());
 }

@@ -27,6 +27,8 @@
 //! * [`cp`] — Barkan & Gordon's critical-points scan conversion (`DETCR`, `MOVEUP`,
 //!   `POLINE`), usable alone; [`sbuffer`] — their one-scanline depth buffer (`sbuffer`);
 //!   [`bsp`] — BSP trees displayed in scanline order (`bsp`).
+//! * [`nishita`] — Nishita, Kaneda & Nakamae's Bézier patches scan-converted directly
+//!   (`nishita`): subpatches per band, Bézier clipping at every row line.
 //!
 //! ```
 //! use cwisim_render::{registry, render, ArrayConfig, Settings, Source, Taps};
@@ -49,6 +51,7 @@ pub mod bsp;
 pub mod cp;
 pub mod cpbench;
 pub mod error;
+pub mod nishita;
 pub mod phong;
 pub mod pipeline;
 pub mod prepare;

@@ -21,6 +21,9 @@ pub struct Entry {
     /// It samples each pixel on an `l × l` grid (`Settings::samples`, `grid`, …) and
     /// resolves visibility itself: `Settings::aa` and `visibility` do not apply to it.
     pub supersampled: bool,
+    /// It draws a world scene's Bézier patches directly (`--tessellate` does not apply
+    /// to them): `tradeoff`'s axis for it is the root tolerance.
+    pub patches: bool,
 }
 
 /// The renderer used when none is named.
@@ -33,24 +36,35 @@ pub const REGISTRY: &[Entry] = &[
         about: crate::vanrij::ABOUT,
         build: crate::vanrij::VanRij::build,
         supersampled: false,
+        patches: false,
     },
     Entry {
         name: "woo-chall",
         about: crate::woochall::ABOUT,
         build: crate::woochall::WooChall::build,
         supersampled: true,
+        patches: false,
     },
     Entry {
         name: "sbuffer",
         about: crate::sbuffer::ABOUT,
         build: crate::sbuffer::SBuffer::build,
         supersampled: true,
+        patches: false,
     },
     Entry {
         name: "bsp",
         about: crate::bsp::ABOUT,
         build: crate::bsp::Bsp::build,
         supersampled: true,
+        patches: false,
+    },
+    Entry {
+        name: "nishita",
+        about: crate::nishita::ABOUT,
+        build: crate::nishita::Nishita::build,
+        supersampled: false,
+        patches: true,
     },
 ];
 

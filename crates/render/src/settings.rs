@@ -84,6 +84,15 @@ pub struct Settings {
     pub bsp_order: BspOrder,
     /// Barkan & Gordon's BSP display, front to back: who keeps the unset pixels.
     pub unset: Unset,
+    /// Nishita: the root finder's tolerance, in the patch parameter (`u` or `v`).
+    pub root_tolerance: f64,
+    /// Nishita: how far (pixels) a subpatch's projected control points may lie from the
+    /// bilinear interpolation of its projected corners.
+    pub flatness: f64,
+    /// Nishita: pixel rows per band of subpatches.
+    pub band: u32,
+    /// Nishita: sub-scanlines per pixel row: roots at every `1/subscan` of a row.
+    pub subscan: u32,
 }
 
 /// `--sbuffer`: what the S-buffer sends the array.
@@ -178,9 +187,22 @@ impl Default for Settings {
             sbuffer: SbufferMode::Host,
             bsp_order: BspOrder::FrontToBack,
             unset: Unset::Host,
+            root_tolerance: 1e-3,
+            flatness: 0.5,
+            band: 4,
+            subscan: 1,
         }
     }
 }
+
+/// The widest root tolerance: the whole parameter interval.
+pub const MAX_ROOT_TOLERANCE: f64 = 1.0;
+/// The most rows in a band of subpatches.
+pub const MAX_BAND: u32 = 4096;
+/// The most sub-scanlines per row.
+pub const MAX_SUBSCAN: u32 = 64;
+/// The finest flatness, pixels.
+pub const MIN_FLATNESS: f64 = 1e-3;
 
 impl Settings {
     /// Refuses settings no renderer could use, saying which and why.
@@ -203,6 +225,31 @@ impl Settings {
                     "--shade-p must be a probability in [0, 1], found {p}"
                 ));
             }
+        }
+        let t = self.root_tolerance;
+        if !(cwisim_world::clip::MIN_TOLERANCE..=MAX_ROOT_TOLERANCE).contains(&t) {
+            return Err(format!(
+                "--root-tolerance must be a number between {:e} and {MAX_ROOT_TOLERANCE} (of the patch parameter), found {t}",
+                cwisim_world::clip::MIN_TOLERANCE
+            ));
+        }
+        if !(self.flatness >= MIN_FLATNESS && self.flatness.is_finite()) {
+            return Err(format!(
+                "--flatness must be a finite number of pixels ≥ {MIN_FLATNESS}, found {}",
+                self.flatness
+            ));
+        }
+        if !(1..=MAX_BAND).contains(&self.band) {
+            return Err(format!(
+                "--band must be 1 to {MAX_BAND} rows, found {}",
+                self.band
+            ));
+        }
+        if !(1..=MAX_SUBSCAN).contains(&self.subscan) {
+            return Err(format!(
+                "--subscan must be 1 to {MAX_SUBSCAN} sub-scanlines per row, found {}",
+                self.subscan
+            ));
         }
         if self.shade_contrast.is_nan() || self.shade_contrast < 0.0 {
             return Err(format!(
@@ -260,6 +307,33 @@ mod tests {
                 ..Settings::default()
             };
             assert!(s.check().unwrap_err().contains("--eval0-tolerance"));
+        }
+        for bad in [0.0, 1e-13, 2.0, f64::NAN] {
+            let s = Settings {
+                root_tolerance: bad,
+                ..Settings::default()
+            };
+            assert!(s.check().unwrap_err().contains("--root-tolerance"));
+        }
+        for bad in [0.0, -1.0, f64::INFINITY, f64::NAN] {
+            let s = Settings {
+                flatness: bad,
+                ..Settings::default()
+            };
+            assert!(s.check().unwrap_err().contains("--flatness"));
+        }
+        for (band, subscan, flag) in [
+            (0, 1, "--band"),
+            (5000, 1, "--band"),
+            (4, 0, "--subscan"),
+            (4, 65, "--subscan"),
+        ] {
+            let s = Settings {
+                band,
+                subscan,
+                ..Settings::default()
+            };
+            assert!(s.check().unwrap_err().contains(flag));
         }
     }
 }

@@ -15,6 +15,7 @@ use cwisim_render::{
     registry, render, ArrayConfig, PolygonScene, Renderer, Settings, Size, Source, Taps,
 };
 use cwisim_scene::{Antialias, Shading};
+use cwisim_world::scene::MAX_TESSELLATION;
 use cwisim_world::Visibility;
 use cwisim_xproc::{ImageSink, Machine, Numeric, Timing};
 use cwisim_ypipe::exact::scene_box_filtered;
@@ -49,6 +50,9 @@ pub struct Row {
     pub visibility: &'static str,
     /// Quads per Bézier patch side (scenes with Bézier meshes, when the grid varies it).
     pub tessellate: Option<u32>,
+    /// The root tolerance of a renderer that draws the patches directly (`nishita`);
+    /// its rows are measured against the reference at the finest tessellation.
+    pub root_tolerance: Option<f64>,
     /// The array's numeric format.
     pub numeric: String,
     /// Register bits per processor and channel (I, dI, ddI and the accumulator).
@@ -104,6 +108,10 @@ pub struct Axes {
     pub tessellations: Vec<u32>,
 }
 
+/// The root tolerances of a renderer that draws Bézier patches directly (Nishita et
+/// al.'s Table 1).
+pub const ROOT_TOLERANCE_AXIS: [f64; 3] = [1e-3, 1e-5, 1e-7];
+
 /// The settings of the grid, in order: renderer, tessellation (scenes with Bézier
 /// meshes), visibility (world scenes), shading (Phong on world scenes with exact
 /// visibility), anti-aliasing (`box`, `box-centre` with Gouraud shading, `none`) and numeric
@@ -126,6 +134,31 @@ pub fn grid(
         axes.tessellations.iter().map(|&n| Some(n)).collect()
     };
     for &renderer in renderers {
+        if renderer.patches && !axes.world {
+            // no patches to draw: its rows would be vanrij's
+            continue;
+        }
+        if renderer.patches {
+            // patches drawn directly: no tessellation, exact visibility, smooth shading;
+            // the root tolerance is its axis
+            for tolerance in ROOT_TOLERANCE_AXIS {
+                for shading in [Shading::Phong, Shading::Gouraud] {
+                    for numeric in formats {
+                        out.push(Setting {
+                            renderer,
+                            settings: Settings {
+                                shading,
+                                size: axes.size,
+                                root_tolerance: tolerance,
+                                ..Settings::default()
+                            },
+                            numeric: *numeric,
+                        });
+                    }
+                }
+            }
+            continue;
+        }
         if renderer.supersampled {
             for &tessellate in &tessellations {
                 for shading in [Shading::Phong, Shading::Gouraud, Shading::Flat] {
@@ -383,15 +416,27 @@ pub fn tradeoff_rows(
         }
         times.sort();
         let stats = &measured.stats;
+        // patches drawn directly are measured against the finest tessellation: the
+        // closest the exact reference comes to the true surface
+        let patches = setting.renderer.patches && axes.world;
+        let reference_tessellation = if patches {
+            Some(MAX_TESSELLATION)
+        } else {
+            setting.settings.tessellate
+        };
         let key = (
             setting.settings.shading == Shading::Phong,
-            setting.settings.tessellate,
+            reference_tessellation,
         );
         let reference = match references.entry(key) {
             std::collections::btree_map::Entry::Occupied(e) => e.into_mut(),
-            std::collections::btree_map::Entry::Vacant(e) => {
-                e.insert(reference_image(scene, &setting.settings)?)
-            }
+            std::collections::btree_map::Entry::Vacant(e) => e.insert(reference_image(
+                scene,
+                &Settings {
+                    tessellate: reference_tessellation,
+                    ..setting.settings
+                },
+            )?),
         };
         let (max_error, rms_error, psnr_db) = errors(&measured.image, reference.as_slice());
         let worst = stats.lines.iter().map(|l| l.busy_cycles).max().unwrap_or(0);
@@ -411,6 +456,7 @@ pub fn tradeoff_rows(
                 "-"
             },
             tessellate: s.tessellate,
+            root_tolerance: patches.then_some(s.root_tolerance),
             numeric: short_numeric(&setting.numeric),
             register_bits: register_bits(&setting.numeric),
             instructions: stats.totals.instructions,
@@ -452,7 +498,11 @@ pub fn write_table(out: &mut dyn Write, rows: &[Row]) -> std::io::Result<()> {
             out,
             "{:<rw$} {:>4} {:<8} {:<10} {:>2} {:<5} {:<34} {:>4} {:>8} {:>9} {:>5.1}% {:>4} {:>8.2} {:>9.2e} {:>9.2e} {:>6} {:>5}  {}",
             r.renderer,
-            r.tessellate.map_or_else(|| "-".to_string(), |n| n.to_string()),
+            match (r.tessellate, r.root_tolerance) {
+                (_, Some(t)) => format!("{t:.0e}"),
+                (Some(n), None) => n.to_string(),
+                (None, None) => "-".to_string(),
+            },
             r.shading,
             r.aa,
             r.samples.map_or_else(|| "-".to_string(), |n| n.to_string()),
@@ -491,7 +541,7 @@ pub fn csv(rows: &[Row]) -> String {
         }
     }
     let mut s = String::from(
-        "renderer,tessellate,shading,aa,samples,visibility,numeric,register_bits,instructions,busy_cycles,worst_line_share,late_lines,host_ms,max_error,rms_error,psnr_db,overflows,pareto",
+        "renderer,tessellate,root_tolerance,shading,aa,samples,visibility,numeric,register_bits,instructions,busy_cycles,worst_line_share,late_lines,host_ms,max_error,rms_error,psnr_db,overflows,pareto",
     );
     for name in &names {
         s.push_str(",counter_");
@@ -500,9 +550,11 @@ pub fn csv(rows: &[Row]) -> String {
     s.push('\n');
     for r in rows {
         s.push_str(&format!(
-            "{},{},{},{},{},{},\"{}\",{},{},{},{},{},{},{:e},{:e},{},{},{}",
+            "{},{},{},{},{},{},{},\"{}\",{},{},{},{},{},{},{:e},{:e},{},{},{}",
             r.renderer,
             r.tessellate.map_or_else(String::new, |n| n.to_string()),
+            r.root_tolerance
+                .map_or_else(String::new, |t| format!("{t:e}")),
             r.shading,
             r.aa,
             r.samples.map_or_else(String::new, |n| n.to_string()),
@@ -543,6 +595,7 @@ mod tests {
             samples: None,
             visibility: "exact",
             tessellate: None,
+            root_tolerance: None,
             numeric: "f64".into(),
             register_bits: 256,
             instructions: 0,

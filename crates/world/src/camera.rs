@@ -55,6 +55,17 @@ impl Camera {
         (p - self.eye).dot(self.forward)
     }
 
+    /// `(depth, depth · y)` of `p`, `y` the screen row it projects to. Both are affine in
+    /// `p`, so for a Bézier curve or patch they are Bernstein coefficients: the scan
+    /// plane through the eye and the pixel row `y_s` is `depth · y_s − depth · y = 0`,
+    /// and `depth_i · y_s − (depth · y)_i` are Nishita et al.'s `Y'_i` (their eq. 3, up to
+    /// the positive factor `1/R` and the direction of `y`): positive above the row.
+    pub fn depth_and_scaled_row(&self, p: DVec3) -> (f64, f64) {
+        let d = p - self.eye;
+        let depth = d.dot(self.forward);
+        (depth, self.centre[1] * depth - self.focal * d.dot(self.up))
+    }
+
     /// Where `p` lands on the screen (pixels), for a point in front of the camera.
     pub fn project(&self, p: DVec3) -> [f64; 2] {
         let d = p - self.eye;
@@ -88,6 +99,12 @@ mod tests {
             (top[1] - 0.0).abs() < 1e-12 && (top[0] - 100.0).abs() < 1e-12,
             "{top:?}"
         );
+        // the scan-plane values: depth·y of a point is its row times its depth
+        for p in [DVec3::new(1.0, 2.0, -3.0), DVec3::new(-0.5, 0.25, 1.0)] {
+            let (d, dy) = c.depth_and_scaled_row(p);
+            assert!((dy / d - c.project(p)[1]).abs() < 1e-12);
+            assert_eq!(d, c.depth(p));
+        }
         // x to the right, square pixels
         let right = c.project(DVec3::new(5.0, 0.0, 0.0));
         assert!((right[0] - 150.0).abs() < 1e-12, "{right:?}");

@@ -19,11 +19,13 @@
 //! the scenes built into the binary.
 //!
 //! - [`bezier`] — bicubic Bézier patches (the Utah teapot), evaluated and tessellated.
+//! - [`clip`] — Bézier clipping: the roots of a curve in Bernstein form (Nishita et al.).
 
 #![warn(missing_docs)]
 
 pub mod bezier;
 pub mod camera;
+pub mod clip;
 pub mod embedded;
 pub mod face;
 pub mod lighting;

@@ -221,6 +221,25 @@ pub fn build(spec: &MeshSpec, k: usize, base: Option<&Path>) -> Result<Mesh, Bui
     })
 }
 
+/// The Bézier patches of a mesh spec placed in the world by its transform (a Bézier
+/// patch is affine invariant: the placed control points are the placed patch's), or
+/// `None` when the mesh is not made of patches. The spec must be valid.
+pub fn placed_patches(spec: &MeshSpec) -> Option<Result<Vec<crate::bezier::Patch>, String>> {
+    let b = spec.bezier.as_ref()?;
+    let indices: Vec<[usize; 16]> = b
+        .patches
+        .iter()
+        .map(|p| std::array::from_fn(|j| p[j] as usize))
+        .collect();
+    let matrix = placement(&spec.transform);
+    let placed: Vec<[f64; 3]> = b
+        .vertices
+        .iter()
+        .map(|v| matrix.transform_point3(DVec3::from_array(*v)).to_array())
+        .collect();
+    Some(patches_from(&placed, &indices))
+}
+
 /// Scale, then rotate (x, then y, then z), then translate.
 fn placement(t: &Transform) -> DMat4 {
     let scale = match t.scale {

@@ -1,0 +1,246 @@
+//! Front, back or twisted: the sign of `g(u, v) = (S(u, v) − E) · (S_u × S_v)` over a
+//! subpatch, exactly and conservatively.
+//!
+//! `S_u × S_v` is the patch's normal (outward on the teapot, `cwisim_world::bezier`), `E`
+//! the eye. A point faces the eye when its normal points toward it, `(E − S)·N > 0`, that
+//! is `g < 0` — the paper's condition `P · P_u × P_v < 0` with the eye at the origin
+//! (§6). `g` is a polynomial of degree (8, 8); its Bernstein coefficients bound it (the
+//! convex-hull property), so all coefficients `≤ 0` (some `< 0`) prove the subpatch
+//! front-facing everywhere, all `≥ 0` back-facing, and mixed signs leave it *twisted*:
+//! it may hold a silhouette. Unlike the paper's wedge test on projected control points,
+//! this is exact under perspective (the projected patch is rational, and differences of
+//! its projected control points are not the control points of its derivative): a cell
+//! called front or back is one, whatever the view. Zero coefficients (at a pole, where
+//! `S_u` vanishes) do not count against either side.
+
+use glam::DVec3;
+
+/// How a subpatch faces the eye.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Facing {
+    /// Toward the eye everywhere.
+    Front,
+    /// Away from the eye everywhere.
+    Back,
+    /// Both signs among the coefficients: may hold a silhouette.
+    Twisted,
+}
+
+/// A bivariate polynomial in Bernstein form: degree `(m, n)`, coefficients `c[i][j]`
+/// (`i` along `u`, `j` along `v`) stored row-major with `n + 1` per row.
+#[derive(Clone, Debug)]
+struct Bern2 {
+    m: usize,
+    n: usize,
+    c: Vec<f64>,
+}
+
+/// `C(n, k)` for `n ≤ 8` (exact: small integers).
+const BINOMIAL: [[f64; 9]; 9] = {
+    let mut t = [[0.0; 9]; 9];
+    let mut n = 0;
+    while n < 9 {
+        t[n][0] = 1.0;
+        let mut k = 1;
+        while k <= n {
+            t[n][k] = t[n - 1][k - 1] + if k < n { t[n - 1][k] } else { 0.0 };
+            k += 1;
+        }
+        n += 1;
+    }
+    t
+};
+
+impl Bern2 {
+    /// The coefficients times `C(m, i)·C(n, j)`: the scaled form, in which a product is
+    /// a plain convolution.
+    fn scaled(&self) -> Vec<f64> {
+        let mut s = self.c.clone();
+        for i in 0..=self.m {
+            for j in 0..=self.n {
+                s[i * (self.n + 1) + j] *= BINOMIAL[self.m][i] * BINOMIAL[self.n][j];
+            }
+        }
+        s
+    }
+
+    /// The product, in Bernstein form of the summed degrees.
+    fn mul(&self, o: &Bern2) -> Bern2 {
+        let (m, n) = (self.m + o.m, self.n + o.n);
+        let (sa, sb) = (self.scaled(), o.scaled());
+        let mut c = vec![0.0; (m + 1) * (n + 1)];
+        for i1 in 0..=self.m {
+            for j1 in 0..=self.n {
+                let a = sa[i1 * (self.n + 1) + j1];
+                if a == 0.0 {
+                    continue;
+                }
+                for i2 in 0..=o.m {
+                    let row = (i1 + i2) * (n + 1) + j1;
+                    for j2 in 0..=o.n {
+                        c[row + j2] += a * sb[i2 * (o.n + 1) + j2];
+                    }
+                }
+            }
+        }
+        for i in 0..=m {
+            for j in 0..=n {
+                c[i * (n + 1) + j] /= BINOMIAL[m][i] * BINOMIAL[n][j];
+            }
+        }
+        Bern2 { m, n, c }
+    }
+
+    fn sub(mut self, o: &Bern2) -> Bern2 {
+        for (a, b) in self.c.iter_mut().zip(&o.c) {
+            *a -= b;
+        }
+        self
+    }
+
+    fn add(mut self, o: &Bern2) -> Bern2 {
+        for (a, b) in self.c.iter_mut().zip(&o.c) {
+            *a += b;
+        }
+        self
+    }
+}
+
+/// One coordinate of control points `q[i][j]` (`i` along `u`) as a [`Bern2`].
+fn coordinate(q: &[Vec<DVec3>], axis: usize) -> Bern2 {
+    let m = q.len() - 1;
+    let n = q[0].len() - 1;
+    Bern2 {
+        m,
+        n,
+        c: q.iter().flatten().map(|p| p[axis]).collect(),
+    }
+}
+
+/// The Bernstein coefficients of `g = (S − E)·(S_u × S_v)` for the patch with control
+/// points `points[row][col]` (`u` along a row, `v` down the rows).
+pub fn facing_coefficients(points: &[[DVec3; 4]; 4], eye: DVec3) -> Vec<f64> {
+    // q[i][j]: i along u (column), j along v (row)
+    let p: Vec<Vec<DVec3>> = (0..4)
+        .map(|i| (0..4).map(|j| points[j][i] - eye).collect())
+        .collect();
+    let su: Vec<Vec<DVec3>> = (0..3)
+        .map(|i| (0..4).map(|j| 3.0 * (p[i + 1][j] - p[i][j])).collect())
+        .collect();
+    let sv: Vec<Vec<DVec3>> = (0..4)
+        .map(|i| (0..3).map(|j| 3.0 * (p[i][j + 1] - p[i][j])).collect())
+        .collect();
+    let c = |q: &[Vec<DVec3>], a| coordinate(q, a);
+    let (ux, uy, uz) = (c(&su, 0), c(&su, 1), c(&su, 2));
+    let (vx, vy, vz) = (c(&sv, 0), c(&sv, 1), c(&sv, 2));
+    let nx = uy.mul(&vz).sub(&uz.mul(&vy));
+    let ny = uz.mul(&vx).sub(&ux.mul(&vz));
+    let nz = ux.mul(&vy).sub(&uy.mul(&vx));
+    let g = c(&p, 0)
+        .mul(&nx)
+        .add(&c(&p, 1).mul(&ny))
+        .add(&c(&p, 2).mul(&nz));
+    g.c
+}
+
+/// How the patch with these control points faces `eye`.
+pub fn facing(points: &[[DVec3; 4]; 4], eye: DVec3) -> Facing {
+    let g = facing_coefficients(points, eye);
+    let neg = g.iter().any(|&x| x < 0.0);
+    let pos = g.iter().any(|&x| x > 0.0);
+    match (neg, pos) {
+        (true, false) => Facing::Front,
+        (false, true) => Facing::Back,
+        _ => Facing::Twisted,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use cwisim_world::bezier::Patch;
+
+    fn bernstein(n: usize, i: usize, t: f64) -> f64 {
+        BINOMIAL[n][i] * t.powi(i as i32) * (1.0 - t).powi((n - i) as i32)
+    }
+
+    /// A wavy patch over the unit square in z = 0 ± bumps.
+    fn wavy() -> Patch {
+        let mut pts = [[DVec3::ZERO; 4]; 4];
+        for (r, row) in pts.iter_mut().enumerate() {
+            for (c, p) in row.iter_mut().enumerate() {
+                let z = [
+                    [0.0, 0.3, -0.2, 0.1],
+                    [0.2, -0.4, 0.5, 0.0],
+                    [-0.1, 0.6, -0.3, 0.2],
+                    [0.0, 0.1, 0.2, -0.1],
+                ][r][c];
+                *p = DVec3::new(c as f64 / 3.0, r as f64 / 3.0, z);
+            }
+        }
+        Patch::new(pts)
+    }
+
+    #[test]
+    fn the_coefficients_are_the_polynomial() {
+        let patch = wavy();
+        let eye = DVec3::new(0.3, -0.7, 2.5);
+        let g = facing_coefficients(&patch.points, eye);
+        assert_eq!(g.len(), 81);
+        for (u, v) in [(0.0, 0.0), (0.3, 0.8), (0.71, 0.12), (1.0, 0.5)] {
+            let direct = (patch.point(u, v) - eye).dot(patch.du(u, v).cross(patch.dv(u, v)));
+            let bern: f64 = (0..9)
+                .flat_map(|i| (0..9).map(move |j| (i, j)))
+                .map(|(i, j)| g[i * 9 + j] * bernstein(8, i, u) * bernstein(8, j, v))
+                .sum();
+            assert!(
+                (direct - bern).abs() < 1e-12 * (1.0 + direct.abs()),
+                "{direct} {bern}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_flat_patch_is_front_from_its_normal_side_and_back_from_the_other() {
+        // the unit square in z = 0: S_u × S_v = +z
+        let mut pts = [[DVec3::ZERO; 4]; 4];
+        for (r, row) in pts.iter_mut().enumerate() {
+            for (c, p) in row.iter_mut().enumerate() {
+                *p = DVec3::new(c as f64 / 3.0, r as f64 / 3.0, 0.0);
+            }
+        }
+        assert_eq!(facing(&pts, DVec3::new(0.5, 0.5, 3.0)), Facing::Front);
+        assert_eq!(facing(&pts, DVec3::new(0.5, 0.5, -3.0)), Facing::Back);
+        // edge-on, the eye in the patch's plane beside it: g ≡ 0 → not proven either way
+        assert_eq!(facing(&pts, DVec3::new(5.0, 0.5, 0.0)), Facing::Twisted);
+        // the wavy patch seen at a grazing angle holds both signs
+        let w = wavy();
+        assert_eq!(
+            facing(&w.points, DVec3::new(0.5, 0.5, 0.05)),
+            Facing::Twisted
+        );
+    }
+
+    #[test]
+    fn front_and_back_are_proven_on_a_dense_grid() {
+        let w = wavy();
+        for eye in [
+            DVec3::new(0.5, 0.5, 4.0),
+            DVec3::new(0.4, 0.6, -4.0),
+            DVec3::new(3.0, 0.2, 0.6),
+        ] {
+            let f = facing(&w.points, eye);
+            for a in 0..=40 {
+                for b in 0..=40 {
+                    let (u, v) = (a as f64 / 40.0, b as f64 / 40.0);
+                    let g = (w.point(u, v) - eye).dot(w.du(u, v).cross(w.dv(u, v)));
+                    match f {
+                        Facing::Front => assert!(g <= 0.0),
+                        Facing::Back => assert!(g >= 0.0),
+                        Facing::Twisted => {}
+                    }
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,538 @@
+//! `nishita`: Nishita, Kaneda & Nakamae, *High-quality rendering of parametric surfaces
+//! by using a robust scanline algorithm* — bicubic Bézier patches scan-converted
+//! directly, band by band, with Bézier clipping finding where subpatch boundaries cross
+//! the row lines, and the straight-sided pieces between those roots filled exactly by the
+//! box filter.
+//!
+//! * [`band`] — one band of rows: the subpatches that meet it (a quadtree cut to the band
+//!   and to a flatness tolerance), the roots of their edges at every row line
+//!   ([`cwisim_world::clip`]), and the pieces between them.
+//! * [`classify`] — front, back or twisted: the sign of `(S − E)·(S_u × S_v)` over a
+//!   subpatch, exactly (Bernstein coefficients of degree 8 × 8).
+//!
+//! The pieces of every band — triangles with their surface points and the patch's own
+//! normals at their corners — go through the project's exact visibility (per triangle,
+//! `cwisim_world::visibility::exact_fragments`) and then through van Rij's trapezia and
+//! box filter, Gouraud (the lighting at each piece corner) or Phong (lit per pixel from
+//! the normals interpolated over the piece, through the span fitter). A screen scene has
+//! no patches: it is drawn as `vanrij` draws it; meshes of a world scene that are not
+//! Bézier patches are projected as `vanrij` projects them and share the visibility pass.
+//!
+//! `docs/RENDERERS.md` says how it reads the paper; `docs/ERRATA.md` what it corrects.
+
+pub mod band;
+pub mod classify;
+
+use crate::error::RenderError;
+use crate::prepare::{PhongSurfaces, PolygonScene};
+use crate::renderer::{Counters, FramePlan, Renderer};
+use crate::settings::Settings;
+use crate::source::LoadedScene;
+use crate::vanrij::VanRij;
+use band::{band_pieces, BandStats, Params, View};
+use classify::Facing;
+use cwisim_isa::{TraceHeader, TraceWrite};
+use cwisim_scene::{SceneError, SceneErrorKind, Shading, MAX_COORDINATE};
+use cwisim_world::camera::Camera;
+use cwisim_world::clip::HISTOGRAM;
+use cwisim_world::face::{ScreenTriangle, Surface};
+use cwisim_world::lighting::Lighting;
+use cwisim_world::shade::PhongShader;
+use cwisim_world::{AnyScene, Visibility, WorldScene};
+use cwisim_xproc::{Image, RunStats};
+use glam::DVec3;
+use std::io;
+use std::ops::Range;
+use std::time::{Duration, Instant};
+
+/// The registry's one line about it.
+pub const ABOUT: &str = "Nishita, Kaneda & Nakamae: Bézier patches scan-converted directly — subpatches per band (--band, --flatness), Bézier clipping of their edges at every row line (--tolerance, --subscan), straight-sided pieces box-filtered exactly, exact visibility, Gouraud or Phong";
+
+/// The histogram counters' names: roots by iterations (the last: that many or more).
+const HISTOGRAM_NAMES: [&str; HISTOGRAM] = [
+    "roots_0_iterations",
+    "roots_1_iteration",
+    "roots_2_iterations",
+    "roots_3_iterations",
+    "roots_4_iterations",
+    "roots_5_iterations",
+    "roots_6_iterations",
+    "roots_7_iterations",
+    "roots_8_iterations",
+    "roots_9_iterations",
+    "roots_10_iterations",
+    "roots_11_iterations",
+    "roots_12_iterations",
+    "roots_13_iterations",
+    "roots_14_iterations",
+    "roots_15_or_more_iterations",
+];
+
+/// Where a piece comes from: mesh, patch, and the patch parameters `(u, v)` at its
+/// corners.
+pub type Origin = (u32, u32, [(f64, f64); 3]);
+
+/// What drawing the patches made, before visibility.
+#[derive(Clone, Debug, Default)]
+pub struct Pieces {
+    /// The pieces as screen triangles (surface points, normals toward the eye, lit
+    /// corners), band by band.
+    pub triangles: Vec<ScreenTriangle>,
+    /// For each triangle: how its subpatch faces the eye.
+    pub facing: Vec<Facing>,
+    /// For each triangle: its mesh, patch and the patch parameters at its corners.
+    pub origin: Vec<Origin>,
+    /// What the bands did.
+    pub stats: BandStats,
+    /// Bands.
+    pub bands: u64,
+    /// Patches.
+    pub patches: u64,
+}
+
+/// The pieces of every Bézier mesh of `w`, band by band (rows `0..height`).
+pub fn pieces(w: &WorldScene, settings: &Settings) -> Result<Pieces, RenderError> {
+    let camera = Camera::new(&w.spec.camera, w.width(), w.height());
+    let view = View { camera };
+    let params = Params {
+        tolerance: settings.root_tolerance,
+        flatness: settings.flatness,
+        subscan: settings.subscan,
+    };
+    let lighting = Lighting {
+        ambient: w.spec.ambient.clone(),
+        lights: w.spec.lights.clone(),
+        channels: w.channels(),
+    };
+    let mut meshes = Vec::new();
+    for (k, m) in w.spec.meshes.iter().enumerate() {
+        let Some(patches) = cwisim_world::mesh::placed_patches(m) else {
+            continue;
+        };
+        let patches = patches.map_err(|e| {
+            SceneError::at_field(SceneErrorKind::Geometry, format!("meshes[{k}].bezier"), e)
+        })?;
+        for (pi, p) in patches.iter().enumerate() {
+            for (i, q) in p.points.iter().flatten().enumerate() {
+                let depth = camera.depth(*q);
+                if depth < camera.near || depth.is_nan() {
+                    return Err(SceneError::at_field(
+                        SceneErrorKind::Geometry,
+                        format!("meshes[{k}].bezier.patches[{pi}]"),
+                        format!(
+                            "control point {i} at {q} is {} the camera (depth {depth:.6}, near {}): a patch must lie in front of the camera; move the camera",
+                            if depth < 0.0 { "behind" } else { "too close to" },
+                            camera.near
+                        ),
+                    )
+                    .into());
+                }
+                let s = camera.project(*q);
+                if !(s[0].abs() <= MAX_COORDINATE && s[1].abs() <= MAX_COORDINATE) {
+                    return Err(SceneError::at_field(
+                        SceneErrorKind::Limit,
+                        format!("meshes[{k}].bezier.patches[{pi}]"),
+                        format!("control point {i} projects to {s:?}, beyond ±{MAX_COORDINATE:e} pixels"),
+                    )
+                    .into());
+                }
+            }
+        }
+        meshes.push((k, patches));
+    }
+    let mut out = Pieces::default();
+    let band = settings.band;
+    let height = w.height();
+    let mut raw = Vec::new();
+    for (k, patches) in &meshes {
+        out.patches += patches.len() as u64;
+        let m = &w.spec.meshes[*k];
+        let mut top = 0;
+        while top < height {
+            let rows = band.min(height - top);
+            raw.clear();
+            band_pieces(
+                &view,
+                patches,
+                m.two_sided,
+                top,
+                rows,
+                &params,
+                &mut raw,
+                &mut out.stats,
+            );
+            for p in &raw {
+                if let Some(t) = triangle(p, *k as u32, m, &camera, &lighting) {
+                    out.triangles.push(t);
+                    out.facing.push(p.facing);
+                    out.origin.push((*k as u32, p.patch, p.uv));
+                }
+            }
+            out.bands += 1;
+            top += rows;
+        }
+    }
+    Ok(out)
+}
+
+/// A piece as a screen triangle: normals turned toward the eye (two-sided meshes), or
+/// `None` for a back-facing piece of a one-sided mesh.
+fn triangle(
+    p: &band::Piece,
+    mesh: u32,
+    m: &cwisim_world::scene::MeshSpec,
+    camera: &Camera,
+    lighting: &Lighting,
+) -> Option<ScreenTriangle> {
+    let eye = camera.eye;
+    let geometric = (p.world[1] - p.world[0]).cross(p.world[2] - p.world[0]);
+    let fallback = geometric.try_normalize().unwrap_or(DVec3::Z);
+    let mut normals = p.normals.map(|n| n.unwrap_or(fallback));
+    if !m.two_sided {
+        // the patch's orientation decides: a triangle whose corners face away is culled
+        let away = normals
+            .iter()
+            .zip(&p.world)
+            .all(|(n, w)| n.dot(eye - *w) < 0.0);
+        if away {
+            return None;
+        }
+    } else {
+        for (n, w) in normals.iter_mut().zip(&p.world) {
+            if n.dot(eye - *w) < 0.0 {
+                *n = -*n;
+            }
+        }
+    }
+    let intensity =
+        std::array::from_fn(|c| lighting.intensity(&m.material, p.world[c], normals[c], eye));
+    Some(ScreenTriangle {
+        points: p.screen,
+        inv_depth: p.world.map(|q| 1.0 / camera.depth(q)),
+        intensity,
+        mesh,
+        face: p.patch,
+        surface: Surface {
+            world: p.world,
+            normals,
+        },
+    })
+}
+
+/// Nishita et al.'s renderer of a scene.
+pub struct Nishita {
+    inner: VanRij,
+    /// What the patches made (empty for a scene without patches).
+    stats: BandStats,
+    bands: u64,
+    patches: u64,
+    triangles: u64,
+    settings: Settings,
+    /// Host time of the visibility pass.
+    visibility_time: Duration,
+}
+
+impl Nishita {
+    /// The renderer of `loaded` under `settings`.
+    pub fn new(loaded: LoadedScene, settings: &Settings) -> Result<Nishita, RenderError> {
+        settings.check().map_err(RenderError::Usage)?;
+        let AnyScene::World(w) = &loaded.scene else {
+            // no patches: the polygons as vanrij draws them
+            let scene = PolygonScene::new(loaded, settings)?;
+            return Ok(Nishita {
+                inner: VanRij::from_polygons(scene, settings),
+                stats: BandStats::default(),
+                bands: 0,
+                patches: 0,
+                triangles: 0,
+                settings: *settings,
+                visibility_time: Duration::ZERO,
+            });
+        };
+        match settings.shading {
+            Shading::Gouraud | Shading::Phong => {}
+            other => {
+                return Err(RenderError::Usage(format!(
+                    "--renderer nishita shades its patches smoothly: --shading gouraud or phong (found {other})"
+                )))
+            }
+        }
+        let phong = settings.shading == Shading::Phong;
+        if phong && settings.visibility != Visibility::Exact {
+            return Err(RenderError::Usage(
+                "Phong shading is drawn on exact visible surfaces only: use --visibility exact"
+                    .into(),
+            ));
+        }
+        let w = w.clone();
+        let start = Instant::now();
+        let made = pieces(&w, settings)?;
+        let geometry_time = start.elapsed();
+        // meshes that are not patches: projected as vanrij projects them
+        let others: Vec<usize> = (0..w.spec.meshes.len())
+            .filter(|&k| w.spec.meshes[k].bezier.is_none())
+            .collect();
+        let mut tris = made.triangles;
+        let mut project = None;
+        if !others.is_empty() {
+            let mut sub = w.clone();
+            sub.spec.meshes = others.iter().map(|&k| w.spec.meshes[k].clone()).collect();
+            sub.meshes = others.iter().map(|&k| w.meshes[k].clone()).collect();
+            let (more, stats) = cwisim_world::project::project(&sub, settings.shading)?;
+            tris.extend(more.into_iter().map(|mut t| {
+                t.mesh = others[t.mesh as usize] as u32;
+                t
+            }));
+            project = Some(stats);
+        }
+        let start = Instant::now();
+        let channels = w.channels();
+        let (polygons, vis, surfaces) = if phong {
+            let (fragments, stats) = cwisim_world::visibility::exact_fragments(&tris, channels);
+            let sources = fragments.iter().map(|f| f.source).collect();
+            let polygons = fragments.into_iter().map(|f| f.polygon).collect();
+            (
+                polygons,
+                Some(stats),
+                Some(PhongSurfaces {
+                    triangles: tris.clone(),
+                    sources,
+                    shader: PhongShader::new(&w),
+                }),
+            )
+        } else {
+            let (p, s) = cwisim_world::resolve(&tris, channels, settings.visibility);
+            (p, s, None)
+        };
+        let visibility_time = start.elapsed();
+        let scene = PolygonScene {
+            source: loaded.source,
+            kind: "world",
+            screen: w.screen(polygons),
+            project,
+            visibility: vis,
+            visibility_mode: Some(settings.visibility),
+            load_time: loaded.load_time,
+            transform_time: geometry_time,
+            visibility_time,
+            phong: surfaces,
+            transparent_meshes: w
+                .spec
+                .meshes
+                .iter()
+                .filter(|m| m.material.transmittance > 0.0)
+                .count() as u64,
+        };
+        Ok(Nishita {
+            inner: VanRij::from_polygons(scene, settings),
+            stats: made.stats,
+            bands: made.bands,
+            patches: made.patches,
+            triangles: tris.len() as u64,
+            settings: *settings,
+            visibility_time,
+        })
+    }
+
+    /// For the registry.
+    pub fn build(
+        loaded: LoadedScene,
+        settings: &Settings,
+    ) -> Result<Box<dyn Renderer>, RenderError> {
+        Ok(Box::new(Nishita::new(loaded, settings)?))
+    }
+
+    /// What the patches made: subpatches, roots and iterations, pieces.
+    pub fn band_stats(&self) -> &BandStats {
+        &self.stats
+    }
+
+    /// The polygons it draws (the visible fragments of its pieces).
+    pub fn polygons(&self) -> &PolygonScene {
+        self.inner.polygons()
+    }
+
+    /// Its own counters (the frame's, besides the Y-processor's).
+    pub fn counters(&self) -> Counters {
+        let s = &self.stats;
+        let c = &s.clip;
+        let mut out = Counters::default()
+            .with("patches", self.patches)
+            .with("bands", self.bands)
+            .with("subpatches_front", s.front)
+            .with("subpatches_back", s.back)
+            .with("subpatches_twisted", s.twisted)
+            .with("subpatches_back_culled", s.back_culled)
+            .with("levels_capped", s.capped)
+            .with("edges", s.edges)
+            .with("curves", c.curves)
+            .with("curves_rejected", c.rejected)
+            .with("roots", c.roots)
+            .with("iterations", c.iterations)
+            .with("root_iterations", c.root_iterations)
+            .with("wasted_iterations", c.wasted)
+            .with("touching", c.touching)
+            .with("clip_splits", c.splits)
+            .with("straight_pieces", s.polygons)
+            .with("straight_pieces_split", s.split_polygons)
+            .with("silhouette_points", s.silhouette_points)
+            .with("silhouettes_unsplit", s.silhouettes_unsplit)
+            .with("piece_triangles", self.triangles);
+        for (name, n) in HISTOGRAM_NAMES.iter().zip(c.histogram) {
+            out.add(name, n);
+        }
+        out
+    }
+}
+
+struct Frame<'a> {
+    inner: Box<dyn FramePlan + 'a>,
+    own: Counters,
+}
+
+impl FramePlan for Frame<'_> {
+    fn counters(&self) -> Counters {
+        let mut c = self.own.clone();
+        c.merge(&self.inner.counters());
+        c
+    }
+
+    fn emit_rows(&self, rows: Range<u32>, sink: &mut dyn TraceWrite) -> io::Result<Counters> {
+        self.inner.emit_rows(rows, sink)
+    }
+}
+
+impl Renderer for Nishita {
+    fn name(&self) -> &'static str {
+        "nishita"
+    }
+
+    fn header(&self) -> TraceHeader {
+        self.inner.header()
+    }
+
+    fn frame<'a>(
+        &'a self,
+        index: u32,
+        previous: Option<&'a Image>,
+    ) -> Result<Box<dyn FramePlan + 'a>, RenderError> {
+        Ok(Box::new(Frame {
+            inner: self.inner.frame(index, previous)?,
+            own: self.counters(),
+        }))
+    }
+
+    fn settings_phrase(&self) -> String {
+        let s = &self.settings;
+        format!(
+            "{}; roots to {:e} of u/v, flatness {} px, bands of {} rows, {} sub-scanline(s) per row",
+            self.inner.settings_phrase(),
+            s.root_tolerance,
+            s.flatness,
+            s.band,
+            s.subscan
+        )
+    }
+
+    fn summary_rows(&self, counters: &Counters, stats: &RunStats) -> Vec<(&'static str, String)> {
+        let mut rows = Vec::new();
+        if self.patches > 0 {
+            let s = &self.stats;
+            let c = &s.clip;
+            rows.push((
+                "subpatches",
+                format!(
+                    "{} patches in {} bands: {} subpatches meeting their band ({} front, {} back, {} twisted; {} back culled), mean level {:.2}{}",
+                    self.patches,
+                    self.bands,
+                    s.front + s.back + s.twisted,
+                    s.front,
+                    s.back,
+                    s.twisted,
+                    s.back_culled,
+                    s.levels as f64 / self.bands.max(1) as f64,
+                    if s.capped > 0 {
+                        format!(", level capped at {} in {} band(s)", band::MAX_LEVEL, s.capped)
+                    } else {
+                        String::new()
+                    }
+                ),
+            ));
+            rows.push((
+                "roots",
+                format!(
+                    "{} roots of {} edge × row-line curves ({} with no sign change, {} tangencies); average iterations per root {} (tolerance {:e}); {} iterations, {} wasted on pieces without a root, {} splits at ½",
+                    c.roots,
+                    c.curves,
+                    c.rejected,
+                    c.touching,
+                    c.average().map_or("-".into(), |a| format!("{a:.3}")),
+                    self.settings.root_tolerance,
+                    c.iterations,
+                    c.wasted,
+                    c.splits
+                ),
+            ));
+            let hist: Vec<String> = c
+                .histogram
+                .iter()
+                .enumerate()
+                .filter(|(_, &n)| n > 0)
+                .map(|(i, n)| {
+                    if i == HISTOGRAM - 1 {
+                        format!("≥{i}: {n}")
+                    } else {
+                        format!("{i}: {n}")
+                    }
+                })
+                .collect();
+            rows.push(("iterations", format!("per root: {}", hist.join(", "))));
+            rows.push((
+                "pieces",
+                format!(
+                    "{} straight-sided pieces ({} crossing their strip more than twice), {} triangles; {} silhouette points on row lines ({} twisted pieces with a silhouette leaving through a subpatch edge, not cut)",
+                    s.polygons, s.split_polygons, self.triangles, s.silhouette_points, s.silhouettes_unsplit
+                ),
+            ));
+            let total =
+                s.subpatch_ns + s.roots_ns + s.pieces_ns + self.visibility_time.as_nanos() as u64;
+            let share = |ns: u64| 100.0 * ns as f64 / total.max(1) as f64;
+            rows.push((
+                "host time",
+                format!(
+                    "subpatches {:.0}%, roots {:.0}%, pieces {:.0}%, visibility {:.0}%",
+                    share(s.subpatch_ns),
+                    share(s.roots_ns),
+                    share(s.pieces_ns),
+                    share(self.visibility_time.as_nanos() as u64)
+                ),
+            ));
+        }
+        rows.extend(self.inner.summary_rows(counters, stats));
+        rows
+    }
+
+    fn stage_times(&self) -> Vec<(&'static str, Duration)> {
+        let s = &self.stats;
+        if self.patches == 0 {
+            return self.inner.stage_times();
+        }
+        vec![
+            ("subpatches", Duration::from_nanos(s.subpatch_ns)),
+            ("roots", Duration::from_nanos(s.roots_ns)),
+            ("pieces", Duration::from_nanos(s.pieces_ns)),
+            ("visibility", self.visibility_time),
+        ]
+    }
+
+    fn scene_json(&self) -> serde_json::Value {
+        let mut v = self.inner.scene_json();
+        if let Some(o) = v.as_object_mut() {
+            o.insert(
+                "nishita".into(),
+                serde_json::to_value(self.counters()).unwrap_or_default(),
+            );
+        }
+        v
+    }
+}
