@@ -14,4 +14,4 @@ fi
 echo "== installing Debian's chromium (apt-get) for the browser test"
 $sudo apt-get update -qq
 DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq chromium >/dev/null
-chromium --version
+chromium --version 2>/dev/null

@@ -63,18 +63,49 @@ fn npy_u32(path: &Path) -> Vec<u32> {
         .unwrap()
 }
 
-/// The page's history lines of processor `x` on scanline `line`.
+/// The page's history lines of processor `x` on scanline `line`, put together from its
+/// columns as the page's script does.
 fn page_history(data: &Value, x: u64, line: u64) -> Vec<String> {
     let h = &data["history"];
     let strings = texts(&h["strings"]);
-    let ids = u32s(&h["ids"]);
     let starts = u32s(&h["starts"]);
+    let shifted = u32s(&h["shifted"]);
+    let hidden = u32s(&h["hidden"]);
+    let index = f64s(&h["visit_index"]);
+    let cycle = f64s(&h["visit_cycle"]);
+    let note = blob(&h["visit_note"]);
+    let before = u32s(&h["visit_before"]);
+    let after = u32s(&h["visit_after"]);
+    let instrs = texts(&data["dump"]["text"]);
+    let i0 = data["dump"]["first_index"].as_u64().unwrap();
     let (x0, x1) = (h["x"][0].as_u64().unwrap(), h["x"][1].as_u64().unwrap());
     let l0 = h["lines"][0].as_u64().unwrap();
     let k = ((line - l0) * (x1 - x0) + (x - x0)) as usize;
-    (starts[k]..starts[k + 1])
-        .map(|i| strings[ids[i as usize] as usize].clone())
-        .collect()
+    let mut out = Vec::new();
+    for v in starts[k] as usize..starts[k + 1] as usize {
+        let how = match note[v] {
+            0 => String::new(),
+            n => format!("  ({})", h["notes"][n as usize - 1].as_str().unwrap()),
+        };
+        out.push(format!(
+            "cycle {:>8}  #{:<6} {}{how}",
+            cycle[v],
+            index[v],
+            instrs[index[v] as usize - i0 as usize]
+        ));
+        out.push(format!("    before  {}", strings[before[v] as usize]));
+        out.push(format!("    after   {}", strings[after[v] as usize]));
+    }
+    if shifted[k] != u32::MAX {
+        out.push(format!("shifted out: {}", strings[shifted[k] as usize]));
+    }
+    if hidden[k] > 0 {
+        out.push(format!(
+            "# {} more instruction(s) passed through without acting (--all lists them)",
+            hidden[k]
+        ));
+    }
+    out
 }
 
 /// `cwisim history`'s lines without its heading.
@@ -119,7 +150,21 @@ fn a_trace_page_holds_what_run_history_and_dump_print() {
     assert!(page_history(&data, 9, 0).contains(&"shifted out: 0.125".to_string()));
 
     // every scanline's disassembly, as `cwisim dump --lines N` prints it
-    let dump = texts(&data["dump"]["text"]);
+    let instrs = texts(&data["dump"]["text"]);
+    let issue = f64s(&data["dump"]["issue"]);
+    let enter = f64s(&data["dump"]["enter"]);
+    let i0 = data["dump"]["first_index"].as_u64().unwrap() as usize;
+    let dump: Vec<String> = (0..instrs.len())
+        .map(|k| {
+            format!(
+                "{:<48} # #{} line {{}} issue {} enter {}",
+                instrs[k],
+                i0 + k,
+                issue[k],
+                enter[k]
+            )
+        })
+        .collect();
     let starts: Vec<usize> = data["dump"]["line_start"]
         .as_array()
         .unwrap()
@@ -134,11 +179,11 @@ fn a_trace_page_holds_what_run_history_and_dump_print() {
             .lines()
             .filter(|l| !l.starts_with('#') && !l.starts_with("cwisim-trace"))
             .collect();
-        assert_eq!(
-            &dump[starts[line]..starts[line + 1]],
-            &cli[..],
-            "line {line}"
-        );
+        let page: Vec<String> = dump[starts[line]..starts[line + 1]]
+            .iter()
+            .map(|l| l.replace("{}", &ls))
+            .collect();
+        assert_eq!(page, cli, "line {line}");
     }
 }
 
@@ -241,6 +286,7 @@ fn a_window_holds_only_its_histories() {
     );
     let data = page(&dir, "w.html");
     assert_eq!(u32s(&data["history"]["starts"]).len(), 10 * 5 + 1);
+    assert_eq!(u32s(&data["history"]["hidden"]).len(), 10 * 5);
     let cli = cli_history(
         &dir,
         &[

@@ -15,7 +15,7 @@
 
 use crate::cost::{viridis, CostMap, CostReader};
 use crate::error::StudyError;
-use crate::history::{hidden_line, shifted_out_line, visit_lines, Visit};
+use crate::history::{state, values, Visit};
 use crate::plot::{group_cycles, issue_costs, GROUPS, OVERRUN};
 use crate::until::UntilLine;
 use cwisim_isa::text::format_instruction;
@@ -146,11 +146,30 @@ impl Strings {
     }
 }
 
+/// The visits `cwisim history` lists, as columns: the instruction's number and the
+/// cycle its token arrived, what it amounted to ([`NOTES`]), the states before and after
+/// (numbers of strings).
+#[derive(Default)]
+struct Visits {
+    index: Vec<f64>,
+    cycle: Vec<f64>,
+    note: Vec<u8>,
+    before: Vec<u32>,
+    after: Vec<u32>,
+}
+
+/// What a visit amounted to, numbered on the page (0: a plain action).
+pub const NOTES: [&str; 3] = [
+    "passes through",
+    "suppressed: locked by Eval0",
+    "suppressed: masked by Dis",
+];
+
 #[derive(Default, Clone)]
 struct Pixel {
-    lines: Vec<u32>,
-    hidden: usize,
-    shifted: Option<Vec<f64>>,
+    visits: Vec<u32>,
+    hidden: u32,
+    shifted: Option<u32>,
 }
 
 /// The probe: every instruction of the frame with its cycles, and every visit to a pixel
@@ -159,9 +178,13 @@ struct Collector {
     frame: (u64, u64),
     window: Window,
     pending: VecDeque<(u64, u64, u64, Instruction)>,
-    dump: Vec<String>,
+    first_index: Option<u64>,
+    texts: Vec<String>,
+    issue: Vec<f64>,
+    enter: Vec<f64>,
     dump_lines: Vec<u64>,
     pixels: Vec<Pixel>,
+    visits: Visits,
     strings: Strings,
 }
 
@@ -179,7 +202,10 @@ impl Probe for Collector {
             return;
         };
         if (self.frame.0..self.frame.1).contains(&line) {
-            self.dump.push(dump_line(index, line, issue, cycle, &instr));
+            self.first_index.get_or_insert(index);
+            self.texts.push(format_instruction(&instr));
+            self.issue.push(issue as f64);
+            self.enter.push(cycle as f64);
             self.dump_lines.push(line);
         }
     }
@@ -202,7 +228,7 @@ impl Probe for Collector {
         let w = self.window.x.1 - self.window.x.0;
         let k = ((line - self.window.lines.0) * w + (x - self.window.x.0)) as usize;
         if instr.op == Opcode::Refresh {
-            self.pixels[k].shifted = Some(before.acc.clone());
+            self.pixels[k].shifted = Some(self.strings.id(values(&before.acc)));
         }
         if addressed || before != after {
             let v = Visit {
@@ -213,10 +239,18 @@ impl Probe for Collector {
                 before: before.clone(),
                 after: after.clone(),
             };
-            for s in visit_lines(&v) {
-                let id = self.strings.id(s);
-                self.pixels[k].lines.push(id);
-            }
+            let note = v.note().map_or(0, |n| {
+                1 + NOTES.iter().position(|&m| m == n).expect("a known note") as u8
+            });
+            let at = self.visits.index.len() as u32;
+            self.visits.index.push(index as f64);
+            self.visits.cycle.push(cycle as f64);
+            self.visits.note.push(note);
+            let b = self.strings.id(state(before));
+            let a = self.strings.id(state(after));
+            self.visits.before.push(b);
+            self.visits.after.push(a);
+            self.pixels[k].visits.push(at);
         } else {
             self.pixels[k].hidden += 1;
         }
@@ -413,8 +447,12 @@ choose a smaller one with --x and --lines",
         frame,
         window,
         pending: VecDeque::new(),
-        dump: Vec::new(),
+        first_index: None,
+        texts: Vec::new(),
+        issue: Vec::new(),
+        enter: Vec::new(),
         dump_lines: Vec::new(),
+        visits: Visits::default(),
         pixels: vec![Pixel::default(); window.pixels() as usize],
         strings: Strings::default(),
     };
@@ -471,21 +509,23 @@ choose a smaller one with --x and --lines",
         line_start[k + 1] += line_start[k];
     }
 
-    // the histories: every pixel's lines as string numbers
+    // the histories: per pixel its visits (consecutive), the value shifted out and how
+    // many visits it left out
     let mut starts = Vec::with_capacity(collector.pixels.len() + 1);
-    let mut ids = Vec::new();
+    let mut order: Vec<u32> = Vec::with_capacity(collector.visits.index.len());
+    let mut shifted = Vec::with_capacity(collector.pixels.len());
+    let mut hidden = Vec::with_capacity(collector.pixels.len());
     starts.push(0u32);
-    let pixels = std::mem::take(&mut collector.pixels);
-    for p in pixels {
-        ids.extend(&p.lines);
-        if let Some(acc) = &p.shifted {
-            ids.push(collector.strings.id(shifted_out_line(acc)));
-        }
-        if p.hidden > 0 {
-            ids.push(collector.strings.id(hidden_line(p.hidden)));
-        }
-        starts.push(ids.len() as u32);
+    for p in &collector.pixels {
+        order.extend(&p.visits);
+        starts.push(order.len() as u32);
+        shifted.push(p.shifted.unwrap_or(u32::MAX));
+        hidden.push(p.hidden);
     }
+    let v = &collector.visits;
+    let pick_f = |c: &[f64]| order.iter().map(|&k| c[k as usize]).collect::<Vec<_>>();
+    let pick_u = |c: &[u32]| order.iter().map(|&k| c[k as usize]).collect::<Vec<_>>();
+    let notes: Vec<u8> = order.iter().map(|&k| v.note[k as usize]).collect();
 
     let lut: Vec<String> = (0..256)
         .map(|k| {
@@ -523,15 +563,25 @@ choose a smaller one with --x and --lines",
             "slack": col(&|l| l.slack as f64),
         },
         "dump": {
-            "text": text_blob(&collector.dump),
+            "first_index": collector.first_index.unwrap_or(0),
+            "text": text_blob(&collector.texts),
+            "issue": f64_blob(&collector.issue),
+            "enter": f64_blob(&collector.enter),
             "line_start": line_start,
         },
         "history": {
             "x": [window.x.0, window.x.1],
             "lines": [window.lines.0, window.lines.1],
             "strings": text_blob(&collector.strings.list),
-            "ids": u32_blob(&ids),
             "starts": u32_blob(&starts),
+            "shifted": u32_blob(&shifted),
+            "hidden": u32_blob(&hidden),
+            "notes": NOTES,
+            "visit_index": f64_blob(&pick_f(&v.index)),
+            "visit_cycle": f64_blob(&pick_f(&v.cycle)),
+            "visit_note": blob(&notes),
+            "visit_before": u32_blob(&pick_u(&v.before)),
+            "visit_after": u32_blob(&pick_u(&v.after)),
         },
     });
     // no `</script>` inside the script element: every `<` as its JSON escape
