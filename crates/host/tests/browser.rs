@@ -98,7 +98,9 @@ fn the_page_shows_a_clicked_pixels_history_in_chromium() {
     let page = dir.join("pot.html").canonicalize().unwrap();
     let url = format!("file://{}#click=80,60", page.display());
 
-    let (dom, log) = run_chromium(&bin, &dir, &url, &["--dump-dom"]);
+    // with every overlay drawn too
+    let with_overlays = format!("{url}&overlay=cost,error,late");
+    let (dom, log) = run_chromium(&bin, &dir, &with_overlays, &["--dump-dom"]);
     assert!(
         dom.contains("data-ready=\"1\""),
         "the page never got ready:\n{log}"
@@ -110,6 +112,11 @@ fn the_page_shows_a_clicked_pixels_history_in_chromium() {
     );
     let console: Vec<&str> = log.lines().filter(|l| l.contains(":CONSOLE")).collect();
     assert!(console.is_empty(), "console messages: {console:#?}");
+    // (the page does report what goes wrong: an address it cannot follow)
+    let bad = format!("file://{}#overlay=bogus", page.display());
+    let (bad_dom, _) = run_chromium(&bin, &dir, &bad, &["--dump-dom"]);
+    assert!(bad_dom.contains("data-errors=\"1\""), "no error shown");
+    assert!(pre(&bad_dom, "errors").contains("no overlay bogus"));
 
     let history = cwisim_ok(
         &dir,
