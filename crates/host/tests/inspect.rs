@@ -345,3 +345,36 @@ fn bad_requests_are_refused_with_exit_2() {
     }
     assert!(!dir.join("x.html").exists());
 }
+
+#[test]
+fn a_later_frame_of_a_trace_and_nothing_from_the_network() {
+    let dir = scratch("inspect_frames");
+    std::fs::write(
+        dir.join("two.cwt"),
+        "cwisim-trace version=1 width=8 lines=2 channels=1\n\
+Eval2 2 4 0.5 0.125\nRefresh\nEval1 0 8 1.0\nRefresh\n\
+Eval1 3 2 0.25\nRefresh\nEval1 1 1 0.75\nRefresh\n",
+    )
+    .unwrap();
+    let said = cwisim_ok(
+        &dir,
+        &["inspect", "two.cwt", "--frames", "1", "-o", "f.html"],
+    );
+    assert!(said.contains("frame 1"), "{said}");
+    let html = std::fs::read_to_string(dir.join("f.html")).unwrap();
+    // self-contained: no address of anything to fetch
+    for fetch in ["http:", "https:", "src=", "href=", "@import", "url("] {
+        assert!(!html.contains(fetch), "the page fetches `{fetch}`");
+    }
+    let data = page(&dir, "f.html");
+    assert_eq!(data["first_line"], 2);
+    assert_eq!(
+        f64s(&data["image"])[8..16],
+        [0.0, 0.75, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+    );
+    for (x, line) in [(1u64, 3u64), (3, 2), (0, 2)] {
+        let (xs, ls) = (x.to_string(), line.to_string());
+        let cli = cli_history(&dir, &["history", "two.cwt", "--x", &xs, "--line", &ls]);
+        assert_eq!(page_history(&data, x, line), cli, "x {x} line {line}");
+    }
+}
