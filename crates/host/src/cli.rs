@@ -8,7 +8,8 @@ use crate::commands::machine::MachineCmdArgs;
 use crate::commands::run::RunArgs;
 use crate::commands::scene::{EmitArgs, RenderArgs};
 use crate::commands::{
-    convert, diff, dump, fit, history, machine, renderers, run, scene, scenes, stats, tradeoff, vcd,
+    convert, diff, dump, fit, history, inspect, machine, renderers, run, scene, scenes, stats,
+    tradeoff, vcd,
 };
 use crate::error::CliError;
 use clap::{Parser, Subcommand};
@@ -195,6 +196,23 @@ Example:\n  cwisim history traces/visibility.cwt --x 9 --y 0",
     )]
     History(history::HistoryArgs),
 
+    /// One frame as one self-contained HTML page to explore in a browser
+    #[command(
+        long_about = "Write one self-contained HTML page (no network: it opens from disk) for one \
+frame: the image, zoomable to single pixels, every channel's value on hover, with overlays of the \
+cost image, the error against the exact reference (scenes) and the late scanlines; the scanline \
+timeline (bus cycles by opcode against the line period, as `cwisim stats`) where a click shows \
+the scanline's disassembly (as `cwisim dump`); and a click on a pixel shows its history (as \
+`cwisim history`). Everything is computed by the cycle-stepped model. A frame over 512×512 \
+pixels holds histories for a window only (--x, --lines; the middle 256×256 by default); \
+frames over 2048×2048 are refused.\n\n\
+The page reads its address: `frame.html#pixel=150,200` selects processor 150 on scanline 200, \
+`#click=150,200` clicks it on the image, `#line=200` selects a scanline.\n\n\
+Example:\n  cwisim inspect pot -o pot.html",
+        after_help = AFTER_HELP
+    )]
+    Inspect(inspect::InspectArgs),
+
     /// A per-cycle waveform (VCD) of one scanline's processors and instruction bus
     #[command(
         long_about = "Write a Value Change Dump of one scanline: the chosen processors' registers and \
@@ -330,6 +348,7 @@ fn dispatch(
         Command::Emit(args) => scene::run_emit(args).map(|()| 0),
         Command::Stats(args) => stats::run(args, stdout, stderr).map(|()| 0),
         Command::History(args) => history::run(args, stdout).map(|()| 0),
+        Command::Inspect(args) => inspect::run(args, stdout).map(|()| 0),
         Command::Vcd(args) => vcd::run(args).map(|()| 0),
         // equal: 0, different: 1
         Command::Diff(args) => diff::run(args, stdout).map(|equal| u8::from(!equal)),

@@ -75,6 +75,59 @@ impl Visit {
     }
 }
 
+/// The lines `cwisim history` prints for one visit: the instruction with the cycle its
+/// token arrived (and [`Visit::note`]), then the registers before and after.
+pub fn visit_lines(v: &Visit) -> [String; 3] {
+    let how = v.note().map_or_else(String::new, |n| format!("  ({n})"));
+    [
+        format!(
+            "cycle {:>8}  #{:<6} {}{how}",
+            v.cycle,
+            v.index,
+            cwisim_isa::text::format_instruction(&v.instr)
+        ),
+        format!("    before  {}", state(&v.before)),
+        format!("    after   {}", state(&v.after)),
+    ]
+}
+
+/// Whether `cwisim history` lists a visit (with `all`, every one; else those that
+/// address the processor or change it).
+pub fn shown(v: &Visit, all: bool) -> bool {
+    all || v.addressed || v.changed()
+}
+
+/// The line after the visits: the value the scanline's `Refresh` shifted out (its
+/// accumulator just before).
+pub fn shifted_out_line(acc: &[f64]) -> String {
+    format!("shifted out: {}", values(acc))
+}
+
+/// The last line when visits were left out.
+pub fn hidden_line(hidden: usize) -> String {
+    format!("# {hidden} more instruction(s) passed through without acting (--all lists them)")
+}
+
+/// Everything `cwisim history` prints after its heading: each shown visit's lines, the
+/// value shifted out, and how many visits were left out. The `inspect` page holds the same
+/// lines for every pixel of its window.
+pub fn history_lines(visits: &[Visit], all: bool) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut shown_count = 0;
+    for v in visits.iter().filter(|v| shown(v, all)) {
+        shown_count += 1;
+        out.extend(visit_lines(v));
+    }
+    if let Some(r) = visits.iter().rev().find(|v| v.instr.op == Opcode::Refresh) {
+        out.push(shifted_out_line(&r.before.acc));
+    }
+    let hidden = visits.len() - shown_count;
+    if hidden > 0 {
+        out.push(hidden_line(hidden));
+    }
+    out
+}
+
 struct Watch {
     x: usize,
     y: u64,

@@ -14,6 +14,8 @@
 //!   registers before and after; [`vcd`] — a scanline's per-cycle waveform as a Value
 //!   Change Dump; both from the cycle-stepped engine's probe. [`until`] ends a trace
 //!   after a given scanline.
+//! * [`inspect`] — one frame as one self-contained HTML page: the image with overlays, the
+//!   scanline timeline and disassembly, every pixel history of a window.
 //! * [`error`] — [`StudyError`].
 
 #![warn(missing_docs)]
@@ -22,6 +24,7 @@ pub mod cost;
 pub mod error;
 pub mod fit;
 pub mod history;
+pub mod inspect;
 pub mod plot;
 pub mod tradeoff;
 pub mod tradeoff_plot;

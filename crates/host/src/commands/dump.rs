@@ -8,8 +8,9 @@ use super::MachineArgs;
 use crate::error::CliError;
 use crate::range::{parse_range, Range};
 use clap::Args;
-use cwisim_isa::text::{format_header, format_instruction};
+use cwisim_isa::text::format_header;
 use cwisim_isa::Instruction;
+use cwisim_study::inspect::dump_line;
 use cwisim_study::until::UntilLine;
 use cwisim_xproc::{replay_probed, NullSink, Probe};
 use std::collections::VecDeque;
@@ -66,11 +67,7 @@ impl Probe for Printer<'_> {
                 writeln!(self.out, "# --- scanline {line}")?;
                 self.current_line = Some(line);
             }
-            writeln!(
-                self.out,
-                "{:<48} # #{index} line {line} issue {begin} enter {cycle}",
-                format_instruction(&instr)
-            )
+            writeln!(self.out, "{}", dump_line(index, line, begin, cycle, &instr))
         };
         if let Err(e) = write() {
             self.error = Some(e);

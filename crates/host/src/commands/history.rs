@@ -8,9 +8,7 @@
 use super::MachineArgs;
 use crate::error::CliError;
 use clap::Args;
-use cwisim_isa::text::format_instruction;
-use cwisim_isa::Opcode;
-use cwisim_study::history::{pixel_history, state, values};
+use cwisim_study::history::{history_lines, pixel_history};
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -73,37 +71,8 @@ arrived, and the registers before → after it acted",
             args.trace.display()
         ),
     )?;
-    let mut shown = 0;
-    for v in &visits {
-        if !(args.all || v.addressed || v.changed()) {
-            continue;
-        }
-        shown += 1;
-        let how = v.note().map_or_else(String::new, |n| format!("  ({n})"));
-        w(
-            stdout,
-            format!(
-                "cycle {:>8}  #{:<6} {}{how}",
-                v.cycle,
-                v.index,
-                format_instruction(&v.instr)
-            ),
-        )?;
-        w(stdout, format!("    before  {}", state(&v.before)))?;
-        w(stdout, format!("    after   {}", state(&v.after)))?;
-    }
-    let refresh = visits.iter().rev().find(|v| v.instr.op == Opcode::Refresh);
-    if let Some(r) = refresh {
-        w(stdout, format!("shifted out: {}", values(&r.before.acc)))?;
-    }
-    let hidden = visits.len() - shown;
-    if hidden > 0 {
-        w(
-            stdout,
-            format!(
-                "# {hidden} more instruction(s) passed through without acting (--all lists them)"
-            ),
-        )?;
+    for line in history_lines(&visits, args.all) {
+        w(stdout, line)?;
     }
     Ok(())
 }

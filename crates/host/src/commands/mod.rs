@@ -5,6 +5,7 @@ pub mod diff;
 pub mod dump;
 pub mod fit;
 pub mod history;
+pub mod inspect;
 pub mod machine;
 pub mod renderers;
 pub mod run;
