@@ -66,6 +66,13 @@ pub const REGISTRY: &[Entry] = &[
         supersampled: false,
         patches: true,
     },
+    Entry {
+        name: "refine",
+        about: crate::refine::ABOUT,
+        build: crate::refine::Refine::build,
+        supersampled: false,
+        patches: false,
+    },
 ];
 
 /// The registered names, in order.
