@@ -131,6 +131,12 @@ pub fn aa_flags(image: &Image, lines: usize, threshold: Threshold) -> Vec<bool> 
     flags
 }
 
+/// A pixel's values as bits: runs are of bit-identical values, so that a claim re-sends
+/// exactly what the array output (`-0.0` is not `+0.0`).
+fn same_bits(a: &[f64], b: &[f64]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
+}
+
 /// Adaptive refinement on a scene's polygons.
 #[derive(Clone, Debug)]
 pub struct Refine {
@@ -288,8 +294,11 @@ impl FramePlan for Antialiased<'_> {
                     x += 1;
                     continue;
                 }
+                // a run of equal values (bit for bit: a NaN, which equals nothing, is a
+                // run of one)
                 let start = x;
-                while x < w && !flags[x] && value(x) == value(start) {
+                x += 1;
+                while x < w && !flags[x] && same_bits(value(x), value(start)) {
                     x += 1;
                 }
                 sink.write(&Instruction::eval0(
