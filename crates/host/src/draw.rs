@@ -1,14 +1,16 @@
 //! How a scene is drawn, as the command line says it: `--renderer`, `--shading`, `--aa`,
 //! `--visibility`, `--eval0-tolerance`, `--size`, the supersampling renderers' `--samples`,
 //! `--grid`, `--merge-subscanlines`, `--shade-p`, `--shade-contrast`, `--seed`, and Barkan &
-//! Gordon's `--cp-increment`, `--sbuffer`, `--order`, `--unset` — one flattened group shared by
+//! Gordon's `--cp-increment`, `--sbuffer`, `--order`, `--unset`, and refinement's thresholds — one flattened group shared by
 //! `render`, `emit`, `stats` and `fit`, converted into `cwisim-render`'s plain
 //! [`Settings`].
 
 use crate::error::CliError;
 use clap::{Args, ValueEnum};
 use cwisim_render::cp::Increment;
-use cwisim_render::settings::{BspOrder, SbufferMode, Unset};
+use cwisim_render::settings::{
+    BspOrder, SbufferMode, Threshold, Unset, DEFAULT_AA_THRESHOLD, DEFAULT_GOURAUD_THRESHOLD,
+};
 use cwisim_render::subsample::Grid;
 use cwisim_render::{registry, LoadedScene, Renderer, Settings, Size, Source};
 use cwisim_scene::{Antialias, Shading};
@@ -310,6 +312,24 @@ pub struct DrawArgs {
         help_heading = "Bézier patches (nishita)"
     )]
     pub subscan: u32,
+    /// Refinement's phase 2 Gouraud-shades a polygon whose vertex-intensity range (the
+    /// largest over channels) exceeds T; `all` or `none`.
+    #[arg(
+        long,
+        value_name = "T",
+        default_value_t = Threshold::Above(DEFAULT_GOURAUD_THRESHOLD),
+        help_heading = "Adaptive refinement (refine)"
+    )]
+    pub gouraud_threshold: Threshold,
+    /// Refinement's anti-aliasing phase box-filters a pixel whose 3x3 neighbourhood range
+    /// in the previous frame exceeds T; `all` or `none`.
+    #[arg(
+        long,
+        value_name = "T",
+        default_value_t = Threshold::Above(DEFAULT_AA_THRESHOLD),
+        help_heading = "Adaptive refinement (refine)"
+    )]
+    pub aa_threshold: Threshold,
 }
 
 impl Default for DrawArgs {
@@ -337,6 +357,8 @@ impl Default for DrawArgs {
             flatness: 0.5,
             band: 4,
             subscan: 1,
+            gouraud_threshold: Threshold::Above(DEFAULT_GOURAUD_THRESHOLD),
+            aa_threshold: Threshold::Above(DEFAULT_AA_THRESHOLD),
         }
     }
 }
@@ -378,6 +400,8 @@ impl DrawArgs {
             flatness: self.flatness,
             band: self.band,
             subscan: self.subscan,
+            gouraud_threshold: self.gouraud_threshold,
+            aa_threshold: self.aa_threshold,
         }
     }
 

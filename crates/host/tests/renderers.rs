@@ -92,7 +92,7 @@ fn an_unknown_renderer_is_one_line_naming_the_known_ones() {
         assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
         assert_eq!(
             stderr,
-            "error: unknown renderer `nishitaa`; known: vanrij, woo-chall, sbuffer, bsp, nishita\n",
+            "error: unknown renderer `nishitaa`; known: vanrij, woo-chall, sbuffer, bsp, nishita, refine\n",
             "{args:?}"
         );
         assert!(stdout.is_empty(), "{args:?}: {stdout}");
@@ -182,4 +182,72 @@ fn nishita_draws_the_teapot_with_its_summary_and_refuses_bad_settings() {
         assert_eq!(stderr.lines().count(), 1, "{stderr}");
     }
     assert!(!dir.join("x.png").exists());
+}
+
+#[test]
+fn refine_prints_its_phases_and_refuses_bad_thresholds() {
+    let dir = scratch("renderers-refine");
+    let out = cwisim_ok(
+        &dir,
+        &[
+            "render",
+            "pot",
+            "--renderer",
+            "refine",
+            "--size",
+            "64x64",
+            "--gouraud-threshold",
+            "0.05",
+            "--aa-threshold",
+            "all",
+            "-o",
+            "r.png",
+        ],
+    );
+    for row in [
+        "phase 1      flat:",
+        "phase 2      Gouraud:",
+        "phase 3      anti-aliasing: 4096 of 4096 pixels box-filtered (100.0%), 0 Eval0 claims",
+    ] {
+        assert!(out.contains(row), "no `{row}`: {out}");
+    }
+    assert!(dir.join("r.png").exists());
+    for (flag, value, says) in [
+        (
+            "--gouraud-threshold",
+            "lots",
+            "expected `all`, `none` or a finite number",
+        ),
+        (
+            "--aa-threshold",
+            "inf",
+            "expected `all`, `none` or a finite number",
+        ),
+        ("--shading", "phong", "--shading phong does not apply"),
+    ] {
+        let out = cwisim(
+            &dir,
+            &[
+                "render",
+                "pot",
+                "--renderer",
+                "refine",
+                flag,
+                value,
+                "-o",
+                "x.png",
+            ],
+        );
+        let (_, stderr) = text(&out);
+        assert_eq!(out.status.code(), Some(2), "{flag} {value}: {stderr}");
+        assert!(stderr.contains(says), "{flag} {value}: {stderr}");
+    }
+    assert!(!dir.join("x.png").exists());
+    let out = cwisim(&dir, &["tradeoff", "fig25", "--renderers", "vanrij,refine"]);
+    let (_, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("tradeoff measures one-frame renderers"),
+        "{stderr}"
+    );
 }

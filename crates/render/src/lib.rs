@@ -55,6 +55,7 @@ pub mod nishita;
 pub mod phong;
 pub mod pipeline;
 pub mod prepare;
+pub mod refine;
 pub mod registry;
 pub mod renderer;
 pub mod sbuffer;

@@ -24,6 +24,9 @@ pub struct Entry {
     /// It draws a world scene's Bézier patches directly (`--tessellate` does not apply
     /// to them): `tradeoff`'s axis for it is the root tolerance.
     pub patches: bool,
+    /// It draws several frames, each refining the previous one's output (`refine`):
+    /// `tradeoff`, which measures one frame against the exact image, leaves it out.
+    pub progressive: bool,
 }
 
 /// The renderer used when none is named.
@@ -37,6 +40,7 @@ pub const REGISTRY: &[Entry] = &[
         build: crate::vanrij::VanRij::build,
         supersampled: false,
         patches: false,
+        progressive: false,
     },
     Entry {
         name: "woo-chall",
@@ -44,6 +48,7 @@ pub const REGISTRY: &[Entry] = &[
         build: crate::woochall::WooChall::build,
         supersampled: true,
         patches: false,
+        progressive: false,
     },
     Entry {
         name: "sbuffer",
@@ -51,6 +56,7 @@ pub const REGISTRY: &[Entry] = &[
         build: crate::sbuffer::SBuffer::build,
         supersampled: true,
         patches: false,
+        progressive: false,
     },
     Entry {
         name: "bsp",
@@ -58,6 +64,7 @@ pub const REGISTRY: &[Entry] = &[
         build: crate::bsp::Bsp::build,
         supersampled: true,
         patches: false,
+        progressive: false,
     },
     Entry {
         name: "nishita",
@@ -65,6 +72,15 @@ pub const REGISTRY: &[Entry] = &[
         build: crate::nishita::Nishita::build,
         supersampled: false,
         patches: true,
+        progressive: false,
+    },
+    Entry {
+        name: "refine",
+        about: crate::refine::ABOUT,
+        build: crate::refine::Refine::build,
+        supersampled: false,
+        patches: false,
+        progressive: true,
     },
 ];
 

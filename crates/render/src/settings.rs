@@ -93,6 +93,62 @@ pub struct Settings {
     pub band: u32,
     /// Nishita: sub-scanlines per pixel row: roots at every `1/subscan` of a row.
     pub subscan: u32,
+    /// Adaptive refinement: a polygon is Gouraud-shaded when its vertex-intensity range
+    /// passes this.
+    pub gouraud_threshold: Threshold,
+    /// Adaptive refinement: a pixel is box-filtered when the range of its 3 × 3
+    /// neighbourhood in the previous frame passes this.
+    pub aa_threshold: Threshold,
+}
+
+/// A refinement threshold: `all` (everything passes), `none` (nothing does), or a
+/// number `T ≥ 0` (a measure passes when it exceeds `T`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Threshold {
+    /// Everything passes.
+    All,
+    /// Nothing passes.
+    None,
+    /// A measure passes when it is greater than this (finite, ≥ 0).
+    Above(f64),
+}
+
+impl Threshold {
+    /// Whether `measure` passes.
+    pub fn passes(self, measure: f64) -> bool {
+        match self {
+            Threshold::All => true,
+            Threshold::None => false,
+            Threshold::Above(t) => measure > t,
+        }
+    }
+}
+
+impl FromStr for Threshold {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.trim() {
+            t if t.eq_ignore_ascii_case("all") => Ok(Threshold::All),
+            t if t.eq_ignore_ascii_case("none") => Ok(Threshold::None),
+            t => match t.parse::<f64>() {
+                Ok(v) if v >= 0.0 && v.is_finite() => Ok(Threshold::Above(v)),
+                _ => Err(format!(
+                    "expected `all`, `none` or a finite number ≥ 0; found `{s}`"
+                )),
+            },
+        }
+    }
+}
+
+impl fmt::Display for Threshold {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Threshold::All => f.write_str("all"),
+            Threshold::None => f.write_str("none"),
+            Threshold::Above(t) => write!(f, "{t}"),
+        }
+    }
 }
 
 /// `--sbuffer`: what the S-buffer sends the array.
@@ -191,9 +247,16 @@ impl Default for Settings {
             flatness: 0.5,
             band: 4,
             subscan: 1,
+            gouraud_threshold: Threshold::Above(DEFAULT_GOURAUD_THRESHOLD),
+            aa_threshold: Threshold::Above(DEFAULT_AA_THRESHOLD),
         }
     }
 }
+
+/// `--gouraud-threshold`'s default: a vertex-intensity range of 1/32.
+pub const DEFAULT_GOURAUD_THRESHOLD: f64 = 1.0 / 32.0;
+/// `--aa-threshold`'s default: a 3 × 3 range of 1/16.
+pub const DEFAULT_AA_THRESHOLD: f64 = 1.0 / 16.0;
 
 /// The widest root tolerance: the whole parameter interval.
 pub const MAX_ROOT_TOLERANCE: f64 = 1.0;
@@ -296,6 +359,29 @@ mod tests {
             "sideways".parse::<BspOrder>().unwrap_err(),
             "unknown BSP order `sideways`; expected back-to-front or front-to-back"
         );
+    }
+
+    #[test]
+    fn thresholds_parse_print_and_refuse() {
+        for (text, t) in [
+            ("all", Threshold::All),
+            ("NONE", Threshold::None),
+            ("0.25", Threshold::Above(0.25)),
+            ("0", Threshold::Above(0.0)),
+        ] {
+            assert_eq!(text.parse::<Threshold>(), Ok(t));
+            assert_eq!(t.to_string().parse::<Threshold>(), Ok(t));
+        }
+        for bad in ["-1", "nan", "inf", "lots", ""] {
+            assert!(bad
+                .parse::<Threshold>()
+                .unwrap_err()
+                .contains("`all`, `none`"));
+        }
+        assert!(Threshold::All.passes(0.0));
+        assert!(!Threshold::None.passes(1e300));
+        assert!(Threshold::Above(0.5).passes(0.6));
+        assert!(!Threshold::Above(0.5).passes(0.5));
     }
 
     #[test]

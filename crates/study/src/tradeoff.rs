@@ -385,12 +385,24 @@ pub fn tradeoff_rows(
     repeat: u32,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<Vec<Row>, StudyError> {
+    // a progressive renderer's frames refine one another: one frame against the exact
+    // image says nothing of it (its phases are measured by its own summary)
     let entries: Vec<&'static registry::Entry> = if renderers.is_empty() {
-        registry::REGISTRY.iter().collect()
+        registry::REGISTRY
+            .iter()
+            .filter(|e| !e.progressive)
+            .collect()
     } else {
         renderers
             .iter()
-            .map(|n| registry::find(n))
+            .map(|n| {
+                registry::find(n).and_then(|e| match e.progressive {
+                    false => Ok(e),
+                    true => Err(cwisim_render::RenderError::Usage(format!(
+                        "`{n}` draws several frames, each refining the previous one: tradeoff measures one-frame renderers against the exact image; `cwisim render --renderer {n}` prints its phases"
+                    ))),
+                })
+            })
             .collect::<Result<_, _>>()?
     };
     let probe = Source::resolve(scene)?.load(size)?.scene;
