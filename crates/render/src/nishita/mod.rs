@@ -46,7 +46,7 @@ use std::ops::Range;
 use std::time::{Duration, Instant};
 
 /// The registry's one line about it.
-pub const ABOUT: &str = "Nishita, Kaneda & Nakamae: Bézier patches scan-converted directly — subpatches per band (--band, --flatness), Bézier clipping of their edges at every row line (--tolerance, --subscan), straight-sided pieces box-filtered exactly, exact visibility, Gouraud or Phong";
+pub const ABOUT: &str = "Nishita, Kaneda & Nakamae: Bézier patches scan-converted directly — subpatches per band (--band, --flatness), Bézier clipping of their edges at every row line (--root-tolerance, --subscan), straight-sided pieces box-filtered exactly, exact visibility, Gouraud or Phong";
 
 /// The histogram counters' names: roots by iterations (the last: that many or more).
 const HISTOGRAM_NAMES: [&str; HISTOGRAM] = [
