@@ -87,6 +87,7 @@ impl PolygonScene {
     /// Makes `loaded` ready as `settings` say.
     pub fn new(loaded: LoadedScene, settings: &Settings) -> Result<PolygonScene, RenderError> {
         settings.check().map_err(RenderError::Usage)?;
+        let loaded = loaded.drawn_as(settings)?;
         let kind = loaded.scene.kind();
         let mut prepared = PolygonScene {
             source: loaded.source,

@@ -64,16 +64,7 @@ impl Source {
     /// Reads the scene (any kind) as `settings` draw it: at its `size`, its Bézier meshes
     /// at its `tessellate`, when given.
     pub fn load_for(&self, settings: &crate::Settings) -> Result<LoadedScene, RenderError> {
-        let mut loaded = self.load(settings.size)?;
-        if let Some(n) = settings.tessellate {
-            let start = Instant::now();
-            loaded.scene = loaded
-                .scene
-                .with_tessellation(n)
-                .map_err(|e| RenderError::Usage(format!("--tessellate {n}: {e}")))?;
-            loaded.load_time += start.elapsed();
-        }
-        Ok(loaded)
+        self.load(settings.size)?.drawn_as(settings)
     }
 
     /// Reads the scene (any kind), at `size` when given. A [`Source::Built`] scene has
@@ -126,6 +117,32 @@ impl LoadedScene {
             scene,
             load_time: Duration::ZERO,
         }
+    }
+
+    /// The scene as `settings` draw it: at their `size` and its Bézier meshes at their
+    /// `tessellate`, when given and not so already. Every registered renderer starts with
+    /// it, so a scene built in code ([`LoadedScene::built`]) is drawn as one read from a
+    /// file with the same settings.
+    pub fn drawn_as(mut self, settings: &crate::Settings) -> Result<LoadedScene, RenderError> {
+        let start = Instant::now();
+        if let Some(s) = settings.size {
+            if self.scene.size() != (s.width, s.height) {
+                self.scene = self
+                    .scene
+                    .with_size(s.width, s.height)
+                    .map_err(|e| RenderError::Usage(format!("--size {s}: {e}")))?;
+            }
+        }
+        if let Some(n) = settings.tessellate {
+            if !self.scene.is_tessellated_at(n) {
+                self.scene = self
+                    .scene
+                    .with_tessellation(n)
+                    .map_err(|e| RenderError::Usage(format!("--tessellate {n}: {e}")))?;
+            }
+        }
+        self.load_time += start.elapsed();
+        Ok(self)
     }
 }
 

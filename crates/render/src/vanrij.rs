@@ -41,6 +41,7 @@ impl VanRij {
     /// The polygons of `loaded` as `settings` say (a world scene projected, lit and its
     /// hidden surfaces removed first).
     pub fn new(loaded: LoadedScene, settings: &Settings) -> Result<VanRij, RenderError> {
+        let loaded = loaded.drawn_as(settings)?;
         let scene = PolygonScene::new(loaded, settings)?;
         Ok(VanRij::from_polygons(scene, settings))
     }

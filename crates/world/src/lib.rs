@@ -82,6 +82,20 @@ impl AnyScene {
         }
     }
 
+    /// Whether every Bézier mesh is tessellated `n` × `n` per patch (true when there is
+    /// none).
+    pub fn is_tessellated_at(&self, n: u32) -> bool {
+        match self {
+            AnyScene::World(w) => w
+                .spec
+                .meshes
+                .iter()
+                .filter_map(|m| m.bezier.as_ref())
+                .all(|b| b.tessellate == n),
+            AnyScene::Screen(_) => true,
+        }
+    }
+
     /// Whether any mesh is made of Bézier patches.
     pub fn has_patches(&self) -> bool {
         match self {

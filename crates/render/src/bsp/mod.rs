@@ -63,6 +63,7 @@ pub struct Bsp {
 impl Bsp {
     /// The renderer of `loaded` under `settings`.
     pub fn new(loaded: LoadedScene, settings: &Settings) -> Result<Bsp, RenderError> {
+        let loaded = loaded.drawn_as(settings)?;
         settings.check().map_err(RenderError::Usage)?;
         let polys = Polys::new(loaded, settings.shading)?;
         let sampler = Sampler::new(settings.samples, settings.grid, polys.width, polys.height)

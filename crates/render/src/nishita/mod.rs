@@ -235,6 +235,7 @@ pub struct Nishita {
 impl Nishita {
     /// The renderer of `loaded` under `settings`.
     pub fn new(loaded: LoadedScene, settings: &Settings) -> Result<Nishita, RenderError> {
+        let loaded = loaded.drawn_as(settings)?;
         settings.check().map_err(RenderError::Usage)?;
         let AnyScene::World(w) = &loaded.scene else {
             // no patches: the polygons as vanrij draws them

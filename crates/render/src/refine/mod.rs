@@ -155,6 +155,7 @@ pub struct Refine {
 impl Refine {
     /// The refinement of `loaded` under `settings`.
     pub fn new(loaded: LoadedScene, settings: &Settings) -> Result<Refine, RenderError> {
+        let loaded = loaded.drawn_as(settings)?;
         if settings.shading != Shading::Gouraud {
             return Err(RenderError::Usage(format!(
                 "--renderer refine chooses each phase's shading itself (flat, then Gouraud above --gouraud-threshold); --shading {} does not apply: leave it at gouraud",

@@ -56,6 +56,7 @@ pub struct SBuffer {
 impl SBuffer {
     /// The renderer of `loaded` under `settings`.
     pub fn new(loaded: LoadedScene, settings: &Settings) -> Result<SBuffer, RenderError> {
+        let loaded = loaded.drawn_as(settings)?;
         settings.check().map_err(RenderError::Usage)?;
         let polys = Polys::new(loaded, settings.shading)?;
         let sampler = Sampler::new(settings.samples, settings.grid, polys.width, polys.height)

@@ -51,6 +51,7 @@ pub struct WooChall {
 impl WooChall {
     /// The renderer of `loaded` under `settings`.
     pub fn new(loaded: LoadedScene, settings: &Settings) -> Result<WooChall, RenderError> {
+        let loaded = loaded.drawn_as(settings)?;
         settings.check().map_err(RenderError::Usage)?;
         let triangles = Triangles::new(loaded, settings.shading)?;
         let sampler = Sampler::new(
