@@ -53,6 +53,13 @@ pub struct PhongSurfaces {
     pub shader: PhongShader,
 }
 
+/// The refusal of Phong shading on a screen scene, the same from every renderer.
+pub fn phong_needs_world() -> RenderError {
+    RenderError::Usage(
+        "Phong shading needs a world scene (normals in 3D); a screen scene has only intensities: use --shading gouraud or flat".into(),
+    )
+}
+
 /// Refuses a screen scene with a negative intensity, naming the value's JSON path: the
 /// array adds light and drops negative contributions (`Acc_mode` off), so a negative
 /// polygon would be drawn as 0 — silently wrong. Every renderer of screen scenes calls it.
@@ -114,11 +121,7 @@ impl PolygonScene {
         }
         let phong = settings.shading == Shading::Phong;
         match loaded.scene {
-            AnyScene::Screen(_) if phong => {
-                return Err(RenderError::Usage(
-                    "Phong shading needs a world scene (normals in 3D); a screen scene has only intensities: use --shading gouraud or flat".into(),
-                ))
-            }
+            AnyScene::Screen(_) if phong => return Err(phong_needs_world()),
             AnyScene::Screen(s) => {
                 no_negative_intensity(&s)?;
                 prepared.screen = s

@@ -13,41 +13,12 @@
 //!
 //! LAYERS default to 1 2 4 8 16 32. Prints a Markdown table: layers, triangles, candidate
 //! pairs, occluding pairs, fragments, wall time of `exact_fragments` and the peak heap it
-//! allocated (a counting allocator wraps the system one). The figures are in
+//! allocated (a counting allocator wraps the system one: `tests/layers/mod.rs`). The figures are in
 //! `docs/VISIBILITY.md`.
 
 use cwisim_scene::Shading;
 use cwisim_world::visibility::exact_fragments;
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
-
-/// The system allocator, counting the bytes live and their peak.
-struct Counting;
-
-static LIVE: AtomicUsize = AtomicUsize::new(0);
-static PEAK: AtomicUsize = AtomicUsize::new(0);
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        // SAFETY: forwarded to the system allocator with the caller's layout.
-        let p = unsafe { System.alloc(layout) };
-        if !p.is_null() {
-            let now = LIVE.fetch_add(layout.size(), Ordering::Relaxed) + layout.size();
-            PEAK.fetch_max(now, Ordering::Relaxed);
-        }
-        p
-    }
-
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: `ptr` came from `alloc` with this layout.
-        unsafe { System.dealloc(ptr, layout) };
-        LIVE.fetch_sub(layout.size(), Ordering::Relaxed);
-    }
-}
-
-#[global_allocator]
-static ALLOCATOR: Counting = Counting;
 
 #[path = "../tests/layers/mod.rs"]
 mod layers;
@@ -74,12 +45,9 @@ fn main() {
                 .expect("a valid scene");
             let (tris, _) =
                 cwisim_world::project::project(&scene, Shading::Gouraud).expect("projects");
-            let base = LIVE.load(Ordering::Relaxed);
-            PEAK.store(base, Ordering::Relaxed);
             let start = Instant::now();
-            let (fragments, stats) = exact_fragments(&tris, 1);
+            let ((fragments, stats), peak) = layers::peak_heap(|| exact_fragments(&tris, 1));
             let time = start.elapsed();
-            let peak = PEAK.load(Ordering::Relaxed) - base;
             drop(fragments);
             println!(
                 "| {family} | {l} | {} | {} | {} | {} | {} | {:.1} | {:.1} |",

@@ -1,45 +1,18 @@
 //! Exact visibility at high depth complexity: memory stays one triangle's occluders deep
 //! (it grew with the square of the layers), and coincident layers resolve to the first.
 //!
-//! A counting allocator wraps the system one for this test binary, to measure the peak
-//! heap `exact_fragments` allocates.
+//! A counting allocator wraps the system one for this test binary (`layers/mod.rs`), to
+//! measure the peak heap `exact_fragments` allocates.
 
 mod layers;
 
 use cwisim_scene::Shading;
 use cwisim_world::visibility::{exact_fragments, Fragment, VisibilityStats};
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
-struct Counting;
-
-static LIVE: AtomicUsize = AtomicUsize::new(0);
-static PEAK: AtomicUsize = AtomicUsize::new(0);
 /// One test at a time: tests run on threads, and the heap is shared (each test holds it
 /// for its whole body).
 static MEASURING: Mutex<()> = Mutex::new(());
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        // SAFETY: forwarded to the system allocator with the caller's layout.
-        let p = unsafe { System.alloc(layout) };
-        if !p.is_null() {
-            let now = LIVE.fetch_add(layout.size(), Ordering::Relaxed) + layout.size();
-            PEAK.fetch_max(now, Ordering::Relaxed);
-        }
-        p
-    }
-
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: `ptr` came from `alloc` with this layout.
-        unsafe { System.dealloc(ptr, layout) };
-        LIVE.fetch_sub(layout.size(), Ordering::Relaxed);
-    }
-}
-
-#[global_allocator]
-static ALLOCATOR: Counting = Counting;
 
 /// The visible fragments of the pot as `layers` layers (radii scaled by `1 + k·step`),
 /// the stats, and the peak heap the visibility pass took (bytes).
@@ -47,10 +20,7 @@ fn visible(layers: usize, step: f64) -> (Vec<Fragment>, VisibilityStats, usize) 
     let scene = cwisim_world::scene::parse_world(&layers::layered_pot(layers, step), None)
         .expect("a valid scene");
     let (tris, _) = cwisim_world::project::project(&scene, Shading::Gouraud).expect("projects");
-    let base = LIVE.load(Ordering::Relaxed);
-    PEAK.store(base, Ordering::Relaxed);
-    let (fragments, stats) = exact_fragments(&tris, 1);
-    let peak = PEAK.load(Ordering::Relaxed) - base;
+    let ((fragments, stats), peak) = layers::peak_heap(|| exact_fragments(&tris, 1));
     (fragments, stats, peak)
 }
 

@@ -119,11 +119,20 @@ pub fn scene_trapezia(scene: &ScreenScene) -> Vec<trapezoid::Trapezium> {
 }
 
 fn flat_intensity(p: &cwisim_scene::Polygon, channels: usize) -> [f64; MAX_CHANNELS] {
-    // the mean, as the first value plus the mean difference from it: a polygon whose
-    // vertices agree (a lit face) keeps their value exactly
-    let n = p.intensity.len().max(1) as f64;
-    trapezoid::vector(channels, |c| match p.intensity.first() {
-        Some(first) => first[c] + p.intensity.iter().map(|v| v[c] - first[c]).sum::<f64>() / n,
+    flat_mean(&p.intensity, channels)
+}
+
+/// A flat-shaded polygon's one intensity: the mean of its vertex intensities, per
+/// channel, taken as the first value plus the mean difference from it, so that a polygon
+/// whose vertices agree (a lit face) keeps their value exactly. Every renderer that
+/// shades flat takes it from here, so that their flat images agree to the bit.
+pub fn flat_mean<V: AsRef<[f64]>>(intensity: &[V], channels: usize) -> [f64; MAX_CHANNELS] {
+    let n = intensity.len().max(1) as f64;
+    trapezoid::vector(channels, |c| match intensity.first() {
+        Some(first) => {
+            let first = first.as_ref()[c];
+            first + intensity.iter().map(|v| v.as_ref()[c] - first).sum::<f64>() / n
+        }
         None => 0.0,
     })
 }

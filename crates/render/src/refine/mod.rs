@@ -74,13 +74,11 @@ impl Phase {
 /// The phases of a world scene, in order.
 pub const WORLD_PHASES: [Phase; 3] = [Phase::Flat, Phase::Gouraud, Phase::Antialias];
 
-/// The polygon at one intensity: the mean of its vertex intensities, per channel.
+/// The polygon at one intensity: the mean of its vertex intensities, per channel (the
+/// flat value every renderer takes, `cwisim_ypipe::flat_mean`).
 pub fn flattened(p: &Polygon) -> Polygon {
-    let n = p.intensity.len().max(1) as f64;
     let channels = p.intensity.first().map_or(0, Vec::len);
-    let mean: Vec<f64> = (0..channels)
-        .map(|c| p.intensity.iter().map(|v| v[c]).sum::<f64>() / n)
-        .collect();
+    let mean = cwisim_ypipe::flat_mean(&p.intensity, channels)[..channels].to_vec();
     Polygon {
         vertices: p.vertices.clone(),
         intensity: vec![mean; p.intensity.len()],

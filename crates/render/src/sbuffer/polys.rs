@@ -74,16 +74,6 @@ fn polygon_plane(p: &Polygon, depth: &[f64]) -> Option<[f64; 3]> {
     plane3([a, v[j], v[j + 1]], [depth[0], depth[j], depth[j + 1]])
 }
 
-/// The mean of the vertex intensities, as the first value plus the mean difference from
-/// it (a polygon whose vertices agree keeps their value exactly) — `vanrij`'s flat value.
-fn mean(intensity: &[Vector], channels: usize) -> Vector {
-    let n = intensity.len().max(1) as f64;
-    cwisim_scene::vector(channels, |c| match intensity.first() {
-        Some(first) => first[c] + intensity.iter().map(|v| v[c] - first[c]).sum::<f64>() / n,
-        None => 0.0,
-    })
-}
-
 /// The polygons of a scene, and what making them did.
 pub struct Polys {
     /// Where the scene came from.
@@ -126,9 +116,7 @@ impl Polys {
         let (width, height, channels) = match loaded.scene {
             AnyScene::Screen(s) => {
                 match shading {
-                    Shading::Phong => return Err(RenderError::Usage(
-                        "Phong shading needs a world scene (normals in 3D); a screen scene has only intensities: use --shading gouraud or flat".into(),
-                    )),
+                    Shading::Phong => return Err(crate::prepare::phong_needs_world()),
                     Shading::Hidden => return Err(hidden()),
                     _ => {}
                 }
@@ -151,7 +139,7 @@ impl Polys {
                         .collect();
                     polys.push(Poly {
                         cp,
-                        flat: mean(&intensity, ch),
+                        flat: cwisim_ypipe::flat_mean(&intensity, ch),
                         intensity,
                         plane,
                         source: k as u32,
@@ -175,7 +163,7 @@ impl Polys {
                     let intensity = t.intensity.to_vec();
                     polys.push(Poly {
                         cp,
-                        flat: mean(&intensity, ch),
+                        flat: cwisim_ypipe::flat_mean(&intensity, ch),
                         intensity,
                         plane,
                         source: k as u32,

@@ -52,9 +52,7 @@ impl Triangles {
         let (width, height, channels, tris) = match loaded.scene {
             AnyScene::Screen(s) => {
                 if shading == Shading::Phong {
-                    return Err(RenderError::Usage(
-                        "Phong shading needs a world scene (normals in 3D); a screen scene has only intensities: use --shading gouraud or flat".into(),
-                    ));
+                    return Err(crate::prepare::phong_needs_world());
                 }
                 crate::prepare::no_negative_intensity(&s)?;
                 polygons = s.polygons.len() as u64;
