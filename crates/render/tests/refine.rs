@@ -1,8 +1,8 @@
 //! `refine` (Bergman et al., adaptive refinement) held to what its phases must equal:
-//! van Rij's Gouraud box filter when every threshold is `all`, the flat frame when every
+//! van Rij's Phong box filter when every threshold is `all`, the flat frame when every
 //! threshold is `none`, a brute-force 3 × 3 range over the array's own previous output
-//! for the anti-aliasing flags, and an error against the full-quality image that does not
-//! grow from the first phase to the last.
+//! for the anti-aliasing flags, an error against the full-quality image that does not
+//! grow from the first phase to the last, and counts equal to a recount written here.
 
 use cwisim_isa::{Instruction, Opcode};
 use cwisim_render::refine::{Phase, Refine};
@@ -12,8 +12,10 @@ use cwisim_render::{
 };
 use cwisim_scene::{Antialias, Shading};
 use cwisim_world::embedded::embedded;
+use cwisim_world::face::ScreenTriangle;
 use cwisim_world::parse_any;
 use cwisim_xproc::ImageSink;
+use glam::DVec3;
 
 fn scene(name: &str, size: u32) -> LoadedScene {
     let e = embedded(name).unwrap();
@@ -24,9 +26,10 @@ fn scene(name: &str, size: u32) -> LoadedScene {
     LoadedScene::built(name, scene)
 }
 
-fn thresholds(gouraud: Threshold, aa: Threshold) -> Settings {
+fn thresholds(gouraud: Threshold, phong: Threshold, aa: Threshold) -> Settings {
     Settings {
         gouraud_threshold: gouraud,
+        phong_angle: phong,
         aa_threshold: aa,
         ..Settings::default()
     }
@@ -82,9 +85,13 @@ fn build(name: &str, loaded: LoadedScene, settings: &Settings) -> Box<dyn Render
     (registry::find(name).unwrap().build)(loaded, settings).unwrap()
 }
 
-/// The full-quality image and stream: `render --renderer vanrij --shading gouraud --aa box`.
+/// The full-quality image and stream: `render --renderer vanrij --shading phong --aa box`.
 fn full(name: &str, size: u32) -> (Vec<f64>, Vec<Instruction>) {
-    let r = build("vanrij", scene(name, size), &Settings::default());
+    let phong = Settings {
+        shading: Shading::Phong,
+        ..Settings::default()
+    };
+    let r = build("vanrij", scene(name, size), &phong);
     let mut stream = Vec::new();
     emit(&*r, &mut stream).unwrap();
     let run = run(&*r, 1);
@@ -97,9 +104,12 @@ fn rms(a: &[f64], b: &[f64]) -> f64 {
 }
 
 #[test]
-fn a_world_scene_is_refined_in_three_complete_frames() {
+fn a_world_scene_is_refined_in_four_complete_frames() {
     let r = Refine::new(scene("pot", 64), &Settings::default()).unwrap();
-    assert_eq!(r.phases(), [Phase::Flat, Phase::Gouraud, Phase::Antialias]);
+    assert_eq!(
+        r.phases(),
+        [Phase::Flat, Phase::Gouraud, Phase::Phong, Phase::Antialias]
+    );
     assert!(r.needs_previous_frame());
     // its stream exists only while it runs through the array
     let e = emit(&r, &mut Vec::new()).unwrap_err().to_string();
@@ -107,29 +117,32 @@ fn a_world_scene_is_refined_in_three_complete_frames() {
 }
 
 #[test]
-fn every_threshold_at_all_gives_van_rijs_gouraud_box_filter_bit_for_bit() {
+fn every_threshold_at_all_gives_van_rijs_phong_box_filter_bit_for_bit() {
+    let all = thresholds(Threshold::All, Threshold::All, Threshold::All);
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
     for name in ["pot", "still-life"] {
         let (image, stream) = full(name, 96);
-        let r = build(
-            "refine",
-            scene(name, 96),
-            &thresholds(Threshold::All, Threshold::All),
-        );
+        let r = build("refine", scene(name, 96), &all);
         let run = run(&*r, 1);
         let last = run.frames.last().unwrap();
-        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
         assert_eq!(bits(last), bits(&image), "{name}: last frame");
         assert_eq!(run.streams.last().unwrap(), &stream, "{name}: last stream");
-        // and the Gouraud phase Gouraud-shades every polygon: van Rij point-sampled
-        let point = build(
-            "vanrij",
-            scene(name, 96),
-            &Settings {
-                aa: Antialias::None,
-                ..Settings::default()
-            },
-        );
-        assert_eq!(bits(&run.frames[1]), bits(&self::run(&*point, 1).frames[0]));
+        // the Gouraud phase Gouraud-shades every polygon: van Rij point-sampled
+        let point = |shading| {
+            let r = build(
+                "vanrij",
+                scene(name, 96),
+                &Settings {
+                    aa: Antialias::None,
+                    shading,
+                    ..Settings::default()
+                },
+            );
+            self::run(&*r, 1).frames.remove(0)
+        };
+        assert_eq!(bits(&run.frames[1]), bits(&point(Shading::Gouraud)));
+        // and the Phong phase lights every polygon per pixel: van Rij's Phong, sampled
+        assert_eq!(bits(&run.frames[2]), bits(&point(Shading::Phong)));
         // nothing was claimed: every pixel box-filtered
         assert_eq!(run.counters.get("aa_claims"), Some(0));
         let h = r.header();
@@ -142,26 +155,37 @@ fn every_threshold_at_all_gives_van_rijs_gouraud_box_filter_bit_for_bit() {
 
 #[test]
 fn every_threshold_at_none_repeats_the_flat_frame_and_regenerates_nothing() {
-    let r = build(
-        "refine",
-        scene("pot", 96),
-        &thresholds(Threshold::None, Threshold::None),
-    );
+    let none = thresholds(Threshold::None, Threshold::None, Threshold::None);
+    let r = build("refine", scene("pot", 96), &none);
     let run = run(&*r, 1);
     let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-    assert_eq!(bits(&run.frames[1]), bits(&run.frames[0]));
-    assert_eq!(bits(&run.frames[2]), bits(&run.frames[0]));
+    for k in 1..4 {
+        assert_eq!(bits(&run.frames[k]), bits(&run.frames[0]), "frame {k}");
+    }
     assert_eq!(
         run.streams[1], run.streams[0],
         "the Gouraud frame re-sends phase 1"
     );
+    assert_eq!(
+        run.streams[2], run.streams[0],
+        "the Phong frame re-sends phase 1"
+    );
     // the AA frame: only claims and Refresh, no filter instruction
-    assert!(run.streams[2]
+    assert!(run.streams[3]
         .iter()
         .all(|i| matches!(i.op, Opcode::Eval0 | Opcode::Refresh)));
-    assert_eq!(run.counters.get("aa_pixels"), Some(0));
-    assert_eq!(run.counters.get("gouraud_polygons"), Some(0));
-    // and the flat frame differs from the full-quality Gouraud one (the test can fail)
+    for counter in [
+        "gouraud_polygons",
+        "gouraud_regenerated",
+        "phong_polygons",
+        "phong_regenerated",
+        "aa_pixels",
+        "aa_regenerated",
+        "aa_fragments",
+    ] {
+        assert_eq!(run.counters.get(counter), Some(0), "{counter}");
+    }
+    // and the flat frame differs from the full-quality one (the test can fail)
     let (image, _) = full("pot", 96);
     assert!(rms(&run.frames[0], &image) > 0.0);
 }
@@ -195,16 +219,14 @@ fn brute_flags(img: &[f64], w: usize, h: usize, ch: usize, t: f64) -> Vec<bool> 
 
 #[test]
 fn aa_flags_are_the_3x3_range_of_the_previous_output_and_the_rest_is_kept() {
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
     for (name, t) in [("pot", 0.05), ("still-life", 0.1), ("pot", 0.0)] {
-        let r = build(
-            "refine",
-            scene(name, 80),
-            &thresholds(Threshold::Above(0.02), Threshold::Above(t)),
-        );
+        let some = |aa| thresholds(Threshold::Above(0.02), Threshold::Above(30.0), aa);
+        let r = build("refine", scene(name, 80), &some(Threshold::Above(t)));
         let h = r.header();
         let (w, lines, ch) = (h.width as usize, h.lines as usize, h.channel_count());
         let run = run(&*r, 1);
-        let flags = brute_flags(&run.frames[1], w, lines, ch, t);
+        let flags = brute_flags(&run.frames[2], w, lines, ch, t);
         let flagged = flags.iter().filter(|&&f| f).count();
         assert!(
             flagged > 0 && flagged < w * lines,
@@ -215,51 +237,134 @@ fn aa_flags_are_the_3x3_range_of_the_previous_output_and_the_rest_is_kept() {
             Some(flagged as u64),
             "{name}"
         );
-        let (image, _) = full(name, 80);
+        // a flagged pixel holds the display list's box filter (every pixel filtered)
+        let filtered = build("refine", scene(name, 80), &some(Threshold::All));
+        let filtered = self::run(&*filtered, 1).frames.pop().unwrap();
         for (p, &f) in flags.iter().enumerate() {
-            let got = &run.frames[2][p * ch..(p + 1) * ch];
+            let got = &run.frames[3][p * ch..(p + 1) * ch];
             let want = if f {
-                &image[p * ch..(p + 1) * ch]
+                &filtered[p * ch..(p + 1) * ch]
             } else {
-                &run.frames[1][p * ch..(p + 1) * ch]
+                &run.frames[2][p * ch..(p + 1) * ch]
             };
-            assert_eq!(
-                got.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
-                want.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
-                "{name}: pixel {p} (flagged: {f})"
-            );
+            assert_eq!(bits(got), bits(want), "{name}: pixel {p} (flagged: {f})");
+        }
+        // the fragments: flagged pixels and the polygons covering them, recounted by
+        // clipping each polygon to each flagged pixel
+        let refine = Refine::new(scene(name, 80), &some(Threshold::Above(t))).unwrap();
+        let polygons = &refine.polygons().screen.polygons;
+        let mut fragments = 0u64;
+        for (p, _) in flags.iter().enumerate().filter(|(_, &f)| f) {
+            let (x, y) = ((p % w) as f64, (p / w) as f64);
+            fragments += polygons
+                .iter()
+                .filter(|poly| covered(&poly.vertices, x, y) > 1e-9)
+                .count() as u64;
+        }
+        assert!(fragments >= flagged as u64 / 2, "{name}: {fragments}");
+        assert_eq!(run.counters.get("aa_fragments"), Some(fragments), "{name}");
+    }
+}
+
+/// The area of polygon `v` inside pixel `[x, x + 1] × [y, y + 1]`: Sutherland–Hodgman
+/// against the pixel's four sides, then the shoelace formula.
+fn covered(v: &[[f64; 2]], x: f64, y: f64) -> f64 {
+    let (lo, hi) = v
+        .iter()
+        .fold(([f64::MAX; 2], [f64::MIN; 2]), |(lo, hi), p| {
+            (
+                [lo[0].min(p[0]), lo[1].min(p[1])],
+                [hi[0].max(p[0]), hi[1].max(p[1])],
+            )
+        });
+    if hi[0] <= x || lo[0] >= x + 1.0 || hi[1] <= y || lo[1] >= y + 1.0 {
+        return 0.0;
+    }
+    let mut poly: Vec<[f64; 2]> = v.to_vec();
+    // (axis, bound, keep the side below the bound)
+    for (axis, bound, below) in [
+        (0, x, false),
+        (0, x + 1.0, true),
+        (1, y, false),
+        (1, y + 1.0, true),
+    ] {
+        let inside = |p: &[f64; 2]| {
+            if below {
+                p[axis] <= bound
+            } else {
+                p[axis] >= bound
+            }
+        };
+        let mut out = Vec::new();
+        for k in 0..poly.len() {
+            let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
+            if inside(&a) {
+                out.push(a);
+            }
+            if inside(&a) != inside(&b) {
+                let s = (bound - a[axis]) / (b[axis] - a[axis]);
+                out.push([a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1])]);
+            }
+        }
+        poly = out;
+        if poly.is_empty() {
+            return 0.0;
         }
     }
+    let n = poly.len();
+    (0..n)
+        .map(|k| poly[k][0] * poly[(k + 1) % n][1] - poly[(k + 1) % n][0] * poly[k][1])
+        .sum::<f64>()
+        .abs()
+        / 2.0
 }
 
 #[test]
 fn the_error_against_full_quality_does_not_grow_from_flat_to_the_last_phase() {
-    for name in ["pot", "still-life", "teapot"] {
-        let r = build("refine", scene(name, 96), &Settings::default());
+    for e in cwisim_world::embedded::EMBEDDED {
+        let r = build("refine", scene(e.name, 64), &Settings::default());
         let run = run(&*r, 1);
-        let (image, _) = full(name, 96);
+        let (image, _) = full_or_gouraud(e.name, 64);
         let errors: Vec<f64> = run.frames.iter().map(|f| rms(f, &image)).collect();
-        println!("{name}: RMS per phase {errors:?}");
+        println!("{}: RMS per phase {errors:?}", e.name);
+        let last = *errors.last().unwrap();
+        if run.frames.len() == 1 {
+            // a screen scene: one frame, van Rij's own
+            assert_eq!(last, 0.0, "{}", e.name);
+            continue;
+        }
         assert!(
             errors[0] > 0.0,
-            "{name}: the flat phase is not full quality"
+            "{}: the flat phase is not full quality",
+            e.name
         );
         assert!(
-            errors[2] <= errors[0],
-            "{name}: RMS grew from {} to {}",
-            errors[0],
-            errors[2]
-        );
-        assert!(
-            errors[2] <= errors[1],
-            "{name}: anti-aliasing made it worse"
+            last <= errors[0],
+            "{}: RMS grew from {} to {last}",
+            e.name,
+            errors[0]
         );
     }
 }
 
+/// The full-quality image of a world scene (Phong), or van Rij's Gouraud box filter of a
+/// screen scene (nothing to light).
+fn full_or_gouraud(name: &str, size: u32) -> (Vec<f64>, Vec<Instruction>) {
+    let loaded = scene(name, size);
+    if matches!(loaded.scene, cwisim_world::AnyScene::World(_)) {
+        return full(name, size);
+    }
+    let r = build("vanrij", loaded, &Settings::default());
+    (run(&*r, 1).frames.remove(0), Vec::new())
+}
+
 #[test]
 fn gouraud_polygons_equal_a_recount() {
-    let settings = thresholds(Threshold::Above(0.02), Threshold::Above(0.05));
+    let settings = thresholds(
+        Threshold::Above(0.02),
+        Threshold::Above(30.0),
+        Threshold::Above(0.05),
+    );
     let r = Refine::new(scene("still-life", 64), &settings).unwrap();
     let recount = r
         .polygons()
@@ -280,6 +385,78 @@ fn gouraud_polygons_equal_a_recount() {
     assert_eq!(r.gouraud_polygons(), recount);
     let run = run(&r, 1);
     assert_eq!(run.counters.get("gouraud_polygons"), Some(recount));
+}
+
+/// The highlight test written out from the scene file: at each corner, for each light
+/// in front of it, the angle between the light's mirror direction and the eye, by
+/// `atan2(|R × V|, R · V)`; a material without a specular term has no highlight.
+fn highlight_within(w: &cwisim_world::WorldScene, t: &ScreenTriangle, degrees: f64) -> bool {
+    let spec = &w.spec;
+    let m = &spec.meshes[t.mesh as usize].material;
+    if (0..w.channels()).all(|c| m.k_s.get(c) == 0.0) {
+        return false;
+    }
+    let eye = DVec3::from_array(spec.camera.eye);
+    (0..3).any(|k| {
+        let p = t.surface.world[k];
+        let n = t.surface.normals[k] / t.surface.normals[k].length();
+        let v = (eye - p) / (eye - p).length();
+        spec.lights.iter().any(|light| {
+            let l = DVec3::from_array(light.position) - p;
+            let l = l / l.length();
+            let d = n.dot(l);
+            let r = n * (2.0 * d) - l;
+            d > 0.0 && r.cross(v).length().atan2(r.dot(v)).to_degrees() <= degrees
+        })
+    })
+}
+
+#[test]
+fn phong_polygons_equal_a_recount() {
+    for (name, degrees) in [("pot", 30.0), ("still-life", 20.0), ("teapot", 45.0)] {
+        let settings = thresholds(
+            Threshold::Above(0.02),
+            Threshold::Above(degrees),
+            Threshold::Above(0.05),
+        );
+        let loaded = scene(name, 64);
+        let cwisim_world::AnyScene::World(w) = &loaded.scene else {
+            panic!("{name} is a world scene");
+        };
+        let w = w.clone();
+        let r = Refine::new(loaded, &settings).unwrap();
+        let s = r.polygons().phong.as_ref().unwrap();
+        let fragments = s
+            .sources
+            .iter()
+            .filter(|&&k| highlight_within(&w, &s.triangles[k], degrees))
+            .count() as u64;
+        let triangles = s
+            .triangles
+            .iter()
+            .filter(|t| highlight_within(&w, t, degrees))
+            .count() as u64;
+        println!(
+            "{name}: {fragments} fragments, {triangles} of {} triangles",
+            s.triangles.len()
+        );
+        assert!(
+            fragments > 0 && triangles < s.triangles.len() as u64,
+            "{name}"
+        );
+        assert_eq!(r.phong_polygons(), fragments, "{name}");
+        assert_eq!(
+            r.highlight_pass(),
+            (triangles, s.triangles.len() as u64),
+            "{name}"
+        );
+        let run = run(&r, 1);
+        assert_eq!(
+            run.counters.get("phong_polygons"),
+            Some(fragments),
+            "{name}"
+        );
+    }
 }
 
 #[test]
