@@ -86,7 +86,7 @@ pub struct RefineRun {
     pub counters: cwisim_render::Counters,
     /// Polygons of the display list (exact visible fragments).
     pub polygons: u64,
-    /// Drawn triangles passing the highlight test, and all drawn triangles.
+    /// Visible triangles passing the highlight test, and all visible triangles.
     pub highlight: (u64, u64),
 }
 

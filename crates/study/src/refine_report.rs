@@ -190,7 +190,7 @@ pub fn write_table(out: &mut dyn Write, run: &RefineRun, label: Option<&str>) ->
     );
     let _ = writeln!(
         s,
-        "Gouraud {} polygons; Phong {} polygons ({} of {} triangles within the highlight angle); anti-aliased {} of {pixels} pixels ({:.1}%), {} fragments",
+        "Gouraud {} polygons; Phong {} polygons ({} of {} visible triangles within the highlight angle); anti-aliased {} of {pixels} pixels ({:.1}%), {} fragments",
         run.counters.get("gouraud_polygons").unwrap_or(0),
         run.counters.get("phong_polygons").unwrap_or(0),
         run.highlight.0,

@@ -183,7 +183,8 @@ pub struct Refine {
     modes: Vec<Mode>,
     gouraud_polygons: u64,
     phong_polygons: u64,
-    /// Triangles (front-facing, drawn) passing the highlight test, of all of them.
+    /// Visible triangles (with a fragment in the display list) passing the highlight
+    /// test, and how many are visible.
     highlight: (u64, u64),
     gouraud_threshold: Threshold,
     phong_angle: Threshold,
@@ -250,12 +251,18 @@ impl Refine {
             scene,
         };
         if let Some(s) = &refine.scene.phong {
-            let passing = s
-                .triangles
+            // the triangles that show: those with a visible fragment
+            let mut visible = s.sources.clone();
+            visible.sort_unstable();
+            visible.dedup();
+            let passing = visible
                 .iter()
-                .filter(|t| settings.phong_angle.admits(s.shader.highlight_angle(t)))
+                .filter(|&&k| {
+                    let t = &s.triangles[k];
+                    settings.phong_angle.admits(s.shader.highlight_angle(t))
+                })
                 .count();
-            refine.highlight = (passing as u64, s.triangles.len() as u64);
+            refine.highlight = (passing as u64, visible.len() as u64);
         }
         refine.plan();
         Ok(refine)
@@ -338,8 +345,8 @@ impl Refine {
         self.phong_polygons
     }
 
-    /// The front-facing (drawn) triangles passing the highlight test, and how many there
-    /// are: the paper's Phong pass rate.
+    /// The visible triangles (those with a fragment in the display list) passing the
+    /// highlight test, and how many are visible: the paper's Phong pass rate.
     pub fn highlight_pass(&self) -> (u64, u64) {
         self.highlight
     }
@@ -480,7 +487,7 @@ impl Renderer for Refine {
                     get("gouraud_polygons")
                 ),
                 Phase::Phong => format!(
-                    "Phong: {} of {polygons} polygons lit per pixel ({} of {} triangles within the highlight angle)",
+                    "Phong: {} of {polygons} polygons lit per pixel ({} of {} visible triangles within the highlight angle)",
                     get("phong_polygons"),
                     self.highlight.0,
                     self.highlight.1
