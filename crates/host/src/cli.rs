@@ -157,7 +157,7 @@ Example:\n  cwisim tradeoff pot --csv pot.csv --plot pot-tradeoff.png",
     #[command(
         long_about = "Refine one world scene (a file or an embedded name; default the pot) in phases, \
 each a complete frame through the array (Bergman, Fuchs, Grant and Spach, 1986; --renderer refine): \
-flat, Gouraud for polygons whose vertex-intensity range exceeds --gouraud-threshold, Phong for \
+(with --phases vertices,edges,… first depth-cued points and lines) flat, Gouraud for polygons whose vertex-intensity range exceeds --gouraud-threshold, Phong for \
 polygons whose highlight vector is within --phong-angle degrees of the eye, and the box filter on \
 pixels whose 3x3 range in the previous frame exceeds --aa-threshold (the rest re-sent as Eval0 \
 claims). Per phase it prints the pixels processed, instructions (total, regenerated), bus-busy \

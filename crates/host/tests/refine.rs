@@ -106,6 +106,14 @@ fn a_sweep_prints_one_table_per_value() {
     let csv = String::from_utf8(read(dir.join("s.csv"))).unwrap();
     // two runs of two phases, the first with its naive sequence
     assert_eq!(csv.lines().count(), 1 + 2 + 2 + 2, "{csv}");
+    // the paper's first phases, before any polygon
+    let out = cwisim_ok(
+        &dir,
+        &["refine", "--size", "64x64", "--phases", "vertices,edges"],
+    );
+    for phase in ["vertices ", "edges "] {
+        assert!(out.lines().any(|l| l.starts_with(phase)), "{phase}: {out}");
+    }
 }
 
 #[test]
@@ -113,7 +121,8 @@ fn bad_input_is_refused_in_one_line_with_exit_2() {
     let dir = scratch("refine-bad");
     for (args, says) in [
         (vec!["--phases", "gouraud,flat"], "--phases"),
-        (vec!["--phases", "flat,vertices"], "not built"),
+        (vec!["--phases", "flat,vertices"], "out of order"),
+        (vec!["--phases", "flat,shadows"], "not built"),
         (vec!["--phong-angle", "270"], "--phong-angle is an angle"),
         (vec!["--aa-threshold", "lots"], "expected `all`, `none`"),
         (vec!["--sweep", "size=1,2"], "unknown threshold `size`"),

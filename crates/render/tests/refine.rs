@@ -510,3 +510,111 @@ fn settings_it_chooses_itself_are_refused_with_a_reason() {
         assert!(e.contains(flag), "{e}");
     }
 }
+
+#[test]
+fn vertices_and_edges_are_depth_cued_points_and_lines_then_the_flat_frame() {
+    let phases = [Phase::Vertices, Phase::Edges, Phase::Flat];
+    let r = Refine::with_phases(scene("pot", 64), &Settings::default(), &phases).unwrap();
+    assert!(!r.needs_previous_frame());
+    let run = run(&r, 1);
+    let h = r.header();
+    let (w, lines) = (h.width as usize, h.lines as usize);
+    let tris = &r.polygons().phong.as_ref().unwrap().triangles;
+    // the distinct corners and edges, and the pixels of the corners inside the image
+    let key = |p: [f64; 2]| (p[0].to_bits(), p[1].to_bits());
+    let mut corners = std::collections::BTreeSet::new();
+    let mut edges = std::collections::BTreeSet::new();
+    let mut corner_pixels = std::collections::BTreeSet::new();
+    for t in tris {
+        for k in 0..3 {
+            let (a, b) = (t.points[k], t.points[(k + 1) % 3]);
+            corners.insert(key(a));
+            edges.insert(std::cmp::min((key(a), key(b)), (key(b), key(a))));
+            let (x, y) = (a[0].floor(), a[1].floor());
+            if x >= 0.0 && y >= 0.0 && (x as usize) < w && (y as usize) < lines {
+                corner_pixels.insert((x as usize, y as usize));
+            }
+        }
+    }
+    assert_eq!(
+        run.counters.get("vertices_drawn"),
+        Some(corners.len() as u64)
+    );
+    assert_eq!(run.counters.get("edges_drawn"), Some(edges.len() as u64));
+    let lit = |frame: &[f64]| -> std::collections::BTreeSet<(usize, usize)> {
+        (0..w * lines)
+            .filter(|&p| frame[p] != 0.0)
+            .map(|p| (p % w, p / w))
+            .collect()
+    };
+    // the vertex frame lights exactly the corners' pixels, depth-cued in [1/4, 1]
+    let points = lit(&run.frames[0]);
+    assert_eq!(points, corner_pixels);
+    assert_eq!(
+        run.counters.get("vertices_pixels"),
+        Some(points.len() as u64)
+    );
+    let values: Vec<f64> = run.frames[0]
+        .iter()
+        .copied()
+        .filter(|&v| v != 0.0)
+        .collect();
+    assert!(values.iter().all(|&v| (0.25..=1.0).contains(&v)));
+    assert_eq!(
+        values.iter().cloned().fold(0.0, f64::max),
+        1.0,
+        "the nearest corner"
+    );
+    // the edge frame: every corner lit, and every lit pixel on an edge (its centre within
+    // half a pixel's diagonal of the segment)
+    let lines_lit = lit(&run.frames[1]);
+    assert!(corner_pixels.is_subset(&lines_lit));
+    assert!(
+        lines_lit.len() > 3 * points.len(),
+        "{} pixels",
+        lines_lit.len()
+    );
+    let near_an_edge = |(x, y): (usize, usize)| {
+        let c = [x as f64 + 0.5, y as f64 + 0.5];
+        tris.iter().any(|t| {
+            (0..3).any(|k| {
+                let (a, b) = (t.points[k], t.points[(k + 1) % 3]);
+                let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+                let len2 = dx * dx + dy * dy;
+                let u = if len2 > 0.0 {
+                    (((c[0] - a[0]) * dx + (c[1] - a[1]) * dy) / len2).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                let (px, py) = (a[0] + u * dx - c[0], a[1] + u * dy - c[1]);
+                (px * px + py * py).sqrt() <= 0.5f64.sqrt() + 1e-9
+            })
+        })
+    };
+    assert!(lines_lit.iter().all(|&p| near_an_edge(p)));
+    // the flat frame after them is the flat frame of the default sequence
+    let default = build("refine", scene("pot", 64), &Settings::default());
+    let first = self::run(&*default, 1).frames.remove(0);
+    assert_eq!(run.frames[2], first);
+}
+
+#[test]
+fn phase_lists_are_checked() {
+    use cwisim_render::refine::parse_phases;
+    assert_eq!(
+        parse_phases("vertices, edges,flat,aa").unwrap(),
+        [Phase::Vertices, Phase::Edges, Phase::Flat, Phase::Antialias]
+    );
+    for (bad, says) in [
+        ("gouraud,flat", "list `flat` before it"),
+        ("flat,phong,gouraud", "out of order"),
+        ("flat,flat", "out of order"),
+        ("vertices,gouraud", "list `flat` before it"),
+        ("flat,shadows", "shadow phase is not built"),
+        ("flat,ray-tracing", "unknown phase `ray-tracing`"),
+        ("", "unknown phase ``"),
+    ] {
+        let e = parse_phases(bad).unwrap_err();
+        assert!(e.contains(says), "{bad}: {e}");
+    }
+}

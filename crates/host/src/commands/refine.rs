@@ -30,8 +30,8 @@ pub struct RefineArgs {
     /// scene has nothing to refine.
     #[arg(value_name = "SCENE")]
     pub scene: Option<PathBuf>,
-    /// The phases to run, comma-separated, in order, starting with flat: flat, gouraud,
-    /// phong, aa.
+    /// The phases to run, comma-separated, in this order: vertices, edges (depth-cued
+    /// points and lines), flat, gouraud, phong, aa; flat before any phase refining it.
     #[arg(long, value_name = "LIST", default_value = "flat,gouraud,phong,aa")]
     pub phases: String,
     /// The Gouraud phase shades a polygon whose vertex-intensity range exceeds T; `all`

@@ -5,6 +5,9 @@
 //! display list ([`display`]), in which a phase regenerates only the polygons or pixels it
 //! refines ([`frame`]):
 //!
+//! 0. optionally (`--phases`), the paper's first two: **vertices**, the model's corners as
+//!    depth-cued points, and **edges**, its triangles' edges as depth-cued one-pixel
+//!    lines ([`sketch`]);
 //! 1. **flat** — every polygon at one intensity (the mean of its vertex intensities),
 //!    point-sampled;
 //! 2. **Gouraud** — polygons whose vertex-intensity range exceeds `--gouraud-threshold`
@@ -19,12 +22,13 @@
 //!    which the claimed (locked) processors then ignore.
 //!
 //! A screen scene (intensities only, nothing to light) is drawn as one frame: Gouraud
-//! with the box filter, as `vanrij` draws it. The paper's earlier phases (vertices,
-//! edges) and shadows are not built (docs/RENDERERS.md, "refine").
+//! with the box filter, as `vanrij` draws it. Shadows are not built: no scene format
+//! carries the paper's precomputed shadow polygons (docs/RENDERERS.md, "refine").
 
 pub mod display;
 pub mod frame;
 pub mod measure;
+pub mod sketch;
 
 pub use measure::{aa_flags, flattened, intensity_range};
 
@@ -40,6 +44,7 @@ use cwisim_xproc::{Image, RunStats};
 use cwisim_ypipe::{emit_rows, header, ScanPlan};
 use display::{Mode, Subset};
 use frame::{Antialiased, Part, Shaded, BOX};
+use sketch::{Sketch, SketchFrame};
 use std::io;
 use std::ops::Range;
 use std::time::Duration;
@@ -51,6 +56,10 @@ pub const ABOUT: &str =
 /// A phase: one complete frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Phase {
+    /// The model's vertices as depth-cued points.
+    Vertices,
+    /// The triangles' edges as depth-cued one-pixel lines.
+    Edges,
     /// Every polygon at its mean intensity, point-sampled.
     Flat,
     /// Polygons above the Gouraud threshold Gouraud-shaded, point-sampled.
@@ -67,6 +76,8 @@ impl Phase {
     /// Its name (in `--phases` and the summary).
     pub fn name(self) -> &'static str {
         match self {
+            Phase::Vertices => "vertices",
+            Phase::Edges => "edges",
             Phase::Flat => "flat",
             Phase::Gouraud => "gouraud",
             Phase::Phong => "phong",
@@ -75,10 +86,23 @@ impl Phase {
         }
     }
 
-    /// The counter `what` (`instructions`, `regenerated`, `pixels`, `polygons`) of this
-    /// phase: `gouraud_polygons`, `aa_instructions`, ….
+    /// The counter `what` (`instructions`, `regenerated`, `pixels`, `polygons` — for
+    /// the vertex and edge phases, the points or lines drawn) of this phase:
+    /// `gouraud_polygons`, `aa_instructions`, ….
     pub fn counter(self, what: &str) -> &'static str {
-        const NAMES: [[&str; 4]; 5] = [
+        const NAMES: [[&str; 4]; 7] = [
+            [
+                "vertices_instructions",
+                "vertices_regenerated",
+                "vertices_pixels",
+                "vertices_drawn",
+            ],
+            [
+                "edges_instructions",
+                "edges_regenerated",
+                "edges_pixels",
+                "edges_drawn",
+            ],
             [
                 "flat_instructions",
                 "flat_regenerated",
@@ -106,11 +130,13 @@ impl Phase {
             ["instructions", "regenerated", "pixels", "polygons"],
         ];
         let row = match self {
-            Phase::Flat => 0,
-            Phase::Gouraud => 1,
-            Phase::Phong => 2,
-            Phase::Antialias => 3,
-            Phase::Whole => 4,
+            Phase::Vertices => 0,
+            Phase::Edges => 1,
+            Phase::Flat => 2,
+            Phase::Gouraud => 3,
+            Phase::Phong => 4,
+            Phase::Antialias => 5,
+            Phase::Whole => 6,
         };
         let col = match what {
             "instructions" => 0,
@@ -125,36 +151,37 @@ impl Phase {
 /// The phases of a world scene, in order.
 pub const WORLD_PHASES: [Phase; 4] = [Phase::Flat, Phase::Gouraud, Phase::Phong, Phase::Antialias];
 
-/// `--phases`: a comma-separated list of `flat`, `gouraud`, `phong`, `aa`, starting with
-/// `flat` (the first frame must be a whole image), in that order, each at most once.
+/// `--phases`: a comma-separated list of `vertices`, `edges`, `flat`, `gouraud`, `phong`,
+/// `aa`, in that order, each at most once, with `flat` whenever a later phase refines it.
 pub fn parse_phases(list: &str) -> Result<Vec<Phase>, String> {
+    const KNOWN: &str = "vertices, edges, flat, gouraud, phong, aa";
     let mut phases = Vec::new();
     for name in list.split(',').map(str::trim) {
         let phase = match name {
+            "vertices" => Phase::Vertices,
+            "edges" => Phase::Edges,
             "flat" => Phase::Flat,
             "gouraud" => Phase::Gouraud,
             "phong" => Phase::Phong,
             "aa" | "anti-aliasing" => Phase::Antialias,
-            "vertices" | "edges" | "shadows" => {
+            "shadows" => {
                 return Err(format!(
-                    "--phases: the paper's `{name}` phase is not built (docs/RENDERERS.md, \"refine\"); known: flat, gouraud, phong, aa"
+                    "--phases: the paper's shadow phase is not built: no scene format carries its precomputed shadow polygons (docs/RENDERERS.md, \"refine\"); known: {KNOWN}"
                 ))
             }
-            _ => {
-                return Err(format!(
-                    "--phases: unknown phase `{name}`; known: flat, gouraud, phong, aa"
-                ))
-            }
+            _ => return Err(format!("--phases: unknown phase `{name}`; known: {KNOWN}")),
         };
         if phases.last().is_some_and(|&p| p >= phase) {
             return Err(format!(
-                "--phases: `{name}` out of order or repeated; the phases run flat, gouraud, phong, aa, each at most once"
+                "--phases: `{name}` out of order or repeated; the phases run {KNOWN}, each at most once"
+            ));
+        }
+        if phase > Phase::Flat && !phases.contains(&Phase::Flat) {
+            return Err(format!(
+                "--phases: `{name}` refines the flat frame: list `flat` before it"
             ));
         }
         phases.push(phase);
-    }
-    if phases.first() != Some(&Phase::Flat) {
-        return Err("--phases must start with `flat` (the first frame is a whole image)".into());
     }
     Ok(phases)
 }
@@ -169,6 +196,8 @@ enum Plan {
     },
     /// The whole display list, box-filtered on flagged pixels.
     Antialias { list: Box<Subset> },
+    /// Points or lines.
+    Sketch(Box<Sketch>),
     /// A screen scene as `vanrij` draws it.
     Whole,
 }
@@ -306,8 +335,12 @@ impl Refine {
                 Phase::Phong => self.phong_polygons = regenerated,
                 _ => {}
             }
+            let (w, h) = (scene.screen.width, scene.screen.height);
+            let triangles = scene.phong.as_ref().map_or(&[][..], |s| &s.triangles[..]);
             plans.push(match phase {
                 Phase::Whole => Plan::Whole,
+                Phase::Vertices => Plan::Sketch(Box::new(Sketch::points(triangles, w, h))),
+                Phase::Edges => Plan::Sketch(Box::new(Sketch::edges(triangles, w, h))),
                 Phase::Antialias => Plan::Antialias {
                     list: Box::new(Subset::of(scene, &next, |_| true)),
                 },
@@ -412,6 +445,12 @@ impl Renderer for Refine {
         };
         let tolerance = self.shade_tolerance;
         Ok(match plan {
+            Plan::Sketch(sketch) => Box::new(SketchFrame {
+                sketch,
+                channels: self.header().channel_count(),
+                names: ["instructions", "regenerated", "pixels", "polygons"]
+                    .map(|what| phase.counter(what)),
+            }),
             Plan::Whole => Box::new(Whole {
                 plan: ScanPlan::new(&self.scene.screen, &BOX),
             }),
@@ -467,7 +506,9 @@ impl Renderer for Refine {
     }
 
     fn summary_rows(&self, counters: &Counters, stats: &RunStats) -> Vec<(&'static str, String)> {
-        const LABELS: [&str; 4] = ["phase 1", "phase 2", "phase 3", "phase 4"];
+        const LABELS: [&str; 6] = [
+            "phase 1", "phase 2", "phase 3", "phase 4", "phase 5", "phase 6",
+        ];
         let mut rows = self.scene.summary_rows();
         if self.phases == [Phase::Whole] {
             return rows;
@@ -481,6 +522,16 @@ impl Renderer for Refine {
                 (b + l.busy_cycles, w.max(l.busy_cycles))
             });
             let what = match phase {
+                Phase::Vertices => format!(
+                    "vertices: {} depth-cued points, {} pixels",
+                    get("vertices_drawn"),
+                    get("vertices_pixels")
+                ),
+                Phase::Edges => format!(
+                    "edges: {} depth-cued lines, {} pixels",
+                    get("edges_drawn"),
+                    get("edges_pixels")
+                ),
                 Phase::Flat => format!("flat: {polygons} polygons at one intensity"),
                 Phase::Gouraud => format!(
                     "Gouraud: {} of {polygons} polygons Gouraud-shaded",
@@ -502,7 +553,7 @@ impl Renderer for Refine {
                 Phase::Whole => String::new(),
             };
             rows.push((
-                LABELS[k.min(3)],
+                LABELS[k.min(LABELS.len() - 1)],
                 format!(
                     "{what}; {} instructions ({} regenerated), {busy} busy cycles (worst scanline {worst} of the line period {})",
                     get(phase.counter("instructions")),
