@@ -132,6 +132,7 @@ fn bad_input_is_refused_in_one_line_with_exit_2() {
         ),
         (vec!["--plot", "q.jpg"], "--plot"),
         (vec!["no-such-scene"], "no-such-scene"),
+        (vec!["fig25"], "fig25 is a screen scene"),
     ] {
         let mut all = vec!["refine", "--size", "32x32"];
         all.extend(&args);

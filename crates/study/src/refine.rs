@@ -287,6 +287,13 @@ pub fn run_refine(
     trace: Option<&mut dyn TraceWrite>,
     progress: Option<&mut dyn FnMut(u64)>,
 ) -> Result<RefineRun, StudyError> {
+    let source = Source::resolve(setup.scene)?;
+    if let cwisim_world::AnyScene::Screen(_) = source.load_for(&setup.settings)?.scene {
+        return Err(StudyError::Usage(format!(
+            "{} is a screen scene (intensities only, nothing to light or refine): refine measures world scenes; `render --renderer refine` draws a screen scene as its one frame",
+            source.name()
+        )));
+    }
     let reference = full_quality(setup.scene, &setup.settings, &setup.machine)?;
     let p = pass(setup, &setup.settings, trace, progress)?;
     let h = p.refine.header();

@@ -199,6 +199,12 @@ pub fn write_table(out: &mut dyn Write, run: &RefineRun, label: Option<&str>) ->
         100.0 * aa.unwrap_or(0) as f64 / pixels.max(1) as f64,
         run.counters.get("aa_fragments").unwrap_or(0),
     );
+    if let Some(points) = run.counters.get("vertices_drawn") {
+        let _ = writeln!(s, "vertices: {points} distinct corners drawn as points");
+    }
+    if let Some(lines) = run.counters.get("edges_drawn") {
+        let _ = writeln!(s, "edges: {lines} distinct edges drawn as lines");
+    }
     s.push('\n');
     table(&mut s, &run.rows, run);
     if !run.naive.is_empty() {

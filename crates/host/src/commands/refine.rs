@@ -179,18 +179,6 @@ pub fn run(args: &RefineArgs, stdout: &mut dyn Write, progress: bool) -> Result<
         if k > 0 {
             writeln!(stdout).map_err(CliError::Stdout)?;
         }
-        if run
-            .rows
-            .first()
-            .is_some_and(|r| r.phase == Phase::Whole.name())
-        {
-            writeln!(
-                stdout,
-                "note: {} is a screen scene (intensities only): one frame, nothing to refine",
-                run.scene
-            )
-            .map_err(CliError::Stdout)?;
-        }
         write_table(stdout, run, label.as_deref()).map_err(CliError::Stdout)?;
     }
     let Some((_, first)) = results.first() else {
