@@ -106,7 +106,9 @@ fn a_sweep_prints_one_table_per_value() {
     let csv = String::from_utf8(read(dir.join("s.csv"))).unwrap();
     // two runs of two phases, the first with its naive sequence
     assert_eq!(csv.lines().count(), 1 + 2 + 2 + 2, "{csv}");
-    // the paper's first phases, before any polygon
+    // the paper's first phases, before any polygon; with no output named, the plot
+    // goes to SCENE-refine.png
+    assert!(!dir.join("pot-refine.png").exists());
     let out = cwisim_ok(
         &dir,
         &["refine", "--size", "64x64", "--phases", "vertices,edges"],
@@ -114,6 +116,7 @@ fn a_sweep_prints_one_table_per_value() {
     for phase in ["vertices ", "edges "] {
         assert!(out.lines().any(|l| l.starts_with(phase)), "{phase}: {out}");
     }
+    assert!(read(dir.join("pot-refine.png")).starts_with(b"\x89PNG"));
 }
 
 #[test]
@@ -146,4 +149,5 @@ fn bad_input_is_refused_in_one_line_with_exit_2() {
     }
     assert!(!dir.join("f").exists());
     assert!(!dir.join("q.jpg").exists());
+    assert!(!dir.join("pot-refine.png").exists());
 }

@@ -15,7 +15,7 @@ use cwisim_render::refine::{parse_phases, Phase};
 use cwisim_render::settings::{
     Threshold, DEFAULT_AA_THRESHOLD, DEFAULT_GOURAUD_THRESHOLD, DEFAULT_PHONG_ANGLE,
 };
-use cwisim_render::{Settings, Size};
+use cwisim_render::{Settings, Size, Source};
 use cwisim_study::cost::render_cost_image;
 use cwisim_study::refine::{run_refine, RefineRun, RefineSetup};
 use cwisim_study::refine_plot::render_refine_plot;
@@ -68,7 +68,8 @@ pub struct RefineArgs {
     #[arg(long, value_name = "OUT.csv")]
     pub csv: Option<PathBuf>,
     /// Draw error against cumulative cycles (with the naive sequence) and busy cycles per
-    /// scanline against the line period, as a PNG.
+    /// scanline against the line period, as a PNG. Without any output option the plot
+    /// goes to SCENE-NAME-refine.png in the working directory.
     #[arg(long, value_name = "OUT.png")]
     pub plot: Option<PathBuf>,
     /// Run once per value of one threshold: NAME=V1,V2,… (NAME: gouraud-threshold,
@@ -95,17 +96,32 @@ fn create_dir(flag: &str, dir: &Path) -> Result<(), CliError> {
     std::fs::create_dir_all(dir).map_err(|e| CliError::write(dir, e))
 }
 
+/// The plot `refine` writes when given no output at all: `SCENE-NAME-refine.png`.
+fn default_plot(args: &RefineArgs) -> Result<Option<PathBuf>, CliError> {
+    let any = args.trace.is_some()
+        || args.frames_png.is_some()
+        || args.cost_images.is_some()
+        || args.csv.is_some()
+        || args.plot.is_some();
+    if any {
+        return Ok(args.plot.clone());
+    }
+    let name = Source::resolve(args.scene.as_deref())?.name();
+    Ok(Some(PathBuf::from(format!("{name}-refine.png"))))
+}
+
 /// Runs `cwisim refine`.
 pub fn run(args: &RefineArgs, stdout: &mut dyn Write, progress: bool) -> Result<(), CliError> {
+    let plot = default_plot(args)?;
     check_outputs(
         None,
         &[
             ("--trace", args.trace.as_deref()),
             ("--csv", args.csv.as_deref()),
-            ("--plot", args.plot.as_deref()),
+            ("--plot", plot.as_deref()),
         ],
     )?;
-    if let Some(p) = &args.plot {
+    if let Some(p) = &plot {
         check_extension("--plot", p, "png")?;
     }
     if let Some(p) = &args.csv {
@@ -216,7 +232,7 @@ pub fn run(args: &RefineArgs, stdout: &mut dyn Write, progress: bool) -> Result<
                 .map_err(|e| CliError::write(path, e))
         })?;
     }
-    if let Some(path) = &args.plot {
+    if let Some(path) = &plot {
         let img = render_refine_plot(&results).map_err(CliError::Usage)?;
         write_rgb_png(path, &img)?;
     }
