@@ -167,7 +167,7 @@ list's bytes against a frame buffer's; then the naive sequence, every phase's re
 (the paper's figure 1).\n\n\
 --plot draws error against cumulative cycles (with the naive sequence) and busy cycles per \
 scanline of each frame against the line period; --cost-images writes each phase's cost image; \
---frames-png each frame; --sweep NAME=V1,V2,… repeats the run per value of one threshold. \
+--frames-png each frame; --ids the polygon-ID view (which polygon owns each pixel: false-colour .png, or the identifiers as .npy); --sweep NAME=V1,V2,… repeats the run per value of one threshold. \
 docs/RENDERERS.md (\"refine\") and docs/REPRODUCTION.md have the results.\n\n\
 Example:\n  cwisim refine pot --plot quality.png --cost-images costs/",
         after_help = AFTER_HELP

@@ -151,3 +151,47 @@ fn bad_input_is_refused_in_one_line_with_exit_2() {
     assert!(!dir.join("q.jpg").exists());
     assert!(!dir.join("pot-refine.png").exists());
 }
+
+#[test]
+fn refine_writes_the_polygon_id_view() {
+    let dir = scratch("refine-ids");
+    let out = cwisim_ok(
+        &dir,
+        &["refine", "pot", "--size", "96x96", "--ids", "ids.npy"],
+    );
+    // the flat phase point-samples every fragment: its pixels are the owned ones
+    let flat: u64 = out
+        .lines()
+        .find(|l| l.starts_with("flat "))
+        .and_then(|l| l.split_whitespace().nth(1))
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no flat row: {out}"));
+    let bytes = read(dir.join("ids.npy"));
+    let npy = npyz::NpyFile::new(&bytes[..]).unwrap();
+    assert_eq!(npy.shape(), &[96, 96]);
+    let ids: Vec<u32> = npy.into_vec().unwrap();
+    assert_eq!(ids.iter().filter(|&&k| k != 0).count() as u64, flat);
+    assert!(ids.iter().all(|&k| k != u32::MAX), "no pixel is shared");
+    let polygons: u32 = out
+        .split(" polygons (visible fragments)")
+        .next()
+        .and_then(|s| s.rsplit(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no polygon count: {out}"));
+    assert!(ids.iter().all(|&k| k <= polygons));
+
+    cwisim_ok(
+        &dir,
+        &["refine", "pot", "--size", "64x64", "--ids", "ids.png"],
+    );
+    assert!(read(dir.join("ids.png")).starts_with(b"\x89PNG"));
+
+    let bad = cwisim(
+        &dir,
+        &["refine", "pot", "--size", "64x64", "--ids", "ids.txt"],
+    );
+    assert_eq!(bad.status.code(), Some(2));
+    let (_, err) = text(&bad);
+    assert!(err.contains("--ids"), "{err}");
+    assert!(!dir.join("ids.txt").exists());
+}

@@ -618,3 +618,125 @@ fn phase_lists_are_checked() {
         assert!(e.contains(says), "{bad}: {e}");
     }
 }
+
+/// Each scanline of the polygon-ID view, collected.
+fn owners(r: &Refine) -> Vec<Vec<u32>> {
+    let view = r.id_view().unwrap();
+    let mut rows = Vec::new();
+    view.scan(&mut |y, owners| {
+        assert_eq!(y, rows.len());
+        rows.push(owners.to_vec());
+    })
+    .unwrap();
+    rows
+}
+
+/// Whether `(x, y)` is inside the polygon `v` (crossing number), and its distance to the
+/// nearest edge.
+fn inside_and_margin(v: &[[f64; 2]], x: f64, y: f64) -> (bool, f64) {
+    let mut inside = false;
+    let mut margin = f64::INFINITY;
+    for i in 0..v.len() {
+        let (a, b) = (v[i], v[(i + 1) % v.len()]);
+        if (a[1] > y) != (b[1] > y) && x < a[0] + (y - a[1]) / (b[1] - a[1]) * (b[0] - a[0]) {
+            inside = !inside;
+        }
+        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+        let len2 = dx * dx + dy * dy;
+        let t = if len2 > 0.0 {
+            (((x - a[0]) * dx + (y - a[1]) * dy) / len2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let (px, py) = (a[0] + t * dx - x, a[1] + t * dy - y);
+        margin = margin.min((px * px + py * py).sqrt());
+    }
+    (inside, margin)
+}
+
+#[test]
+fn the_id_view_names_the_polygon_at_each_pixel_centre() {
+    for name in ["pot", "still-life", "teapot"] {
+        let r = Refine::new(scene(name, 96), &Settings::default()).unwrap();
+        let rows = owners(&r);
+        let screen = &r.polygons().screen;
+        let (w, h) = (screen.width as usize, screen.height as usize);
+        assert_eq!(rows.len(), h);
+        // brute force, polygon by polygon over its bounding box: which polygons hold
+        // each pixel centre, away from every edge
+        let mut holders = vec![Vec::new(); w * h];
+        let mut near_edge = vec![false; w * h];
+        for (k, p) in screen.polygons.iter().enumerate() {
+            let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+            for v in &p.vertices {
+                (x0, x1, y0, y1) = (x0.min(v[0]), x1.max(v[0]), y0.min(v[1]), y1.max(v[1]));
+            }
+            let xs = (x0.floor().max(0.0) as usize)..((x1.ceil() as usize).min(w));
+            let ys = (y0.floor().max(0.0) as usize)..((y1.ceil() as usize).min(h));
+            for y in ys {
+                for x in xs.clone() {
+                    let (inside, margin) =
+                        inside_and_margin(&p.vertices, x as f64 + 0.5, y as f64 + 0.5);
+                    if margin < 1e-6 {
+                        near_edge[y * w + x] = true;
+                    } else if inside {
+                        holders[y * w + x].push(k as u32 + 1);
+                    }
+                }
+            }
+        }
+        let mut checked = 0;
+        for y in 0..h {
+            for x in 0..w {
+                let o = rows[y][x];
+                assert_ne!(o, cwisim_render::refine::ids::SHARED, "{name} ({x}, {y})");
+                if near_edge[y * w + x] {
+                    continue;
+                }
+                let want = match holders[y * w + x][..] {
+                    [] => cwisim_render::refine::ids::NONE,
+                    [k] => k,
+                    ref many => panic!("{name} ({x}, {y}): fragments overlap: {many:?}"),
+                };
+                assert_eq!(o, want, "{name} pixel ({x}, {y})");
+                checked += 1;
+            }
+        }
+        assert!(
+            checked > w * h * 9 / 10,
+            "{name}: {checked} of {} checked",
+            w * h
+        );
+    }
+}
+
+#[test]
+fn the_flat_frame_is_the_owners_flat_value_and_phase_pixels_are_owned_pixels() {
+    let settings = thresholds(Threshold::Above(0.02), Threshold::None, Threshold::None);
+    let r = Refine::new(scene("still-life", 80), &settings).unwrap();
+    let rows = owners(&r);
+    let run = run(&r, 1);
+    let screen = &r.polygons().screen;
+    let ch = usize::from(screen.channels);
+    let w = screen.width as usize;
+    let (mut owned, mut gouraud) = (0u64, 0u64);
+    for (y, row) in rows.iter().enumerate() {
+        for (x, &o) in row.iter().enumerate() {
+            let pixel = &run.frames[0][(y * w + x) * ch..][..ch];
+            if o == cwisim_render::refine::ids::NONE {
+                assert!(pixel.iter().all(|&v| v == 0.0), "({x}, {y}) {pixel:?}");
+                continue;
+            }
+            owned += 1;
+            let p = &screen.polygons[o as usize - 1];
+            let mean = cwisim_ypipe::flat_mean(&p.intensity, ch);
+            assert_eq!(pixel, &mean[..ch], "({x}, {y}) owned by {o}");
+            if r.modes()[o as usize - 1] == cwisim_render::refine::display::Mode::Gouraud {
+                gouraud += 1;
+            }
+        }
+    }
+    assert!(gouraud > 0 && gouraud < owned);
+    assert_eq!(run.counters.get("flat_pixels"), Some(owned));
+    assert_eq!(run.counters.get("gouraud_pixels"), Some(gouraud));
+}

@@ -30,6 +30,7 @@ pub mod history;
 pub mod inspect;
 pub mod plot;
 pub mod refine;
+pub mod refine_ids;
 pub mod refine_plot;
 pub mod refine_report;
 pub mod tradeoff;

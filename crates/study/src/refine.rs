@@ -7,6 +7,7 @@
 
 use crate::cost::CostMap;
 use crate::error::StudyError;
+use crate::refine_ids::IdImage;
 use crate::tradeoff::errors;
 use cwisim_isa::{Instruction, Opcode, TraceWrite};
 use cwisim_render::refine::{Phase, Refine};
@@ -82,6 +83,8 @@ pub struct RefineRun {
     pub frames: Vec<Image>,
     /// Each frame's cost map (when asked for).
     pub cost_maps: Vec<CostMap>,
+    /// The polygon-ID view of the display list (when asked for).
+    pub ids: Option<IdImage>,
     /// The renderer's counters over the run (`gouraud_polygons`, `aa_fragments`, …).
     pub counters: cwisim_render::Counters,
     /// Polygons of the display list (exact visible fragments).
@@ -105,6 +108,8 @@ pub struct RefineSetup<'a> {
     pub naive: bool,
     /// Keep each frame's cost map.
     pub cost_maps: bool,
+    /// Gather the polygon-ID view ([`RefineRun::ids`]).
+    pub ids: bool,
 }
 
 /// A tap on the stream: each frame's cost map and display-list bytes, and the stream
@@ -306,6 +311,7 @@ pub fn run_refine(
         };
         let full = RefineSetup {
             cost_maps: false,
+            ids: false,
             ..setup.clone()
         };
         let mut rows = rows(&pass(&full, &all, None, None)?, &reference);
@@ -330,6 +336,11 @@ pub fn run_refine(
         })
         .collect();
     let (width, lines, channels) = (h.width as usize, h.lines as usize, h.channel_count());
+    let ids = if setup.ids {
+        Some(IdImage::gather(&p.refine.id_view()?, lines)?)
+    } else {
+        None
+    };
     Ok(RefineRun {
         scene: Source::resolve(setup.scene)?.name(),
         header: h,
@@ -346,5 +357,6 @@ pub fn run_refine(
         highlight: p.refine.highlight_pass(),
         frames: p.frames,
         cost_maps: p.maps,
+        ids,
     })
 }

@@ -18,6 +18,7 @@ use cwisim_render::settings::{
 use cwisim_render::{Settings, Size, Source};
 use cwisim_study::cost::render_cost_image;
 use cwisim_study::refine::{run_refine, RefineRun, RefineSetup};
+use cwisim_study::refine_ids::{encode_id_npy, id_rgb};
 use cwisim_study::refine_plot::render_refine_plot;
 use cwisim_study::refine_report::{csv, write_table, Sweep};
 use std::io::Write;
@@ -64,6 +65,11 @@ pub struct RefineArgs {
     /// Write each phase's cost image (instructions per pixel) as DIR/phase-K-NAME-cost.png.
     #[arg(long, value_name = "DIR")]
     pub cost_images: Option<PathBuf>,
+    /// Write the polygon-ID view: which polygon of the display list owns each pixel
+    /// (the paper's ID buffer), as a false-colour .png or the identifiers as .npy
+    /// (uint32; 0 none, k the display list's polygon k-1).
+    #[arg(long, value_name = "OUT.png|OUT.npy")]
+    pub ids: Option<PathBuf>,
     /// Write the table as CSV (one line per phase, refined and naive).
     #[arg(long, value_name = "OUT.csv")]
     pub csv: Option<PathBuf>,
@@ -102,6 +108,7 @@ fn default_plot(args: &RefineArgs) -> Result<Option<PathBuf>, CliError> {
         || args.frames_png.is_some()
         || args.cost_images.is_some()
         || args.csv.is_some()
+        || args.ids.is_some()
         || args.plot.is_some();
     if any {
         return Ok(args.plot.clone());
@@ -119,8 +126,14 @@ pub fn run(args: &RefineArgs, stdout: &mut dyn Write, progress: bool) -> Result<
             ("--trace", args.trace.as_deref()),
             ("--csv", args.csv.as_deref()),
             ("--plot", plot.as_deref()),
+            ("--ids", args.ids.as_deref()),
         ],
     )?;
+    let ids_npy = match &args.ids {
+        Some(p) if p.extension().is_some_and(|e| e.eq_ignore_ascii_case("npy")) => Some(true),
+        Some(p) => check_extension("--ids", p, "png").map(|()| Some(false))?,
+        None => None,
+    };
     if let Some(p) = &plot {
         check_extension("--plot", p, "png")?;
     }
@@ -133,6 +146,7 @@ pub fn run(args: &RefineArgs, stdout: &mut dyn Write, progress: bool) -> Result<
             ("--trace", args.trace.is_some()),
             ("--frames-png", args.frames_png.is_some()),
             ("--cost-images", args.cost_images.is_some()),
+            ("--ids", args.ids.is_some()),
         ] {
             if given {
                 return Err(CliError::Usage(format!(
@@ -181,6 +195,7 @@ pub fn run(args: &RefineArgs, stdout: &mut dyn Write, progress: bool) -> Result<
             machine: machine.clone(),
             naive: k == 0,
             cost_maps: args.cost_images.is_some(),
+            ids: args.ids.is_some(),
         };
         let mut report = |lines: u64| bar.update(done_before + lines);
         let trace = encoding
@@ -223,6 +238,15 @@ pub fn run(args: &RefineArgs, stdout: &mut dyn Write, progress: bool) -> Result<
             let name = format!("{}, {}", first.scene, stem(k, first));
             let img = render_cost_image(map, &name)?;
             write_rgb_png(&dir.join(format!("{}-cost.png", stem(k, first))), &img)?;
+        }
+    }
+    if let (Some(path), Some(npy), Some(ids)) = (&args.ids, ids_npy, &first.ids) {
+        if npy {
+            write_atomic(path, |w| {
+                encode_id_npy(w, ids).map_err(|e| CliError::write(path, e))
+            })?;
+        } else {
+            write_rgb_png(path, &id_rgb(ids))?;
         }
     }
     if let Some(path) = &args.csv {

@@ -27,6 +27,7 @@
 
 pub mod display;
 pub mod frame;
+pub mod ids;
 pub mod measure;
 pub mod sketch;
 
@@ -353,6 +354,12 @@ impl Refine {
         }
         self.plans = plans;
         self.modes = modes;
+    }
+
+    /// The polygon-ID view of the display list (its polygons in order, identifiers from
+    /// 1), drawn one scanline at a time.
+    pub fn id_view(&self) -> Result<ids::IdView, RenderError> {
+        ids::IdView::new(&self.scene.screen)
     }
 
     /// For the registry.
