@@ -159,8 +159,8 @@ Example:\n  cwisim tradeoff pot --csv pot.csv --plot pot-tradeoff.png",
 each a complete frame through the array (Bergman, Fuchs, Grant and Spach, 1986; --renderer refine): \
 (with --phases vertices,edges,… first depth-cued points and lines) flat, Gouraud for polygons whose vertex-intensity range exceeds --gouraud-threshold, Phong for \
 polygons whose highlight vector is within --phong-angle degrees of the eye, and the box filter on \
-pixels whose 3x3 range in the previous frame exceeds --aa-threshold (the rest re-sent as Eval0 \
-claims). Per phase it prints the pixels processed, instructions (total, regenerated), bus-busy \
+pixels whose 3x3 range in the previous frame exceeds --aa-threshold (the previous frame's \
+instructions re-sent around them, masked with Dis). Per phase it prints the pixels processed, instructions (total, regenerated), bus-busy \
 and cumulative cycles, the worst scanline against the line period, late scanlines, RMS error \
 and PSNR against the full-quality image (render --shading phong --aa box) and the display \
 list's bytes against a frame buffer's; then the naive sequence, every phase's renderer in full \

@@ -209,7 +209,7 @@ fn refine_prints_its_phases_and_refuses_bad_thresholds() {
         "phase 2      Gouraud:",
         "phase 3      Phong:",
         "phase 4      anti-aliasing: 4096 of 4096 pixels box-filtered (100.0%),",
-        "0 Eval0 claims",
+        "0 Dis masks",
     ] {
         assert!(out.contains(row), "no `{row}`: {out}");
     }

@@ -1,16 +1,15 @@
 //! A phase's frame of instructions. Every row is the display list's polygons, in parts
 //! (those kept as the previous frame drew them, then those the phase regenerates), each
 //! part scanned on its own with its `Refresh` held back, and one `Refresh` to end the row.
-//! The anti-aliasing frame first re-sends the previous frame's unflagged pixels as
-//! `Eval0` claims.
+//! The anti-aliasing frame re-sends the previous frame's instructions with its flagged
+//! pixels masked (`Dis`), then the box filter with the others masked.
 
 use super::display::Subset;
 use super::Phase;
 use crate::phong::PhongFrame;
 use crate::renderer::{Counters, FramePlan};
-use cwisim_isa::{Instruction, Intensity, Opcode, TraceWrite};
+use cwisim_isa::{Instruction, Opcode, TraceWrite};
 use cwisim_scene::{Antialias, Shading};
-use cwisim_xproc::Image;
 use cwisim_ypipe::{emit_rows, Claim, Options, ScanPlan};
 use std::io;
 use std::ops::Range;
@@ -136,21 +135,92 @@ impl FramePlan for Shaded<'_> {
     }
 }
 
-/// A pixel's values as bits: runs are of bit-identical values, so that a claim re-sends
-/// exactly what the array output (`-0.0` is not `+0.0`).
-fn same_bits(a: &[f64], b: &[f64]) -> bool {
-    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
+/// A sink that lets the Evals of one row write only where `writes` (the row's pixels) is
+/// true: before an Eval whose span reaches a pixel it must not write, one `Dis` per run
+/// of such pixels in the span. `Dis` lasts until the next Eval, so each mask holds for
+/// exactly the Eval after it; the wave still passes through a masked processor and picks
+/// up its preloads (docs/ISA.md), so every unmasked pixel gets bit for bit what the
+/// stream alone gives it. An Eval that would write nothing is dropped, as long as nothing
+/// but Evals (and `Acc_mode`, `Nop`) has come before it in the row: then no preload or
+/// mask is pending that its wave would have consumed or cleared.
+struct Masked<'s> {
+    inner: &'s mut dyn TraceWrite,
+    writes: &'s [bool],
+    /// Whether an Eval that writes nothing may still be dropped.
+    may_drop: bool,
+    written: u64,
+    masks: u64,
 }
 
-/// The anti-aliasing frame: per row, the previous frame's unflagged pixels claimed with
-/// `Eval0`, then (in rows with a flagged pixel) the box filter of the whole display list.
+impl TraceWrite for Masked<'_> {
+    fn write(&mut self, i: &Instruction) -> io::Result<()> {
+        match i.op {
+            Opcode::Eval0 | Opcode::Eval1 | Opcode::Eval2 | Opcode::Eval3 => {
+                let (a, b) = i.span().map_or((0, 0), |(a, b)| (a as usize, b as usize));
+                let span = &self.writes[a..b];
+                if self.may_drop && !span.contains(&true) {
+                    return Ok(());
+                }
+                let mut x = 0;
+                while x < span.len() {
+                    if span[x] {
+                        x += 1;
+                        continue;
+                    }
+                    let start = x;
+                    while x < span.len() && !span[x] {
+                        x += 1;
+                    }
+                    self.inner
+                        .write(&Instruction::dis((a + start) as u32, (x - start) as u32))?;
+                    self.masks += 1;
+                }
+            }
+            Opcode::AccMode | Opcode::Nop | Opcode::Refresh => {}
+            _ => self.may_drop = false,
+        }
+        self.written += 1;
+        self.inner.write(i)
+    }
+
+    fn finish(&mut self) -> io::Result<()> {
+        Ok(())
+    }
+}
+
+/// Writes `row` of `parts` without their `Refresh`, masked to the pixels of `writes`:
+/// `(instructions, masks)`, the masks not among the instructions.
+fn emit_masked_row(
+    parts: &[Part],
+    row: u32,
+    writes: &[bool],
+    sink: &mut dyn TraceWrite,
+) -> io::Result<(u64, u64)> {
+    let mut masked = Masked {
+        inner: sink,
+        writes,
+        may_drop: true,
+        written: 0,
+        masks: 0,
+    };
+    emit_row(parts, row, &mut masked)?;
+    Ok((masked.written, masked.masks))
+}
+
+/// The anti-aliasing frame, per row: the previous frame's own instructions with its
+/// flagged pixels masked (so the others come out bit for bit as before), then — in rows
+/// with a flagged pixel — the box filter of the whole display list with the unflagged
+/// pixels masked. A row with no flagged pixel is the previous frame's row; a row with
+/// every pixel flagged is the box filter's.
 pub struct Antialiased<'a> {
     /// The display list, box-filtered.
     pub parts: Vec<Part<'a>>,
-    /// The previous frame's output.
-    pub previous: &'a Image,
+    /// The previous frame's parts (point-sampled), in the order it sent them.
+    pub previous_parts: Vec<Part<'a>>,
     /// The pixels to filter, row-major.
     pub flags: Vec<bool>,
+    /// Pixel columns.
+    pub width: usize,
     /// Their fragments (`super::measure::aa_fragments`).
     pub fragments: u64,
 }
@@ -166,43 +236,34 @@ impl FramePlan for Antialiased<'_> {
     }
 
     fn emit_rows(&self, rows: Range<u32>, sink: &mut dyn TraceWrite) -> io::Result<Counters> {
-        let (w, ch) = (self.previous.width, self.previous.channels);
-        let (mut claims, mut regenerated) = (0u64, 0u64);
+        let w = self.width;
+        // instructions re-sent from the previous frame and regenerated, each with its masks
+        let (mut kept, mut regenerated, mut masks) = (0u64, 0u64, 0u64);
         let mut rows_count = 0u64;
+        let mut keep = vec![false; w];
         for row in rows {
             rows_count += 1;
             let r = row as usize;
             let flags = &self.flags[r * w..(r + 1) * w];
-            let value = |x: usize| &self.previous.data[(r * w + x) * ch..(r * w + x + 1) * ch];
-            let mut x = 0;
-            while x < w {
-                if flags[x] {
-                    x += 1;
-                    continue;
-                }
-                // a run of equal values (bit for bit: a NaN, which equals nothing, is a
-                // run of one)
-                let start = x;
-                x += 1;
-                while x < w && !flags[x] && same_bits(value(x), value(start)) {
-                    x += 1;
-                }
-                sink.write(&Instruction::eval0(
-                    start as u32,
-                    (x - start) as u32,
-                    Intensity::new(value(start)),
-                ))?;
-                claims += 1;
+            for (k, &f) in keep.iter_mut().zip(flags) {
+                *k = !f;
+            }
+            if keep.iter().any(|&k| k) {
+                let (n, m) = emit_masked_row(&self.previous_parts, row, &keep, sink)?;
+                kept += n + m;
+                masks += m;
             }
             if flags.iter().any(|&f| f) {
-                regenerated += emit_row(&self.parts, row, sink)?.0;
+                let (n, m) = emit_masked_row(&self.parts, row, flags, sink)?;
+                regenerated += n + m;
+                masks += m;
             }
             sink.write(&Instruction::refresh())?;
         }
         let p = Phase::Antialias;
         Ok(Counters::default()
-            .with("aa_claims", claims)
-            .with(p.counter("instructions"), claims + regenerated + rows_count)
+            .with("aa_masks", masks)
+            .with(p.counter("instructions"), kept + regenerated + rows_count)
             .with(p.counter("regenerated"), regenerated))
     }
 }

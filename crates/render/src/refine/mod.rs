@@ -17,9 +17,9 @@
 //!    `cwisim_world::shade::PhongShader::highlight_angle`) lit per pixel, point-sampled;
 //! 4. **anti-aliasing** — pixels whose 3 × 3 neighbourhood range in the previous frame's
 //!    output exceeds `--aa-threshold` box-filtered (each polygon as the display list
-//!    draws it); every other pixel keeps the previous frame's value, re-sent as an
-//!    `Eval0` claim (one per run of equal values) before the box filter's instructions,
-//!    which the claimed (locked) processors then ignore.
+//!    draws it); every other pixel keeps the previous frame's value: the previous
+//!    frame's own instructions are re-sent with the flagged pixels masked (`Dis` before
+//!    each Eval reaching them), then the box filter's with the others masked.
 //!
 //! A screen scene (intensities only, nothing to light) is drawn as one frame: Gouraud
 //! with the box filter, as `vanrij` draws it. Shadows are not built: no scene format
@@ -52,7 +52,7 @@ use std::time::Duration;
 
 /// The registry's one line about it.
 pub const ABOUT: &str =
-    "Bergman et al.'s adaptive refinement: each phase a complete frame (flat, Gouraud above a range threshold, Phong within a highlight angle, box filter on pixels whose 3x3 range exceeds a threshold, the rest re-sent as Eval0 claims)";
+    "Bergman et al.'s adaptive refinement: each phase a complete frame (flat, Gouraud above a range threshold, Phong within a highlight angle, box filter on pixels whose 3x3 range exceeds a threshold, the rest re-sent from the previous frame with Dis masks)";
 
 /// A phase: one complete frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
@@ -67,7 +67,7 @@ pub enum Phase {
     Gouraud,
     /// Polygons passing the highlight test lit per pixel, point-sampled.
     Phong,
-    /// Flagged pixels box-filtered, the rest claimed with the previous frame's values.
+    /// Flagged pixels box-filtered, the rest re-sent as the previous frame drew them.
     Antialias,
     /// A screen scene: the polygons as given, Gouraud, box filter (one frame).
     Whole,
@@ -488,9 +488,23 @@ impl Renderer for Refine {
                     )));
                 }
                 let flags = aa_flags(previous, lines, self.aa_threshold);
+                // the previous frame's own parts, in the order it sent them
+                let previous_parts = match k.checked_sub(1).and_then(|j| self.plans.get(j)) {
+                    Some(Plan::Shaded { kept, refined }) => {
+                        let mut parts = Part::of(kept, Antialias::None, tolerance);
+                        parts.extend(Part::of(refined, Antialias::None, tolerance));
+                        parts
+                    }
+                    _ => {
+                        return Err(RenderError::Usage(
+                            "refine's anti-aliasing phase follows a shading phase (flat, gouraud or phong)".into(),
+                        ))
+                    }
+                };
                 Box::new(Antialiased {
                     parts: Part::of(list, Antialias::Box, tolerance),
-                    previous,
+                    previous_parts,
+                    width: w,
                     fragments: measure::aa_fragments(&self.scene.screen, &flags),
                     flags,
                 })
@@ -551,11 +565,11 @@ impl Renderer for Refine {
                     self.highlight.1
                 ),
                 Phase::Antialias => format!(
-                    "anti-aliasing: {} of {pixels} pixels box-filtered ({:.1}%), {} fragments, {} Eval0 claims re-send the rest",
+                    "anti-aliasing: {} of {pixels} pixels box-filtered ({:.1}%), {} fragments, {} Dis masks (the previous frame re-sent around them)",
                     get("aa_pixels"),
                     100.0 * get("aa_pixels") as f64 / pixels.max(1) as f64,
                     get("aa_fragments"),
-                    get("aa_claims")
+                    get("aa_masks")
                 ),
                 Phase::Whole => String::new(),
             };
