@@ -778,3 +778,38 @@ fn anti_aliasing_a_few_pixels_costs_less_than_the_full_box_filter() {
     );
     assert!(masks > 0);
 }
+
+#[test]
+fn kept_pixels_are_the_previous_frames_in_a_narrow_fixed_format_too() {
+    // the kept pixels get the very instructions that made them, masks around them
+    // included, so a fixed format whose I register is narrower than acc keeps them bit
+    // for bit as well
+    let settings = thresholds(
+        Threshold::Above(0.02),
+        Threshold::Above(30.0),
+        Threshold::Above(0.05),
+    );
+    let r = build("refine", scene("pot", 96), &settings);
+    let h = r.header();
+    let (w, lines, ch) = (h.width as usize, h.lines as usize, h.channel_count());
+    let array = ArrayConfig {
+        numeric: "fixed:I=12.20,dI=4.28,ddI=1.36,acc=12.36".parse().unwrap(),
+        ..ArrayConfig::default()
+    };
+    let mut sink = ImageSink::new(w, ch, 1 << 30);
+    render(&*r, &array, 1, &mut sink, Taps::default()).unwrap();
+    let data = sink.finish().unwrap().data;
+    let per = w * lines * ch;
+    let (phong, aa) = (&data[2 * per..3 * per], &data[3 * per..4 * per]);
+    let flags = brute_flags(phong, w, lines, ch, 0.05);
+    let kept = flags.iter().filter(|&&f| !f).count();
+    assert!(kept > 0 && kept < w * lines);
+    for (p, _) in flags.iter().enumerate().filter(|(_, &f)| !f) {
+        let (a, b) = (&phong[p * ch..(p + 1) * ch], &aa[p * ch..(p + 1) * ch]);
+        assert_eq!(
+            a.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+            b.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+            "pixel {p}"
+        );
+    }
+}
