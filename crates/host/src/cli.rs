@@ -8,8 +8,8 @@ use crate::commands::machine::MachineCmdArgs;
 use crate::commands::run::RunArgs;
 use crate::commands::scene::{EmitArgs, RenderArgs};
 use crate::commands::{
-    convert, diff, dump, fit, history, inspect, machine, renderers, run, scene, scenes, stats,
-    tradeoff, vcd,
+    convert, diff, dump, fit, history, inspect, machine, refine, renderers, run, scene, scenes,
+    stats, tradeoff, vcd,
 };
 use crate::error::CliError;
 use clap::{Parser, Subcommand};
@@ -152,6 +152,27 @@ Example:\n  cwisim tradeoff pot --csv pot.csv --plot pot-tradeoff.png",
         after_help = AFTER_HELP
     )]
     Tradeoff(tradeoff::TradeoffArgs),
+
+    /// Adaptive refinement (Bergman et al.) phase by phase: cost against error
+    #[command(
+        long_about = "Refine one world scene (a file or an embedded name; default the pot) in phases, \
+each a complete frame through the array (Bergman, Fuchs, Grant and Spach, 1986; --renderer refine): \
+(with --phases vertices,edges,… first depth-cued points and lines) flat, Gouraud for polygons whose vertex-intensity range exceeds --gouraud-threshold, Phong for \
+polygons whose highlight vector is within --phong-angle degrees of the eye, and the box filter on \
+pixels whose 3x3 range in the previous frame exceeds --aa-threshold (the previous frame's \
+instructions re-sent around them, masked with Dis). Per phase it prints the pixels processed, instructions (total, regenerated), bus-busy \
+and cumulative cycles, the worst scanline against the line period, late scanlines, RMS error \
+and PSNR against the full-quality image (render --shading phong --aa box) and the display \
+list's bytes against a frame buffer's; then the naive sequence, every phase's renderer in full \
+(the paper's figure 1).\n\n\
+--plot draws error against cumulative cycles (with the naive sequence) and busy cycles per \
+scanline of each frame against the line period; --cost-images writes each phase's cost image; \
+--frames-png each frame; --ids the polygon-ID view (which polygon owns each pixel: false-colour .png, or the identifiers as .npy); --sweep NAME=V1,V2,… repeats the run per value of one threshold. \
+docs/RENDERERS.md (\"refine\") and docs/REPRODUCTION.md have the results.\n\n\
+Example:\n  cwisim refine pot --plot quality.png --cost-images costs/",
+        after_help = AFTER_HELP
+    )]
+    Refine(refine::RefineArgs),
 
     /// The narrowest fixed-point registers that draw a scene within an error
     #[command(
@@ -344,6 +365,7 @@ fn dispatch(
         Command::Scenes(args) => scenes::run(args, stdout, stderr).map(|()| 0),
         Command::Renderers(args) => renderers::run(args, stdout).map(|()| 0),
         Command::Tradeoff(args) => tradeoff::run(args, stdout).map(|()| 0),
+        Command::Refine(args) => refine::run(args, stdout, progress).map(|()| 0),
         Command::Fit(args) => fit::run(args, stdout).map(|()| 0),
         Command::Emit(args) => scene::run_emit(args).map(|()| 0),
         Command::Stats(args) => stats::run(args, stdout, stderr).map(|()| 0),

@@ -1,7 +1,7 @@
 //! How a scene is drawn, as the command line says it: `--renderer`, `--shading`, `--aa`,
 //! `--visibility`, `--eval0-tolerance`, `--size`, the supersampling renderers' `--samples`,
 //! `--grid`, `--merge-subscanlines`, `--shade-p`, `--shade-contrast`, `--seed`, and Barkan &
-//! Gordon's `--cp-increment`, `--sbuffer`, `--order`, `--unset`, and refinement's thresholds — one flattened group shared by
+//! Gordon's `--cp-increment`, `--sbuffer`, `--order`, `--unset`, and refinement's thresholds and `--phong-angle` — one flattened group shared by
 //! `render`, `emit`, `stats` and `fit`, converted into `cwisim-render`'s plain
 //! [`Settings`].
 
@@ -10,6 +10,7 @@ use clap::{Args, ValueEnum};
 use cwisim_render::cp::Increment;
 use cwisim_render::settings::{
     BspOrder, SbufferMode, Threshold, Unset, DEFAULT_AA_THRESHOLD, DEFAULT_GOURAUD_THRESHOLD,
+    DEFAULT_PHONG_ANGLE,
 };
 use cwisim_render::subsample::Grid;
 use cwisim_render::{registry, LoadedScene, Renderer, Settings, Size, Source};
@@ -330,6 +331,16 @@ pub struct DrawArgs {
         help_heading = "Adaptive refinement (refine)"
     )]
     pub aa_threshold: Threshold,
+    /// Refinement's Phong phase lights per pixel a polygon whose highlight vector (the
+    /// light mirrored in the normal) at some vertex is within DEG degrees of the
+    /// direction to the eye; `all` or `none`.
+    #[arg(
+        long,
+        value_name = "DEG",
+        default_value_t = Threshold::Above(DEFAULT_PHONG_ANGLE),
+        help_heading = "Adaptive refinement (refine)"
+    )]
+    pub phong_angle: Threshold,
 }
 
 impl Default for DrawArgs {
@@ -359,6 +370,7 @@ impl Default for DrawArgs {
             subscan: 1,
             gouraud_threshold: Threshold::Above(DEFAULT_GOURAUD_THRESHOLD),
             aa_threshold: Threshold::Above(DEFAULT_AA_THRESHOLD),
+            phong_angle: Threshold::Above(DEFAULT_PHONG_ANGLE),
         }
     }
 }
@@ -402,6 +414,7 @@ impl DrawArgs {
             subscan: self.subscan,
             gouraud_threshold: self.gouraud_threshold,
             aa_threshold: self.aa_threshold,
+            phong_angle: self.phong_angle,
         }
     }
 

@@ -207,7 +207,9 @@ fn refine_prints_its_phases_and_refuses_bad_thresholds() {
     for row in [
         "phase 1      flat:",
         "phase 2      Gouraud:",
-        "phase 3      anti-aliasing: 4096 of 4096 pixels box-filtered (100.0%), 0 Eval0 claims",
+        "phase 3      Phong:",
+        "phase 4      anti-aliasing: 4096 of 4096 pixels box-filtered (100.0%),",
+        "0 Dis masks",
     ] {
         assert!(out.contains(row), "no `{row}`: {out}");
     }
@@ -224,6 +226,16 @@ fn refine_prints_its_phases_and_refuses_bad_thresholds() {
             "expected `all`, `none` or a finite number",
         ),
         ("--shading", "phong", "--shading phong does not apply"),
+        (
+            "--phong-angle",
+            "200",
+            "--phong-angle is an angle in degrees",
+        ),
+        (
+            "--phong-angle",
+            "wide",
+            "expected `all`, `none` or a finite number",
+        ),
     ] {
         let out = cwisim(
             &dir,

@@ -99,6 +99,8 @@ fn an_output_extension_the_command_cannot_write_is_refused() {
         &["render", "fig25", "--npy", "x.png"],
         &["render", "fig25", "--cost-image", "x.bmp"],
         &["tradeoff", "fig25", "--plot", "x.svg"],
+        &["refine", "--plot", "x.svg"],
+        &["refine", "--csv", "x.txt"],
     ] {
         let out = cwisim(&dir, args);
         let (_, stderr) = text(&out);

@@ -99,6 +99,9 @@ pub struct Settings {
     /// Adaptive refinement: a pixel is box-filtered when the range of its 3 × 3
     /// neighbourhood in the previous frame passes this.
     pub aa_threshold: Threshold,
+    /// Adaptive refinement: a polygon is Phong-shaded when the angle (degrees) between a
+    /// corner's highlight vector and the direction to the eye is within this.
+    pub phong_angle: Threshold,
 }
 
 /// A refinement threshold: `all` (everything passes), `none` (nothing does), or a
@@ -120,6 +123,19 @@ impl Threshold {
             Threshold::All => true,
             Threshold::None => false,
             Threshold::Above(t) => measure > t,
+        }
+    }
+}
+
+impl Threshold {
+    /// Whether `measure` lies within the threshold read as a tolerance (`--phong-angle`:
+    /// an angle passes when it is at most `T`): `all` admits everything, a missing
+    /// measure too; `none` admits nothing; a number `T` admits a measure `≤ T`.
+    pub fn admits(self, measure: Option<f64>) -> bool {
+        match self {
+            Threshold::All => true,
+            Threshold::None => false,
+            Threshold::Above(t) => measure.is_some_and(|m| m <= t),
         }
     }
 }
@@ -249,6 +265,7 @@ impl Default for Settings {
             subscan: 1,
             gouraud_threshold: Threshold::Above(DEFAULT_GOURAUD_THRESHOLD),
             aa_threshold: Threshold::Above(DEFAULT_AA_THRESHOLD),
+            phong_angle: Threshold::Above(DEFAULT_PHONG_ANGLE),
         }
     }
 }
@@ -257,6 +274,11 @@ impl Default for Settings {
 pub const DEFAULT_GOURAUD_THRESHOLD: f64 = 1.0 / 32.0;
 /// `--aa-threshold`'s default: a 3 × 3 range of 1/16.
 pub const DEFAULT_AA_THRESHOLD: f64 = 1.0 / 16.0;
+
+/// `--phong-angle`'s default, degrees.
+pub const DEFAULT_PHONG_ANGLE: f64 = 30.0;
+/// The widest `--phong-angle`, degrees: every angle between two directions is within it.
+pub const MAX_PHONG_ANGLE: f64 = 180.0;
 
 /// The widest root tolerance: the whole parameter interval.
 pub const MAX_ROOT_TOLERANCE: f64 = 1.0;
@@ -270,6 +292,13 @@ pub const MIN_FLATNESS: f64 = 1e-3;
 impl Settings {
     /// Refuses settings no renderer could use, saying which and why.
     pub fn check(&self) -> Result<(), String> {
+        if let Threshold::Above(a) = self.phong_angle {
+            if a > MAX_PHONG_ANGLE {
+                return Err(format!(
+                    "--phong-angle is an angle in degrees between 0 and {MAX_PHONG_ANGLE} (or `all`, `none`), found {a}"
+                ));
+            }
+        }
         if !(self.eval0_tolerance >= 0.0 && self.eval0_tolerance.is_finite()) {
             return Err(format!(
                 "--eval0-tolerance must be a finite number ≥ 0, found {}",
@@ -382,6 +411,16 @@ mod tests {
         assert!(!Threshold::None.passes(1e300));
         assert!(Threshold::Above(0.5).passes(0.6));
         assert!(!Threshold::Above(0.5).passes(0.5));
+        assert!(Threshold::Above(0.5).admits(Some(0.5)));
+        assert!(!Threshold::Above(0.5).admits(Some(0.6)));
+        assert!(!Threshold::Above(180.0).admits(None));
+        assert!(Threshold::All.admits(None));
+        assert!(!Threshold::None.admits(Some(0.0)));
+        let wide = Settings {
+            phong_angle: Threshold::Above(181.0),
+            ..Settings::default()
+        };
+        assert!(wide.check().unwrap_err().contains("--phong-angle"));
     }
 
     #[test]

@@ -9,6 +9,9 @@
 //!   stats chart: bus cycles per scanline by opcode group against the line period.
 //! * [`tradeoff`] — one scene over a grid of renderers and settings, each measured
 //!   against the exact image, with the Pareto front; [`tradeoff_plot`] draws it.
+//! * [`refine`] — Bergman et al.'s adaptive refinement measured phase by phase against
+//!   the full-quality image and the naive sequence; [`refine_report`] its table, CSV and
+//!   sweeps, [`refine_plot`] its chart.
 //! * [`fit`] — the narrowest fixed-point registers within an error budget.
 //! * [`history`] — one pixel's history: every instruction that reached it on a scanline,
 //!   registers before and after; [`vcd`] — a scanline's per-cycle waveform as a Value
@@ -26,6 +29,10 @@ pub mod fit;
 pub mod history;
 pub mod inspect;
 pub mod plot;
+pub mod refine;
+pub mod refine_ids;
+pub mod refine_plot;
+pub mod refine_report;
 pub mod tradeoff;
 pub mod tradeoff_plot;
 pub mod until;

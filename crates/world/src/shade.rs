@@ -53,6 +53,43 @@ impl PhongShader {
         Some((point, normal))
     }
 
+    /// Bergman et al.'s highlight measure of `t` (their Phong test, docs/ERRATA.md
+    /// "RB5"): the smallest angle, in degrees, between a corner's highlight vector `R`
+    /// (the vector to a light mirrored in the corner's unit normal, `2 (N·L) N − L`) and
+    /// the direction of maximum highlight, the unit vector `V` to the eye — over the three
+    /// corners and every light that lights the corner (`N·L > 0`, the lighting formula's
+    /// own rule). `None` when no light lights a corner, or the material has no specular
+    /// term in any channel: such a triangle has no highlight to refine.
+    pub fn highlight_angle(&self, t: &ScreenTriangle) -> Option<f64> {
+        let m = self.materials.get(t.mesh as usize)?;
+        if (0..self.lighting.channels).all(|c| m.k_s.get(c) == 0.0) {
+            return None;
+        }
+        let mut best: Option<f64> = None;
+        for k in 0..3 {
+            let point = t.surface.world[k];
+            let Some(n) = t.surface.normals[k].try_normalize() else {
+                continue;
+            };
+            let Some(v) = (self.eye - point).try_normalize() else {
+                continue;
+            };
+            for light in &self.lighting.lights {
+                let Some(l) = (DVec3::from_array(light.position) - point).try_normalize() else {
+                    continue;
+                };
+                let n_dot_l = n.dot(l);
+                if n_dot_l <= 0.0 {
+                    continue;
+                }
+                let r = 2.0 * n_dot_l * n - l;
+                let angle = r.dot(v).clamp(-1.0, 1.0).acos().to_degrees();
+                best = Some(best.map_or(angle, |b| b.min(angle)));
+            }
+        }
+        best
+    }
+
     /// The intensity of `t` at screen point `p` (see [`Self::surface_at`]).
     pub fn at(&self, t: &ScreenTriangle, p: [f64; 2]) -> Option<Vector> {
         let (point, normal) = self.surface_at(t, p)?;

@@ -7,6 +7,7 @@ pub mod fit;
 pub mod history;
 pub mod inspect;
 pub mod machine;
+pub mod refine;
 pub mod renderers;
 pub mod run;
 pub mod scene;

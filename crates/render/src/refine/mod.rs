@@ -2,161 +2,243 @@
 //! (1986), on a display without a frame buffer. The paper refines one image in place;
 //! the CWI array keeps nothing from one frame to the next (each `Refresh` shifts a
 //! scanline out), so here **each phase is a complete frame**, re-sent from the host's
-//! display list, in which a phase regenerates only the polygons or pixels it refines:
+//! display list ([`display`]), in which a phase regenerates only the polygons or pixels it
+//! refines ([`frame`]):
 //!
+//! 0. optionally (`--phases`), the paper's first two: **vertices**, the model's corners as
+//!    depth-cued points, and **edges**, its triangles' edges as depth-cued one-pixel
+//!    lines ([`sketch`]);
 //! 1. **flat** — every polygon at one intensity (the mean of its vertex intensities),
 //!    point-sampled;
 //! 2. **Gouraud** — polygons whose vertex-intensity range exceeds `--gouraud-threshold`
-//!    Gouraud-shaded, the rest as in phase 1, point-sampled;
-//! 3. **anti-aliasing** — pixels whose 3 × 3 neighbourhood range in the previous frame's
-//!    output exceeds `--aa-threshold` box-filtered; every other pixel keeps the previous
-//!    frame's value, re-sent as an `Eval0` claim (one per run of equal values) before the
-//!    box filter's instructions, which the claimed (locked) processors then ignore.
+//!    Gouraud-shaded, the rest as in the previous frame, point-sampled;
+//! 3. **Phong** — polygons passing the paper's highlight test (a corner's highlight
+//!    vector within `--phong-angle` degrees of the direction to the eye,
+//!    `cwisim_world::shade::PhongShader::highlight_angle`) lit per pixel, point-sampled;
+//! 4. **anti-aliasing** — pixels whose 3 × 3 neighbourhood range in the previous frame's
+//!    output exceeds `--aa-threshold` box-filtered (each polygon as the display list
+//!    draws it); every other pixel keeps the previous frame's value: the previous
+//!    frame's own instructions are re-sent with the flagged pixels masked (`Dis` before
+//!    each Eval reaching them), then the box filter's with the others masked.
 //!
 //! A screen scene (intensities only, nothing to light) is drawn as one frame: Gouraud
-//! with the box filter, as `vanrij` draws it. Phong and the paper's earlier phases
-//! (vertices, edges) are not built yet (docs/RENDERERS.md, "Adaptive refinement").
+//! with the box filter, as `vanrij` draws it. Shadows are not built: no scene format
+//! carries the paper's precomputed shadow polygons (docs/RENDERERS.md, "refine").
+
+pub mod display;
+pub mod frame;
+pub mod ids;
+pub mod measure;
+pub mod sketch;
+
+pub use measure::{aa_flags, flattened, intensity_range};
 
 use crate::error::RenderError;
 use crate::prepare::PolygonScene;
 use crate::renderer::{Counters, FramePlan, Renderer};
 use crate::settings::{Settings, Threshold};
 use crate::source::LoadedScene;
-use crate::vanrij;
-use cwisim_isa::{Instruction, Intensity, TraceHeader, TraceWrite};
-use cwisim_scene::{Antialias, Polygon, ScreenScene, Shading};
+use cwisim_isa::TraceHeader;
+use cwisim_scene::{Antialias, Shading};
 use cwisim_world::{AnyScene, Visibility};
 use cwisim_xproc::{Image, RunStats};
-use cwisim_ypipe::{emit_rows, header, Claim, Options, ScanPlan};
+use cwisim_ypipe::{emit_rows, header, ScanPlan};
+use display::{Mode, Subset};
+use frame::{Antialiased, Part, Shaded, BOX};
+use sketch::{Sketch, SketchFrame};
 use std::io;
 use std::ops::Range;
 use std::time::Duration;
 
 /// The registry's one line about it.
 pub const ABOUT: &str =
-    "Bergman et al.'s adaptive refinement: each phase a complete frame (flat, Gouraud above a threshold, box filter on pixels whose 3x3 range exceeds a threshold, the rest re-sent as Eval0 claims)";
+    "Bergman et al.'s adaptive refinement: each phase a complete frame (flat, Gouraud above a range threshold, Phong within a highlight angle, box filter on pixels whose 3x3 range exceeds a threshold, the rest re-sent from the previous frame with Dis masks)";
 
 /// A phase: one complete frame.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Phase {
+    /// The model's vertices as depth-cued points.
+    Vertices,
+    /// The triangles' edges as depth-cued one-pixel lines.
+    Edges,
     /// Every polygon at its mean intensity, point-sampled.
     Flat,
     /// Polygons above the Gouraud threshold Gouraud-shaded, point-sampled.
     Gouraud,
-    /// Flagged pixels box-filtered, the rest claimed with the previous frame's values.
+    /// Polygons passing the highlight test lit per pixel, point-sampled.
+    Phong,
+    /// Flagged pixels box-filtered, the rest re-sent as the previous frame drew them.
     Antialias,
     /// A screen scene: the polygons as given, Gouraud, box filter (one frame).
     Whole,
 }
 
 impl Phase {
-    /// Its name in the summary.
+    /// Its name (in `--phases` and the summary).
     pub fn name(self) -> &'static str {
         match self {
+            Phase::Vertices => "vertices",
+            Phase::Edges => "edges",
             Phase::Flat => "flat",
             Phase::Gouraud => "gouraud",
-            Phase::Antialias => "anti-aliasing",
+            Phase::Phong => "phong",
+            Phase::Antialias => "aa",
             Phase::Whole => "whole",
         }
     }
 
-    /// Counter: instructions it emitted.
-    fn instructions(self) -> &'static str {
-        match self {
-            Phase::Flat => "flat_instructions",
-            Phase::Gouraud => "gouraud_instructions",
-            Phase::Antialias => "aa_instructions",
-            Phase::Whole => "instructions",
-        }
+    /// The counter `what` (`instructions`, `regenerated`, `pixels`, `polygons` — for
+    /// the vertex and edge phases, the points or lines drawn) of this phase:
+    /// `gouraud_polygons`, `aa_instructions`, ….
+    pub fn counter(self, what: &str) -> &'static str {
+        const NAMES: [[&str; 4]; 7] = [
+            [
+                "vertices_instructions",
+                "vertices_regenerated",
+                "vertices_pixels",
+                "vertices_drawn",
+            ],
+            [
+                "edges_instructions",
+                "edges_regenerated",
+                "edges_pixels",
+                "edges_drawn",
+            ],
+            [
+                "flat_instructions",
+                "flat_regenerated",
+                "flat_pixels",
+                "flat_polygons",
+            ],
+            [
+                "gouraud_instructions",
+                "gouraud_regenerated",
+                "gouraud_pixels",
+                "gouraud_polygons",
+            ],
+            [
+                "phong_instructions",
+                "phong_regenerated",
+                "phong_pixels",
+                "phong_polygons",
+            ],
+            [
+                "aa_instructions",
+                "aa_regenerated",
+                "aa_pixels",
+                "aa_polygons",
+            ],
+            ["instructions", "regenerated", "pixels", "polygons"],
+        ];
+        let row = match self {
+            Phase::Vertices => 0,
+            Phase::Edges => 1,
+            Phase::Flat => 2,
+            Phase::Gouraud => 3,
+            Phase::Phong => 4,
+            Phase::Antialias => 5,
+            Phase::Whole => 6,
+        };
+        let col = match what {
+            "instructions" => 0,
+            "regenerated" => 1,
+            "pixels" => 2,
+            _ => 3,
+        };
+        NAMES[row][col]
     }
 }
 
 /// The phases of a world scene, in order.
-pub const WORLD_PHASES: [Phase; 3] = [Phase::Flat, Phase::Gouraud, Phase::Antialias];
+pub const WORLD_PHASES: [Phase; 4] = [Phase::Flat, Phase::Gouraud, Phase::Phong, Phase::Antialias];
 
-/// The polygon at one intensity: the mean of its vertex intensities, per channel (the
-/// flat value every renderer takes, `cwisim_ypipe::flat_mean`).
-pub fn flattened(p: &Polygon) -> Polygon {
-    let channels = p.intensity.first().map_or(0, Vec::len);
-    let mean = cwisim_ypipe::flat_mean(&p.intensity, channels)[..channels].to_vec();
-    Polygon {
-        vertices: p.vertices.clone(),
-        intensity: vec![mean; p.intensity.len()],
-        depth: p.depth.clone(),
-    }
-}
-
-/// The polygon's vertex-intensity range: the largest, over channels, of max − min over
-/// its vertices (the Gouraud test's measure).
-pub fn intensity_range(p: &Polygon) -> f64 {
-    let channels = p.intensity.first().map_or(0, Vec::len);
-    (0..channels)
-        .map(|c| {
-            let (lo, hi) = p
-                .intensity
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
-                    (lo.min(v[c]), hi.max(v[c]))
-                });
-            hi - lo
-        })
-        .fold(0.0, f64::max)
-}
-
-/// The anti-aliasing test: for each pixel of `image` (`lines × width`), whether the range
-/// (max − min, largest over channels) of its 3 × 3 neighbourhood, clipped to the image,
-/// passes `threshold`.
-pub fn aa_flags(image: &Image, lines: usize, threshold: Threshold) -> Vec<bool> {
-    let (w, ch) = (image.width, image.channels);
-    let mut flags = vec![false; w * lines];
-    for y in 0..lines {
-        for x in 0..w {
-            let mut range = 0.0f64;
-            for c in 0..ch {
-                let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-                for ny in y.saturating_sub(1)..(y + 2).min(lines) {
-                    for nx in x.saturating_sub(1)..(x + 2).min(w) {
-                        let v = image.data[(ny * w + nx) * ch + c];
-                        lo = lo.min(v);
-                        hi = hi.max(v);
-                    }
-                }
-                range = range.max(hi - lo);
+/// `--phases`: a comma-separated list of `vertices`, `edges`, `flat`, `gouraud`, `phong`,
+/// `aa`, in that order, each at most once, with `flat` whenever a later phase refines it.
+pub fn parse_phases(list: &str) -> Result<Vec<Phase>, String> {
+    const KNOWN: &str = "vertices, edges, flat, gouraud, phong, aa";
+    let mut phases = Vec::new();
+    for name in list.split(',').map(str::trim) {
+        let phase = match name {
+            "vertices" => Phase::Vertices,
+            "edges" => Phase::Edges,
+            "flat" => Phase::Flat,
+            "gouraud" => Phase::Gouraud,
+            "phong" => Phase::Phong,
+            "aa" | "anti-aliasing" => Phase::Antialias,
+            "shadows" => {
+                return Err(format!(
+                    "--phases: the paper's shadow phase is not built: no scene format carries its precomputed shadow polygons (docs/RENDERERS.md, \"refine\"); known: {KNOWN}"
+                ))
             }
-            flags[y * w + x] = threshold.passes(range);
+            _ => return Err(format!("--phases: unknown phase `{name}`; known: {KNOWN}")),
+        };
+        if phases.last().is_some_and(|&p| p >= phase) {
+            return Err(format!(
+                "--phases: `{name}` out of order or repeated; the phases run {KNOWN}, each at most once"
+            ));
         }
+        if phase > Phase::Flat && !phases.contains(&Phase::Flat) {
+            return Err(format!(
+                "--phases: `{name}` refines the flat frame: list `flat` before it"
+            ));
+        }
+        phases.push(phase);
     }
-    flags
+    Ok(phases)
 }
 
-/// A pixel's values as bits: runs are of bit-identical values, so that a claim re-sends
-/// exactly what the array output (`-0.0` is not `+0.0`).
-fn same_bits(a: &[f64], b: &[f64]) -> bool {
-    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
+/// What one phase's frame draws.
+#[derive(Clone, Debug)]
+enum Plan {
+    /// Kept polygons as the previous frame drew them, then the regenerated ones.
+    Shaded {
+        kept: Box<Subset>,
+        refined: Box<Subset>,
+    },
+    /// The whole display list, box-filtered on flagged pixels.
+    Antialias { list: Box<Subset> },
+    /// Points or lines.
+    Sketch(Box<Sketch>),
+    /// A screen scene as `vanrij` draws it.
+    Whole,
 }
 
 /// Adaptive refinement on a scene's polygons.
 #[derive(Clone, Debug)]
 pub struct Refine {
     scene: PolygonScene,
-    /// Phase 1's polygons.
-    flat: ScreenScene,
-    /// Phase 2's polygons.
-    gouraud: ScreenScene,
-    /// How many polygons phase 2 Gouraud-shades.
-    gouraud_polygons: u64,
     phases: Vec<Phase>,
+    plans: Vec<Plan>,
+    /// How each polygon is drawn after the last shading phase.
+    modes: Vec<Mode>,
+    gouraud_polygons: u64,
+    phong_polygons: u64,
+    /// Visible triangles (with a fragment in the display list) passing the highlight
+    /// test, and how many are visible.
+    highlight: (u64, u64),
     gouraud_threshold: Threshold,
+    phong_angle: Threshold,
     aa_threshold: Threshold,
+    shade_tolerance: f64,
 }
 
 impl Refine {
-    /// The refinement of `loaded` under `settings`.
+    /// The refinement of `loaded` under `settings`, in every phase.
     pub fn new(loaded: LoadedScene, settings: &Settings) -> Result<Refine, RenderError> {
+        Refine::with_phases(loaded, settings, &WORLD_PHASES)
+    }
+
+    /// The refinement of `loaded` under `settings` in `phases` (of a world scene; a screen
+    /// scene is one frame). `phases` as [`parse_phases`] admits them.
+    pub fn with_phases(
+        loaded: LoadedScene,
+        settings: &Settings,
+        phases: &[Phase],
+    ) -> Result<Refine, RenderError> {
         let loaded = loaded.drawn_as(settings)?;
         if settings.shading != Shading::Gouraud {
             return Err(RenderError::Usage(format!(
-                "--renderer refine chooses each phase's shading itself (flat, then Gouraud above --gouraud-threshold); --shading {} does not apply: leave it at gouraud",
+                "--renderer refine chooses each phase's shading itself (flat, then Gouraud above --gouraud-threshold, Phong within --phong-angle); --shading {} does not apply: leave it at gouraud",
                 settings.shading
             )));
         }
@@ -170,33 +252,114 @@ impl Refine {
                 "--renderer refine point-samples its first phases and box-filters in its last: --aa does not apply, leave it at box".into(),
             ));
         }
+        let names: Vec<&str> = phases.iter().map(|p| p.name()).collect();
+        let checked = parse_phases(&names.join(",")).map_err(RenderError::Usage)?;
         let world = matches!(loaded.scene, AnyScene::World(_));
-        let scene = PolygonScene::new(loaded, settings)?;
-        let mut flat = scene.screen.clone();
-        let mut gouraud = scene.screen.clone();
-        let mut gouraud_polygons = 0;
-        for (k, p) in scene.screen.polygons.iter().enumerate() {
-            flat.polygons[k] = flattened(p);
-            if settings.gouraud_threshold.passes(intensity_range(p)) {
-                gouraud_polygons += 1;
+        // a world scene is prepared for Phong (the same fragments and vertex intensities
+        // as Gouraud, and the source triangle of each): every phase draws from it
+        let prepared = Settings {
+            shading: if world {
+                Shading::Phong
             } else {
-                gouraud.polygons[k] = flat.polygons[k].clone();
-            }
-        }
-        let phases = if world {
-            WORLD_PHASES.to_vec()
-        } else {
-            vec![Phase::Whole]
+                Shading::Gouraud
+            },
+            ..*settings
         };
-        Ok(Refine {
-            scene,
-            flat,
-            gouraud,
-            gouraud_polygons,
-            phases,
+        let scene = PolygonScene::new(loaded, &prepared)?;
+        let n = scene.screen.polygons.len();
+        let mut refine = Refine {
+            phases: if world { checked } else { vec![Phase::Whole] },
+            plans: Vec::new(),
+            modes: vec![Mode::Flat; n],
+            gouraud_polygons: 0,
+            phong_polygons: 0,
+            highlight: (0, 0),
             gouraud_threshold: settings.gouraud_threshold,
+            phong_angle: settings.phong_angle,
             aa_threshold: settings.aa_threshold,
-        })
+            shade_tolerance: settings.shade_tolerance,
+            scene,
+        };
+        if let Some(s) = &refine.scene.phong {
+            // the triangles that show: those with a visible fragment
+            let mut visible = s.sources.clone();
+            visible.sort_unstable();
+            visible.dedup();
+            let passing = visible
+                .iter()
+                .filter(|&&k| {
+                    let t = &s.triangles[k];
+                    settings.phong_angle.admits(s.shader.highlight_angle(t))
+                })
+                .count();
+            refine.highlight = (passing as u64, visible.len() as u64);
+        }
+        refine.plan();
+        Ok(refine)
+    }
+
+    /// Each phase's plan, and the display list's modes as they end.
+    fn plan(&mut self) {
+        let scene = &self.scene;
+        let n = scene.screen.polygons.len();
+        let mut modes = vec![Mode::Flat; n];
+        let mut plans = Vec::new();
+        for &phase in &self.phases {
+            let next: Vec<Mode> = (0..n)
+                .map(|k| {
+                    let p = &scene.screen.polygons[k];
+                    match phase {
+                        Phase::Gouraud
+                            if modes[k] == Mode::Flat
+                                && self.gouraud_threshold.passes(intensity_range(p)) =>
+                        {
+                            Mode::Gouraud
+                        }
+                        Phase::Phong
+                            if scene.phong.as_ref().is_some_and(|s| {
+                                let t = &s.triangles[s.sources[k]];
+                                self.phong_angle.admits(s.shader.highlight_angle(t))
+                            }) =>
+                        {
+                            Mode::Phong
+                        }
+                        _ => modes[k],
+                    }
+                })
+                .collect();
+            let changed: Vec<bool> = (0..n)
+                .map(|k| phase == Phase::Flat || next[k] != modes[k])
+                .collect();
+            let regenerated = changed.iter().filter(|&&c| c).count() as u64;
+            match phase {
+                Phase::Gouraud => self.gouraud_polygons = regenerated,
+                Phase::Phong => self.phong_polygons = regenerated,
+                _ => {}
+            }
+            let (w, h) = (scene.screen.width, scene.screen.height);
+            let triangles = scene.phong.as_ref().map_or(&[][..], |s| &s.triangles[..]);
+            plans.push(match phase {
+                Phase::Whole => Plan::Whole,
+                Phase::Vertices => Plan::Sketch(Box::new(Sketch::points(triangles, w, h))),
+                Phase::Edges => Plan::Sketch(Box::new(Sketch::edges(triangles, w, h))),
+                Phase::Antialias => Plan::Antialias {
+                    list: Box::new(Subset::of(scene, &next, |_| true)),
+                },
+                _ => Plan::Shaded {
+                    kept: Box::new(Subset::of(scene, &modes, |k| !changed[k])),
+                    refined: Box::new(Subset::of(scene, &next, |k| changed[k])),
+                },
+            });
+            modes = next;
+        }
+        self.plans = plans;
+        self.modes = modes;
+    }
+
+    /// The polygon-ID view of the display list (its polygons in order, identifiers from
+    /// 1), drawn one scanline at a time.
+    pub fn id_view(&self) -> Result<ids::IdView, RenderError> {
+        ids::IdView::new(&self.scene.screen)
     }
 
     /// For the registry.
@@ -212,9 +375,25 @@ impl Refine {
         &self.phases
     }
 
-    /// The polygons phase 2 Gouraud-shades.
+    /// The polygons the Gouraud phase Gouraud-shades.
     pub fn gouraud_polygons(&self) -> u64 {
         self.gouraud_polygons
+    }
+
+    /// The polygons (visible fragments) the Phong phase lights per pixel.
+    pub fn phong_polygons(&self) -> u64 {
+        self.phong_polygons
+    }
+
+    /// The visible triangles (those with a fragment in the display list) passing the
+    /// highlight test, and how many are visible: the paper's Phong pass rate.
+    pub fn highlight_pass(&self) -> (u64, u64) {
+        self.highlight
+    }
+
+    /// How each polygon is drawn after the last shading phase.
+    pub fn modes(&self) -> &[Mode] {
+        &self.modes
     }
 
     /// The polygons of every phase as prepared (the full-quality scene).
@@ -223,100 +402,22 @@ impl Refine {
     }
 }
 
-const POINT: Options = Options {
-    shading: Shading::Gouraud,
-    aa: Antialias::None,
-    claim: Claim::Accumulate,
-};
-
-const BOX: Options = Options {
-    shading: Shading::Gouraud,
-    aa: Antialias::Box,
-    claim: Claim::Accumulate,
-};
-
-/// A point-sampled or whole frame: a scene through DO_FILL.
-struct Drawn<'a> {
+/// A screen scene's one frame: `vanrij`'s box filter.
+struct Whole<'a> {
     plan: ScanPlan<'a>,
-    options: &'static Options,
-    phase: Phase,
-    regenerated: u64,
 }
 
-impl FramePlan for Drawn<'_> {
+impl FramePlan for Whole<'_> {
     fn counters(&self) -> Counters {
-        let c = Counters::default();
-        match self.phase {
-            Phase::Whole => vanrij::counters(&self.plan.scene_stats()),
-            Phase::Gouraud => c.with("gouraud_polygons", self.regenerated),
-            _ => c,
-        }
+        crate::vanrij::counters(&self.plan.scene_stats())
     }
 
-    fn emit_rows(&self, rows: Range<u32>, sink: &mut dyn TraceWrite) -> io::Result<Counters> {
-        let e = emit_rows(&self.plan, self.options, rows, sink)?;
-        Ok(match self.phase {
-            Phase::Whole => vanrij::counters(&e),
-            p => Counters::default().with(p.instructions(), e.instructions),
-        })
-    }
-}
-
-/// The anti-aliasing frame: per row, the previous frame's unflagged pixels claimed with
-/// `Eval0`, then (in rows with a flagged pixel) the box filter's instructions.
-struct Antialiased<'a> {
-    plan: ScanPlan<'a>,
-    previous: &'a Image,
-    flags: Vec<bool>,
-    width: usize,
-}
-
-impl FramePlan for Antialiased<'_> {
-    fn counters(&self) -> Counters {
-        Counters::default().with(
-            "aa_pixels",
-            self.flags.iter().filter(|&&f| f).count() as u64,
-        )
-    }
-
-    fn emit_rows(&self, rows: Range<u32>, sink: &mut dyn TraceWrite) -> io::Result<Counters> {
-        let (w, ch) = (self.width, self.previous.channels);
-        let mut claims = 0u64;
-        let mut instructions = 0u64;
-        for row in rows {
-            let r = row as usize;
-            let flags = &self.flags[r * w..(r + 1) * w];
-            let value = |x: usize| &self.previous.data[(r * w + x) * ch..(r * w + x + 1) * ch];
-            let mut x = 0;
-            while x < w {
-                if flags[x] {
-                    x += 1;
-                    continue;
-                }
-                // a run of equal values (bit for bit: a NaN, which equals nothing, is a
-                // run of one)
-                let start = x;
-                x += 1;
-                while x < w && !flags[x] && same_bits(value(x), value(start)) {
-                    x += 1;
-                }
-                sink.write(&Instruction::eval0(
-                    start as u32,
-                    (x - start) as u32,
-                    Intensity::new(value(start)),
-                ))?;
-                claims += 1;
-            }
-            if flags.iter().any(|&f| f) {
-                instructions += emit_rows(&self.plan, &BOX, row..row + 1, sink)?.instructions;
-            } else {
-                sink.write(&Instruction::refresh())?;
-                instructions += 1;
-            }
-        }
-        Ok(Counters::default()
-            .with("aa_claims", claims)
-            .with("aa_instructions", instructions + claims))
+    fn emit_rows(
+        &self,
+        rows: Range<u32>,
+        sink: &mut dyn cwisim_isa::TraceWrite,
+    ) -> io::Result<Counters> {
+        emit_rows(&self.plan, &BOX, rows, sink).map(|e| crate::vanrij::counters(&e))
     }
 }
 
@@ -342,25 +443,31 @@ impl Renderer for Refine {
         index: u32,
         previous: Option<&'a Image>,
     ) -> Result<Box<dyn FramePlan + 'a>, RenderError> {
-        let phase = *self.phases.get(index as usize).ok_or_else(|| {
-            RenderError::Usage(format!(
+        let k = index as usize;
+        let (Some(&phase), Some(plan)) = (self.phases.get(k), self.plans.get(k)) else {
+            return Err(RenderError::Usage(format!(
                 "refine has {} frame(s); frame {index} asked for",
                 self.phases.len()
-            ))
-        })?;
-        let drawn = |scene: &'a ScreenScene, options: &'static Options, regenerated| {
-            Box::new(Drawn {
-                plan: ScanPlan::new(scene, options),
-                options,
-                phase,
-                regenerated,
-            })
+            )));
         };
-        Ok(match phase {
-            Phase::Whole => drawn(&self.scene.screen, &BOX, 0),
-            Phase::Flat => drawn(&self.flat, &POINT, 0),
-            Phase::Gouraud => drawn(&self.gouraud, &POINT, self.gouraud_polygons),
-            Phase::Antialias => {
+        let tolerance = self.shade_tolerance;
+        Ok(match plan {
+            Plan::Sketch(sketch) => Box::new(SketchFrame {
+                sketch,
+                channels: self.header().channel_count(),
+                names: ["instructions", "regenerated", "pixels", "polygons"]
+                    .map(|what| phase.counter(what)),
+            }),
+            Plan::Whole => Box::new(Whole {
+                plan: ScanPlan::new(&self.scene.screen, &BOX),
+            }),
+            Plan::Shaded { kept, refined } => Box::new(Shaded {
+                phase,
+                kept: Part::of(kept, Antialias::None, tolerance),
+                refined: Part::of(refined, Antialias::None, tolerance),
+                refined_polygons: refined.polygons,
+            }),
+            Plan::Antialias { list } => {
                 let h = self.header();
                 let previous = previous.ok_or_else(|| {
                     RenderError::Usage(
@@ -380,11 +487,26 @@ impl Renderer for Refine {
                         h.channel_count()
                     )));
                 }
+                let flags = aa_flags(previous, lines, self.aa_threshold);
+                // the previous frame's own parts, in the order it sent them
+                let previous_parts = match k.checked_sub(1).and_then(|j| self.plans.get(j)) {
+                    Some(Plan::Shaded { kept, refined }) => {
+                        let mut parts = Part::of(kept, Antialias::None, tolerance);
+                        parts.extend(Part::of(refined, Antialias::None, tolerance));
+                        parts
+                    }
+                    _ => {
+                        return Err(RenderError::Usage(
+                            "refine's anti-aliasing phase follows a shading phase (flat, gouraud or phong)".into(),
+                        ))
+                    }
+                };
                 Box::new(Antialiased {
-                    plan: ScanPlan::new(&self.scene.screen, &BOX),
-                    previous,
-                    flags: aa_flags(previous, lines, self.aa_threshold),
+                    parts: Part::of(list, Antialias::Box, tolerance),
+                    previous_parts,
                     width: w,
+                    fragments: measure::aa_fragments(&self.scene.screen, &flags),
+                    flags,
                 })
             }
         })
@@ -394,49 +516,69 @@ impl Renderer for Refine {
         if self.phases == [Phase::Whole] {
             return "a screen scene: one frame, Gouraud shading, box filter (exact)".into();
         }
+        let names: Vec<&str> = self.phases.iter().map(|p| p.name()).collect();
         format!(
-            "adaptive refinement: flat, Gouraud above range {}, box filter where the 3x3 range exceeds {} (point sampling before), exact visibility",
-            self.gouraud_threshold, self.aa_threshold
+            "adaptive refinement ({}): Gouraud above range {}, Phong within {}° of the highlight, box filter where the 3x3 range exceeds {} (point sampling before), exact visibility",
+            names.join(", "),
+            self.gouraud_threshold,
+            self.phong_angle,
+            self.aa_threshold
         )
     }
 
     fn summary_rows(&self, counters: &Counters, stats: &RunStats) -> Vec<(&'static str, String)> {
+        const LABELS: [&str; 6] = [
+            "phase 1", "phase 2", "phase 3", "phase 4", "phase 5", "phase 6",
+        ];
         let mut rows = self.scene.summary_rows();
         if self.phases == [Phase::Whole] {
             return rows;
         }
         let pixels = u64::from(self.header().lines) * u64::from(self.header().width);
         let polygons = self.scene.screen.polygons.len() as u64;
+        let get = |name: &str| counters.get(name).unwrap_or(0);
         for (k, phase) in self.phases.iter().enumerate() {
             let frame = stats.lines.iter().filter(|l| l.frame == k as u64);
             let (busy, worst) = frame.fold((0u64, 0u64), |(b, w), l| {
                 (b + l.busy_cycles, w.max(l.busy_cycles))
             });
             let what = match phase {
-                Phase::Flat => format!("flat: {polygons} polygons at one intensity, {pixels} pixels"),
+                Phase::Vertices => format!(
+                    "vertices: {} depth-cued points, {} pixels",
+                    get("vertices_drawn"),
+                    get("vertices_pixels")
+                ),
+                Phase::Edges => format!(
+                    "edges: {} depth-cued lines, {} pixels",
+                    get("edges_drawn"),
+                    get("edges_pixels")
+                ),
+                Phase::Flat => format!("flat: {polygons} polygons at one intensity"),
                 Phase::Gouraud => format!(
                     "Gouraud: {} of {polygons} polygons Gouraud-shaded",
-                    counters.get("gouraud_polygons").unwrap_or(0)
+                    get("gouraud_polygons")
+                ),
+                Phase::Phong => format!(
+                    "Phong: {} of {polygons} polygons lit per pixel ({} of {} visible triangles within the highlight angle)",
+                    get("phong_polygons"),
+                    self.highlight.0,
+                    self.highlight.1
                 ),
                 Phase::Antialias => format!(
-                    "anti-aliasing: {} of {pixels} pixels box-filtered ({:.1}%), {} Eval0 claims re-send the rest",
-                    counters.get("aa_pixels").unwrap_or(0),
-                    100.0 * counters.get("aa_pixels").unwrap_or(0) as f64 / pixels.max(1) as f64,
-                    counters.get("aa_claims").unwrap_or(0)
+                    "anti-aliasing: {} of {pixels} pixels box-filtered ({:.1}%), {} fragments, {} Dis masks (the previous frame re-sent around them)",
+                    get("aa_pixels"),
+                    100.0 * get("aa_pixels") as f64 / pixels.max(1) as f64,
+                    get("aa_fragments"),
+                    get("aa_masks")
                 ),
                 Phase::Whole => String::new(),
             };
-            let label: &'static str = match phase {
-                Phase::Flat => "phase 1",
-                Phase::Gouraud => "phase 2",
-                Phase::Antialias => "phase 3",
-                Phase::Whole => "phase",
-            };
             rows.push((
-                label,
+                LABELS[k.min(LABELS.len() - 1)],
                 format!(
-                    "{what}; {} instructions, {busy} busy cycles (worst scanline {worst} of the line period {})",
-                    counters.get(phase.instructions()).unwrap_or(0),
+                    "{what}; {} instructions ({} regenerated), {busy} busy cycles (worst scanline {worst} of the line period {})",
+                    get(phase.counter("instructions")),
+                    get(phase.counter("regenerated")),
                     stats.line_period
                 ),
             ));
@@ -452,6 +594,7 @@ impl Renderer for Refine {
         let mut j = self.scene.scene_json();
         j["phases"] = serde_json::json!(self.phases.iter().map(|p| p.name()).collect::<Vec<_>>());
         j["gouraud_polygons"] = serde_json::json!(self.gouraud_polygons);
+        j["phong_polygons"] = serde_json::json!(self.phong_polygons);
         j
     }
 }

@@ -1,0 +1,264 @@
+//! `cwisim refine`: Bergman et al.'s adaptive refinement measured phase by phase (the
+//! measuring is `cwisim_study::refine`'s; this is the command: arguments, files, the
+//! table).
+
+use super::MachineArgs;
+use crate::cost_args::check_extension;
+use crate::error::CliError;
+use crate::files::{check_outputs, write_atomic};
+use crate::output::{write_png, write_rgb_png};
+use crate::progress::Progress;
+use clap::Args;
+use cwisim_isa::encoding::Encoding;
+use cwisim_isa::{Instruction, TraceWrite};
+use cwisim_render::refine::{parse_phases, Phase};
+use cwisim_render::settings::{
+    Threshold, DEFAULT_AA_THRESHOLD, DEFAULT_GOURAUD_THRESHOLD, DEFAULT_PHONG_ANGLE,
+};
+use cwisim_render::{Settings, Size, Source};
+use cwisim_study::cost::render_cost_image;
+use cwisim_study::refine::{run_refine, RefineRun, RefineSetup};
+use cwisim_study::refine_ids::{encode_id_npy, id_rgb};
+use cwisim_study::refine_plot::render_refine_plot;
+use cwisim_study::refine_report::{csv, write_table, Sweep};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// The arguments of `cwisim refine`.
+#[derive(Args, Clone, Debug, PartialEq)]
+pub struct RefineArgs {
+    /// The scene: a file or an embedded name (default: the pot). A world scene: a screen
+    /// scene has nothing to refine.
+    #[arg(value_name = "SCENE")]
+    pub scene: Option<PathBuf>,
+    /// The phases to run, comma-separated, in this order: vertices, edges (depth-cued
+    /// points and lines), flat, gouraud, phong, aa; flat before any phase refining it.
+    #[arg(long, value_name = "LIST", default_value = "flat,gouraud,phong,aa")]
+    pub phases: String,
+    /// The Gouraud phase shades a polygon whose vertex-intensity range exceeds T; `all`
+    /// or `none`.
+    #[arg(long, value_name = "T", default_value_t = Threshold::Above(DEFAULT_GOURAUD_THRESHOLD))]
+    pub gouraud_threshold: Threshold,
+    /// The Phong phase lights per pixel a polygon whose highlight vector at some vertex is
+    /// within DEG degrees of the direction to the eye; `all` or `none`.
+    #[arg(long, value_name = "DEG", default_value_t = Threshold::Above(DEFAULT_PHONG_ANGLE))]
+    pub phong_angle: Threshold,
+    /// The anti-aliasing phase box-filters a pixel whose 3x3 range in the previous frame
+    /// exceeds T; `all` or `none`.
+    #[arg(long, value_name = "T", default_value_t = Threshold::Above(DEFAULT_AA_THRESHOLD))]
+    pub aa_threshold: Threshold,
+    /// Draw at this size, WIDTHxHEIGHT (default: the scene's).
+    #[arg(long, value_name = "WxH")]
+    pub size: Option<Size>,
+    /// Tessellate Bézier meshes N×N per patch (default: as the scene says).
+    #[arg(long, value_name = "N")]
+    pub tessellate: Option<u32>,
+    /// Phong's span fitter tolerance, in intensity.
+    #[arg(long, value_name = "E", default_value_t = 1.0 / 512.0)]
+    pub shade_tolerance: f64,
+    /// Also write the whole stream, every phase's frame (.cwt, .jsonl or .cwb).
+    #[arg(long, value_name = "OUT")]
+    pub trace: Option<PathBuf>,
+    /// Write each phase's frame as DIR/phase-K-NAME.png.
+    #[arg(long, value_name = "DIR")]
+    pub frames_png: Option<PathBuf>,
+    /// Write each phase's cost image (instructions per pixel) as DIR/phase-K-NAME-cost.png.
+    #[arg(long, value_name = "DIR")]
+    pub cost_images: Option<PathBuf>,
+    /// Write the polygon-ID view: which polygon of the display list owns each pixel
+    /// (the paper's ID buffer), as a false-colour .png or the identifiers as .npy
+    /// (uint32; 0 none, k the display list's polygon k-1).
+    #[arg(long, value_name = "OUT.png|OUT.npy")]
+    pub ids: Option<PathBuf>,
+    /// Write the table as CSV (one line per phase, refined and naive).
+    #[arg(long, value_name = "OUT.csv")]
+    pub csv: Option<PathBuf>,
+    /// Draw error against cumulative cycles (with the naive sequence) and busy cycles per
+    /// scanline against the line period, as a PNG. Without any output option the plot
+    /// goes to SCENE-NAME-refine.png in the working directory.
+    #[arg(long, value_name = "OUT.png")]
+    pub plot: Option<PathBuf>,
+    /// Run once per value of one threshold: NAME=V1,V2,… (NAME: gouraud-threshold,
+    /// phong-angle, aa-threshold).
+    #[arg(long, value_name = "NAME=V1,V2,…")]
+    pub sweep: Option<Sweep>,
+    /// The machine model.
+    #[command(flatten)]
+    pub machine: MachineArgs,
+}
+
+/// `phase-K-NAME` of frame `k`.
+fn stem(k: usize, run: &RefineRun) -> String {
+    format!("phase-{}-{}", k + 1, run.rows[k].phase)
+}
+
+fn create_dir(flag: &str, dir: &Path) -> Result<(), CliError> {
+    if dir.is_file() {
+        return Err(CliError::Usage(format!(
+            "{flag} {}: a file, not a directory",
+            dir.display()
+        )));
+    }
+    std::fs::create_dir_all(dir).map_err(|e| CliError::write(dir, e))
+}
+
+/// The plot `refine` writes when given no output at all: `SCENE-NAME-refine.png`.
+fn default_plot(args: &RefineArgs) -> Result<Option<PathBuf>, CliError> {
+    let any = args.trace.is_some()
+        || args.frames_png.is_some()
+        || args.cost_images.is_some()
+        || args.csv.is_some()
+        || args.ids.is_some()
+        || args.plot.is_some();
+    if any {
+        return Ok(args.plot.clone());
+    }
+    let name = Source::resolve(args.scene.as_deref())?.name();
+    Ok(Some(PathBuf::from(format!("{name}-refine.png"))))
+}
+
+/// Runs `cwisim refine`.
+pub fn run(args: &RefineArgs, stdout: &mut dyn Write, progress: bool) -> Result<(), CliError> {
+    let plot = default_plot(args)?;
+    check_outputs(
+        None,
+        &[
+            ("--trace", args.trace.as_deref()),
+            ("--csv", args.csv.as_deref()),
+            ("--plot", plot.as_deref()),
+            ("--ids", args.ids.as_deref()),
+        ],
+    )?;
+    let ids_npy = match &args.ids {
+        Some(p) if p.extension().is_some_and(|e| e.eq_ignore_ascii_case("npy")) => Some(true),
+        Some(p) => check_extension("--ids", p, "png").map(|()| Some(false))?,
+        None => None,
+    };
+    if let Some(p) = &plot {
+        check_extension("--plot", p, "png")?;
+    }
+    if let Some(p) = &args.csv {
+        check_extension("--csv", p, "csv")?;
+    }
+    let encoding = args.trace.as_deref().map(Encoding::from_path).transpose()?;
+    if args.sweep.is_some() {
+        for (flag, given) in [
+            ("--trace", args.trace.is_some()),
+            ("--frames-png", args.frames_png.is_some()),
+            ("--cost-images", args.cost_images.is_some()),
+            ("--ids", args.ids.is_some()),
+        ] {
+            if given {
+                return Err(CliError::Usage(format!(
+                    "{flag} writes one run's frames; --sweep makes several: drop one of them"
+                )));
+            }
+        }
+    }
+    let phases: Vec<Phase> = parse_phases(&args.phases).map_err(CliError::Usage)?;
+    let settings = Settings {
+        gouraud_threshold: args.gouraud_threshold,
+        phong_angle: args.phong_angle,
+        aa_threshold: args.aa_threshold,
+        size: args.size,
+        tessellate: args.tessellate,
+        shade_tolerance: args.shade_tolerance,
+        ..Settings::default()
+    };
+    settings.check().map_err(CliError::Usage)?;
+    let machine = args.machine.load()?;
+    let runs: Vec<(Option<String>, Settings)> = match &args.sweep {
+        Some(sweep) => sweep
+            .values
+            .iter()
+            .map(|&v| {
+                (
+                    Some(format!("--{} {v}", sweep.name.flag())),
+                    sweep.name.apply(&settings, v),
+                )
+            })
+            .collect(),
+        None => vec![(None, settings)],
+    };
+    for (_, s) in &runs {
+        s.check().map_err(CliError::Usage)?;
+    }
+    let mut bar = Progress::scanlines(0, progress);
+    let mut done_before = 0u64;
+    let mut results: Vec<(Option<String>, RefineRun)> = Vec::new();
+    let mut stream: Vec<Instruction> = Vec::new();
+    for (k, (label, s)) in runs.iter().enumerate() {
+        let setup = RefineSetup {
+            scene: args.scene.as_deref(),
+            settings: *s,
+            phases: phases.clone(),
+            machine: machine.clone(),
+            naive: k == 0,
+            cost_maps: args.cost_images.is_some(),
+            ids: args.ids.is_some(),
+        };
+        let mut report = |lines: u64| bar.update(done_before + lines);
+        let trace = encoding
+            .is_some()
+            .then_some(&mut stream as &mut dyn TraceWrite);
+        let run = run_refine(&setup, trace, Some(&mut report))?;
+        done_before += (run.lines * run.rows.len()) as u64;
+        results.push((label.clone(), run));
+    }
+    drop(bar);
+    for (k, (label, run)) in results.iter().enumerate() {
+        if k > 0 {
+            writeln!(stdout).map_err(CliError::Stdout)?;
+        }
+        write_table(stdout, run, label.as_deref()).map_err(CliError::Stdout)?;
+    }
+    let Some((_, first)) = results.first() else {
+        return Err(CliError::Usage("nothing to run".into()));
+    };
+    if let (Some(path), Some(encoding)) = (&args.trace, encoding) {
+        write_atomic(path, |w| {
+            let mut out = encoding
+                .writer(w, &first.header)
+                .map_err(|e| CliError::write(path, e))?;
+            for i in &stream {
+                out.write(i).map_err(|e| CliError::write(path, e))?;
+            }
+            out.finish().map_err(|e| CliError::write(path, e))
+        })?;
+    }
+    if let Some(dir) = &args.frames_png {
+        create_dir("--frames-png", dir)?;
+        for (k, frame) in first.frames.iter().enumerate() {
+            write_png(&dir.join(format!("{}.png", stem(k, first))), frame)?;
+        }
+    }
+    if let Some(dir) = &args.cost_images {
+        create_dir("--cost-images", dir)?;
+        for (k, map) in first.cost_maps.iter().enumerate() {
+            let name = format!("{}, {}", first.scene, stem(k, first));
+            let img = render_cost_image(map, &name)?;
+            write_rgb_png(&dir.join(format!("{}-cost.png", stem(k, first))), &img)?;
+        }
+    }
+    if let (Some(path), Some(npy), Some(ids)) = (&args.ids, ids_npy, &first.ids) {
+        if npy {
+            write_atomic(path, |w| {
+                encode_id_npy(w, ids).map_err(|e| CliError::write(path, e))
+            })?;
+        } else {
+            write_rgb_png(path, &id_rgb(ids))?;
+        }
+    }
+    if let Some(path) = &args.csv {
+        let text = csv(&results);
+        write_atomic(path, |w| {
+            w.write_all(text.as_bytes())
+                .map_err(|e| CliError::write(path, e))
+        })?;
+    }
+    if let Some(path) = &plot {
+        let img = render_refine_plot(&results).map_err(CliError::Usage)?;
+        write_rgb_png(path, &img)?;
+    }
+    stdout.flush().map_err(CliError::Stdout)
+}

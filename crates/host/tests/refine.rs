@@ -1,0 +1,197 @@
+//! `cwisim refine`: the phase table, the files it writes, sweeps, and clear refusals of
+//! bad input (exit 2, the reason on the first line, nothing written).
+
+mod common;
+
+use common::{cwisim, cwisim_ok, read, scratch, text};
+
+#[test]
+fn refine_prints_the_phase_table_and_writes_its_files() {
+    let dir = scratch("refine-pot");
+    let out = cwisim_ok(
+        &dir,
+        &[
+            "refine",
+            "pot",
+            "--size",
+            "96x96",
+            "--plot",
+            "q.png",
+            "--csv",
+            "q.csv",
+            "--trace",
+            "t.cwb",
+            "--frames-png",
+            "frames",
+            "--cost-images",
+            "costs",
+        ],
+    );
+    let header = "phase    pixels  instructions  regenerated";
+    assert!(out.contains(header), "{out}");
+    for column in [
+        "busy",
+        "cumulative",
+        "worst line",
+        "late",
+        "RMS",
+        "PSNR dB",
+        "display list",
+    ] {
+        assert!(
+            out.lines()
+                .any(|l| l.starts_with("phase ") && l.contains(column)),
+            "{column}: {out}"
+        );
+    }
+    for phase in ["flat", "gouraud", "phong", "aa"] {
+        // a row per phase in the refined sequence and the naive one
+        assert_eq!(
+            out.lines()
+                .filter(|l| l.starts_with(&format!("{phase} ")))
+                .count(),
+            2,
+            "{phase}: {out}"
+        );
+    }
+    assert!(
+        out.contains("naive: every phase's renderer in full"),
+        "{out}"
+    );
+    assert!(out.contains("× FB)"), "{out}");
+    for name in [
+        "phase-1-flat",
+        "phase-2-gouraud",
+        "phase-3-phong",
+        "phase-4-aa",
+    ] {
+        assert!(
+            dir.join("frames").join(format!("{name}.png")).exists(),
+            "{name}"
+        );
+        assert!(
+            dir.join("costs").join(format!("{name}-cost.png")).exists(),
+            "{name}"
+        );
+    }
+    assert!(read(dir.join("q.png")).starts_with(b"\x89PNG"));
+    let csv = String::from_utf8(read(dir.join("q.csv"))).unwrap();
+    assert!(csv.starts_with("scene,sweep,sequence,phase,"), "{csv}");
+    assert_eq!(csv.lines().count(), 1 + 8, "{csv}");
+    // the trace replays: four frames of 96 scanlines
+    let stats = cwisim_ok(&dir, &["stats", "t.cwb"]);
+    assert!(stats.contains("384 of 384 scanline(s)"), "{stats}");
+}
+
+#[test]
+fn a_sweep_prints_one_table_per_value() {
+    let dir = scratch("refine-sweep");
+    let out = cwisim_ok(
+        &dir,
+        &[
+            "refine",
+            "--size",
+            "64x64",
+            "--phases",
+            "flat,phong",
+            "--sweep",
+            "phong-angle=5,none",
+            "--csv",
+            "s.csv",
+        ],
+    );
+    assert!(out.contains("pot (--phong-angle 5)"), "{out}");
+    assert!(out.contains("pot (--phong-angle none)"), "{out}");
+    assert!(!out.contains("\ngouraud "), "{out}");
+    let csv = String::from_utf8(read(dir.join("s.csv"))).unwrap();
+    // two runs of two phases, the first with its naive sequence
+    assert_eq!(csv.lines().count(), 1 + 2 + 2 + 2, "{csv}");
+    // the paper's first phases, before any polygon; with no output named, the plot
+    // goes to SCENE-refine.png
+    assert!(!dir.join("pot-refine.png").exists());
+    let out = cwisim_ok(
+        &dir,
+        &["refine", "--size", "64x64", "--phases", "vertices,edges"],
+    );
+    for phase in ["vertices ", "edges "] {
+        assert!(out.lines().any(|l| l.starts_with(phase)), "{phase}: {out}");
+    }
+    assert!(read(dir.join("pot-refine.png")).starts_with(b"\x89PNG"));
+}
+
+#[test]
+fn bad_input_is_refused_in_one_line_with_exit_2() {
+    let dir = scratch("refine-bad");
+    for (args, says) in [
+        (vec!["--phases", "gouraud,flat"], "--phases"),
+        (vec!["--phases", "flat,vertices"], "out of order"),
+        (vec!["--phases", "flat,shadows"], "not built"),
+        (vec!["--phong-angle", "270"], "--phong-angle is an angle"),
+        (vec!["--aa-threshold", "lots"], "expected `all`, `none`"),
+        (vec!["--sweep", "size=1,2"], "unknown threshold `size`"),
+        (
+            vec!["--sweep", "aa-threshold=0.1,0.2", "--frames-png", "f"],
+            "--frames-png writes one run's frames",
+        ),
+        (vec!["--plot", "q.jpg"], "--plot"),
+        (vec!["no-such-scene"], "no-such-scene"),
+        (vec!["fig25"], "fig25 is a screen scene"),
+    ] {
+        let mut all = vec!["refine", "--size", "32x32"];
+        all.extend(&args);
+        let out = cwisim(&dir, &all);
+        let (_, stderr) = text(&out);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+        // the message is the first line (clap adds a usage hint after its own)
+        let first = stderr.lines().next().unwrap_or("");
+        assert!(first.starts_with("error: "), "{args:?}: {stderr}");
+        assert!(first.contains(says), "{args:?}: {stderr}");
+    }
+    assert!(!dir.join("f").exists());
+    assert!(!dir.join("q.jpg").exists());
+    assert!(!dir.join("pot-refine.png").exists());
+}
+
+#[test]
+fn refine_writes_the_polygon_id_view() {
+    let dir = scratch("refine-ids");
+    let out = cwisim_ok(
+        &dir,
+        &["refine", "pot", "--size", "96x96", "--ids", "ids.npy"],
+    );
+    // the flat phase point-samples every fragment: its pixels are the owned ones
+    let flat: u64 = out
+        .lines()
+        .find(|l| l.starts_with("flat "))
+        .and_then(|l| l.split_whitespace().nth(1))
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no flat row: {out}"));
+    let bytes = read(dir.join("ids.npy"));
+    let npy = npyz::NpyFile::new(&bytes[..]).unwrap();
+    assert_eq!(npy.shape(), &[96, 96]);
+    let ids: Vec<u32> = npy.into_vec().unwrap();
+    assert_eq!(ids.iter().filter(|&&k| k != 0).count() as u64, flat);
+    assert!(ids.iter().all(|&k| k != u32::MAX), "no pixel is shared");
+    let polygons: u32 = out
+        .split(" polygons (visible fragments)")
+        .next()
+        .and_then(|s| s.rsplit(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no polygon count: {out}"));
+    assert!(ids.iter().all(|&k| k <= polygons));
+
+    cwisim_ok(
+        &dir,
+        &["refine", "pot", "--size", "64x64", "--ids", "ids.png"],
+    );
+    assert!(read(dir.join("ids.png")).starts_with(b"\x89PNG"));
+
+    let bad = cwisim(
+        &dir,
+        &["refine", "pot", "--size", "64x64", "--ids", "ids.txt"],
+    );
+    assert_eq!(bad.status.code(), Some(2));
+    let (_, err) = text(&bad);
+    assert!(err.contains("--ids"), "{err}");
+    assert!(!dir.join("ids.txt").exists());
+}
