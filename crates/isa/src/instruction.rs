@@ -84,10 +84,15 @@ impl fmt::Debug for Intensity {
 
 /// One X-processor instruction.
 ///
-/// A uniform record: `x` and `dx` are zero and value slots empty where the opcode has no
-/// such operand ([`Opcode::operands`]). Build them with the constructors, which keep that
-/// invariant.
-#[derive(Clone, Copy, PartialEq, Eq)]
+/// `x` and `dx` are zero and value slots empty where the opcode has no such operand
+/// ([`Opcode::operands`]). Build them with the constructors, which keep that invariant.
+///
+/// The record is as big as what the common instruction carries: the values of a grey
+/// trace (one channel) are held inline, three `f64` slots, and any other intensities
+/// (colour, or slots of unequal lengths, which [`Self::check`] refuses) are boxed
+/// (48 bytes on a 64-bit target, against 136 when every slot had room for four
+/// channels). Equality is bit-exact on the values.
+#[derive(Clone, PartialEq, Eq)]
 pub struct Instruction {
     /// The opcode.
     pub op: Opcode,
@@ -95,17 +100,96 @@ pub struct Instruction {
     pub x: u32,
     /// Range length (`Count`) or period (`Period`).
     pub dx: u32,
-    /// `[I, dI, ddI]`; slots the opcode does not carry are [`Intensity::NONE`].
-    pub values: [Intensity; 3],
+    values: Values,
+}
+
+/// The `[I, dI, ddI]` slots of an [`Instruction`].
+#[derive(Clone)]
+enum Values {
+    /// Every slot empty or of one channel: bit `s` of `present` says slot `s` carries a
+    /// value, held in `v[s]` (0.0 in an empty slot).
+    Grey { present: u8, v: [f64; 3] },
+    /// Anything else.
+    Wide(Box<[Intensity; 3]>),
+}
+
+impl PartialEq for Values {
+    /// Bit-exact, as [`Intensity`]'s. A representation is canonical ([`Values::new`]),
+    /// so a grey and a wide one never hold equal slots.
+    fn eq(&self, other: &Self) -> bool {
+        match (self, other) {
+            (Values::Grey { present: p, v: a }, Values::Grey { present: q, v: b }) => {
+                p == q && a.iter().zip(b).all(|(a, b)| a.to_bits() == b.to_bits())
+            }
+            (Values::Wide(a), Values::Wide(b)) => a == b,
+            _ => false,
+        }
+    }
+}
+
+impl Eq for Values {}
+
+impl Values {
+    fn new(values: [Intensity; 3]) -> Values {
+        if values.iter().all(|v| v.len() <= 1) {
+            let mut present = 0;
+            let mut v = [0.0; 3];
+            for (s, slot) in values.iter().enumerate() {
+                if let [f] = slot.as_slice() {
+                    present |= 1 << s;
+                    v[s] = *f;
+                }
+            }
+            Values::Grey { present, v }
+        } else {
+            Values::Wide(Box::new(values))
+        }
+    }
 }
 
 impl Instruction {
     fn with(op: Opcode, x: u32, dx: u32, i: Intensity, di: Intensity, ddi: Intensity) -> Self {
+        Self::from_parts(op, x, dx, [i, di, ddi])
+    }
+
+    /// An instruction from its fields as they are, the value slots `[I, dI, ddI]` among
+    /// them. Nothing is checked (decoders and fuzzers build what they read, then
+    /// [`Self::check`] it).
+    pub fn from_parts(op: Opcode, x: u32, dx: u32, values: [Intensity; 3]) -> Self {
         Instruction {
             op,
             x,
             dx,
-            values: [i, di, ddi],
+            values: Values::new(values),
+        }
+    }
+
+    /// A grey instruction: bit `s` of `present` says slot `s` carries `v[s]`, and the
+    /// other slots of `v` are 0.0 — what a decoder of a one-channel trace builds.
+    #[inline]
+    pub(crate) fn grey(op: Opcode, x: u32, dx: u32, present: u8, v: [f64; 3]) -> Self {
+        debug_assert!((0..3).all(|s| present & (1 << s) != 0 || v[s].to_bits() == 0));
+        Instruction {
+            op,
+            x,
+            dx,
+            values: Values::Grey { present, v },
+        }
+    }
+
+    /// The values of slot `slot` (0 = `I`, 1 = `dI`, 2 = `ddI`), one per channel; empty
+    /// for a slot the instruction does not carry.
+    #[inline]
+    pub fn value(&self, slot: usize) -> &[f64] {
+        match &self.values {
+            Values::Grey { present, v } => {
+                if present & (1 << slot) != 0 {
+                    std::slice::from_ref(&v[slot])
+                } else {
+                    &[]
+                }
+            }
+            Values::Wide(v) => v[slot].as_slice(),
         }
     }
     /// `SetI(x, I)`.
@@ -217,7 +301,7 @@ impl Instruction {
                 OperandKind::Period => i.dx = period,
                 _ => {
                     let s = kind.value_slot().expect("an intensity operand");
-                    i.values[s] = Intensity::new(&values[s * channels..(s + 1) * channels]);
+                    i.set_value(s, Intensity::new(&values[s * channels..(s + 1) * channels]));
                 }
             }
         }
@@ -228,17 +312,38 @@ impl Instruction {
         Self::with(op, 0, 0, Intensity::NONE, Intensity::NONE, Intensity::NONE)
     }
 
+    /// Slot `slot` as an [`Intensity`] ([`Intensity::NONE`] if the instruction does not
+    /// carry it).
+    pub fn intensity(&self, slot: usize) -> Intensity {
+        match self.value(slot) {
+            [] => Intensity::NONE,
+            v => Intensity::new(v),
+        }
+    }
+
+    /// The three slots `[I, dI, ddI]`.
+    pub fn values(&self) -> [Intensity; 3] {
+        [self.intensity(0), self.intensity(1), self.intensity(2)]
+    }
+
+    /// Replaces slot `slot` (nothing is checked, as [`Self::from_parts`]).
+    pub fn set_value(&mut self, slot: usize, value: Intensity) {
+        let mut values = self.values();
+        values[slot] = value;
+        self.values = Values::new(values);
+    }
+
     /// `I` (empty if the opcode has none).
-    pub fn i(&self) -> &Intensity {
-        &self.values[0]
+    pub fn i(&self) -> Intensity {
+        self.intensity(0)
     }
     /// `dI` (empty if the opcode has none).
-    pub fn di(&self) -> &Intensity {
-        &self.values[1]
+    pub fn di(&self) -> Intensity {
+        self.intensity(1)
     }
     /// `ddI` (empty if the opcode has none).
-    pub fn ddi(&self) -> &Intensity {
-        &self.values[2]
+    pub fn ddi(&self) -> Intensity {
+        self.intensity(2)
     }
 
     /// The processors this instruction addresses, as `(first, end)` of a half-open range,
@@ -286,7 +391,7 @@ impl Instruction {
                 }
                 OperandKind::I | OperandKind::DI | OperandKind::DDI => {
                     let slot = kind.value_slot().expect("value operand");
-                    let v = &self.values[slot];
+                    let v = self.value(slot);
                     if v.len() != header.channel_count() {
                         return Err(OperandError::Channels(format!(
                             "{} has {} channel(s), the trace has {}",
@@ -295,7 +400,7 @@ impl Instruction {
                             header.channels
                         )));
                     }
-                    if let Some(bad) = v.as_slice().iter().find(|f| !f.is_finite()) {
+                    if let Some(bad) = v.iter().find(|f| !f.is_finite()) {
                         return Err(OperandError::NonFinite(format!(
                             "{} holds {bad}; values must be finite",
                             kind.name()
@@ -394,6 +499,37 @@ mod tests {
             Instruction::eval1(0, 1, Intensity::grey(f64::NAN)).check(&h),
             Err(OperandError::NonFinite(_))
         ));
+    }
+
+    #[test]
+    fn the_record_is_as_big_as_a_grey_instruction_carries() {
+        // op, x, dx and three f64s (33 bytes), the slots present and the variant
+        assert!(std::mem::size_of::<Instruction>() <= 48);
+        let grey = Instruction::eval3(
+            1,
+            2,
+            Intensity::grey(0.5),
+            Intensity::grey(-0.0),
+            Intensity::grey(0.25),
+        );
+        assert!(matches!(grey.values, Values::Grey { present: 7, .. }));
+        assert_eq!(grey.value(1)[0].to_bits(), (-0.0f64).to_bits());
+        assert_ne!(
+            grey,
+            Instruction::eval3(
+                1,
+                2,
+                Intensity::grey(0.5),
+                Intensity::grey(0.0),
+                Intensity::grey(0.25)
+            )
+        );
+        let rgb = Instruction::eval1(0, 4, Intensity::new(&[0.1, 0.2, 0.3]));
+        assert!(matches!(rgb.values, Values::Wide(_)));
+        assert_eq!(rgb.value(0), &[0.1, 0.2, 0.3]);
+        assert_eq!(rgb.value(1), &[] as &[f64]);
+        assert_eq!(rgb.i(), Intensity::new(&[0.1, 0.2, 0.3]));
+        assert_eq!(Instruction::refresh().value(0), &[] as &[f64]);
     }
 
     #[test]

@@ -216,7 +216,7 @@ impl<'p, A: Arith> SteppedEngine<'p, A> {
                 out[slot] = vector(
                     &self.arith,
                     reg,
-                    &instr.values[slot],
+                    instr.value(slot),
                     self.channels,
                     overflows,
                 );
@@ -406,7 +406,7 @@ impl<A: Arith> Engine<A::Out> for SteppedEngine<'_, A> {
                 let cost = self.timeline.issue_cycles(instr);
                 self.probe.issue(self.t, self.issued, line, instr);
                 self.bus = Some(Bus {
-                    instr: *instr,
+                    instr: instr.clone(),
                     index: self.issued,
                     line,
                     begin: self.t,
