@@ -11,7 +11,7 @@ use crate::machine::Timeline;
 use crate::numeric::Register;
 use crate::output::{LineOut, LineSink};
 use crate::sample::Sample;
-use crate::stats::{Recorder, RunStats, Work};
+use crate::stats::{LineRecords, Recorder, RunStats, Work};
 use cwisim_isa::{Instruction, Opcode, TraceHeader, MAX_CHANNELS};
 
 const HAS_I: u8 = 1;
@@ -288,8 +288,8 @@ impl<A: Arith> FastEngine<A> {
 }
 
 impl<A: Arith> Engine<A::Out> for FastEngine<A> {
-    fn keep_line_stats(&mut self, keep: bool) {
-        self.recorder.keep_lines(keep);
+    fn line_records(&mut self, to: LineRecords) {
+        self.recorder.line_records(to);
     }
 
     fn execute(&mut self, instr: &Instruction, sink: &mut dyn LineSink<A::Out>) {

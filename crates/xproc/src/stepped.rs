@@ -14,7 +14,7 @@ use crate::numeric::Register;
 use crate::output::{LineOut, LineSink};
 use crate::probe::{NoProbe, Probe, ProcessorState};
 use crate::sample::Sample;
-use crate::stats::{Recorder, RunStats, Work};
+use crate::stats::{LineRecords, Recorder, RunStats, Work};
 use cwisim_isa::{Instruction, Opcode, TraceHeader, MAX_CHANNELS};
 
 type Vector<T> = [T; MAX_CHANNELS];
@@ -385,8 +385,8 @@ impl<'p, A: Arith> SteppedEngine<'p, A> {
 }
 
 impl<A: Arith> Engine<A::Out> for SteppedEngine<'_, A> {
-    fn keep_line_stats(&mut self, keep: bool) {
-        self.recorder.keep_lines(keep);
+    fn line_records(&mut self, to: LineRecords) {
+        self.recorder.line_records(to);
     }
 
     fn execute(&mut self, instr: &Instruction, sink: &mut dyn LineSink<A::Out>) {
