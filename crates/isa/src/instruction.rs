@@ -360,7 +360,46 @@ impl Instruction {
 
     /// Checks the operands against a trace header: ranges inside the array, periods at
     /// least 1, every carried intensity with the trace's channel count and finite values.
+    #[inline]
     pub fn check(&self, header: &TraceHeader) -> Result<(), OperandError> {
+        if self.fits(header) {
+            return Ok(());
+        }
+        self.check_operands(header)
+    }
+
+    /// [`Self::check`]'s verdict without its message, from the opcode's shape in a table:
+    /// the test every sound instruction of a replay passes.
+    #[inline]
+    fn fits(&self, header: &TraceHeader) -> bool {
+        let shape = SHAPES[self.op.index()];
+        let width = header.width;
+        if shape & HAS_X != 0 && self.x >= width {
+            return false;
+        }
+        if shape & HAS_COUNT != 0 && u64::from(self.x) + u64::from(self.dx) > u64::from(width) {
+            return false;
+        }
+        if shape & HAS_PERIOD != 0 && self.dx == 0 {
+            return false;
+        }
+        let slots = shape >> SLOT_SHIFT;
+        match &self.values {
+            Values::Grey { present, v } => {
+                (slots == 0 || header.channels == 1)
+                    && present & slots == slots
+                    && (0..3).all(|s| slots & (1 << s) == 0 || v[s].is_finite())
+            }
+            Values::Wide(w) => (0..3).all(|s| {
+                slots & (1 << s) == 0
+                    || (w[s].len() == header.channel_count()
+                        && w[s].as_slice().iter().all(|f| f.is_finite()))
+            }),
+        }
+    }
+
+    /// [`Self::check`] operand by operand, saying what is wrong.
+    fn check_operands(&self, header: &TraceHeader) -> Result<(), OperandError> {
         let width = header.width;
         for kind in self.op.operands() {
             match kind {
@@ -412,6 +451,36 @@ impl Instruction {
         Ok(())
     }
 }
+
+const HAS_X: u8 = 1;
+const HAS_COUNT: u8 = 2;
+const HAS_PERIOD: u8 = 4;
+/// Bits `SLOT_SHIFT + s` of a shape: the opcode carries value slot `s`.
+const SLOT_SHIFT: u32 = 3;
+
+/// Each opcode's operands as bits ([`HAS_X`], …, and the value slots), by
+/// [`Opcode::index`].
+const SHAPES: [u8; Opcode::COUNT] = {
+    let mut table = [0u8; Opcode::COUNT];
+    let mut i = 0;
+    while i < Opcode::COUNT {
+        let ops = Opcode::ALL[i].operands();
+        let mut k = 0;
+        while k < ops.len() {
+            table[i] |= match ops[k] {
+                OperandKind::X => HAS_X,
+                OperandKind::Count => HAS_COUNT,
+                OperandKind::Period => HAS_PERIOD,
+                OperandKind::I => 1 << SLOT_SHIFT,
+                OperandKind::DI => 2 << SLOT_SHIFT,
+                OperandKind::DDI => 4 << SLOT_SHIFT,
+            };
+            k += 1;
+        }
+        i += 1;
+    }
+    table
+};
 
 impl fmt::Debug for Instruction {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -530,6 +599,41 @@ mod tests {
         assert_eq!(rgb.value(1), &[] as &[f64]);
         assert_eq!(rgb.i(), Intensity::new(&[0.1, 0.2, 0.3]));
         assert_eq!(Instruction::refresh().value(0), &[] as &[f64]);
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::test_runner::Config {
+            failure_persistence: None,
+            ..proptest::test_runner::Config::with_cases(2000)
+        })]
+
+        /// The table's verdict is the operand-by-operand one.
+        #[test]
+        fn fits_is_check_without_the_message(
+            op in 0..Opcode::COUNT,
+            x in 0u32..20,
+            dx in 0u32..20,
+            lens in proptest::array::uniform3(0usize..5),
+            bad in 0usize..16,
+            channels in 1u8..=4,
+        ) {
+            let h = TraceHeader::new(16, 4, channels).unwrap();
+            let mut k = 0;
+            let values = lens.map(|n| {
+                if n == 0 {
+                    return Intensity::NONE;
+                }
+                let v: Vec<f64> = (0..n)
+                    .map(|_| {
+                        k += 1;
+                        if k == bad { f64::NAN } else { 0.5 }
+                    })
+                    .collect();
+                Intensity::new(&v)
+            });
+            let i = Instruction::from_parts(Opcode::ALL[op], x, dx, values);
+            proptest::prop_assert_eq!(i.fits(&h), i.check_operands(&h).is_ok(), "{:?}", i);
+        }
     }
 
     #[test]

@@ -213,7 +213,17 @@ impl Recorder {
         }
     }
 
+    #[inline]
     fn line_mut(&mut self, line: u64) -> &mut LineStats {
+        // the common case: the scanline being issued, the last one open
+        if self.open.back().is_some_and(|l| l.line == line) {
+            return self.open.back_mut().expect("just seen");
+        }
+        self.open_line(line)
+    }
+
+    #[cold]
+    fn open_line(&mut self, line: u64) -> &mut LineStats {
         assert!(
             line >= self.base,
             "an event for scanline {line}, folded already (the margin is too small)"
@@ -266,6 +276,7 @@ impl Recorder {
 
     /// An instruction of scanline `line` started issuing at `begin` and entered the first
     /// processor at `entry` after `cost` bus cycles.
+    #[inline]
     pub(crate) fn issue(&mut self, line: u64, op: Opcode, begin: u64, entry: u64, cost: u64) {
         let stall = entry - self.last_entry - cost;
         self.last_entry = entry;
