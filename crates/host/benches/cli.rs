@@ -5,7 +5,9 @@
 //! pipeline -- stages_1024`).
 //!
 //! * `cli_render/pot_1024/exact`, `cli_render/pot_1024/eval0` — `cwisim render pot
-//!   --size 1024x1024 --visibility V -o pot.png --quiet`, one thread.
+//!   --size 1024x1024 --visibility V -o pot.png --quiet`, one thread. After each, five
+//!   runs without `--quiet` print the command's own stage times (its summary's `time`
+//!   line) to standard error.
 //!
 //! The figures are in docs/PERFORMANCE.md.
 
@@ -37,14 +39,23 @@ fn cli_render(c: &mut Criterion) {
         .map(OsString::from)
         .chain([png.clone().into_os_string()])
         .collect();
+        let run = |args: &[OsString]| {
+            let (mut out, mut err) = (Vec::new(), Vec::new());
+            let code = run_cli_with(args.to_vec(), &mut out, &mut err, false);
+            assert_eq!(code, 0, "{}", String::from_utf8_lossy(&err));
+            out
+        };
         g.bench_function(BenchmarkId::new("pot_1024", vis), |b| {
-            b.iter(|| {
-                let (mut out, mut err) = (Vec::new(), Vec::new());
-                let code = run_cli_with(args.clone(), &mut out, &mut err, false);
-                assert_eq!(code, 0, "{}", String::from_utf8_lossy(&err));
-                black_box(out)
-            })
+            b.iter(|| black_box(run(&args)))
         });
+        // the command's own account of its stages, in this process after the warm-up
+        // (the figures to hold against `stages_1024`)
+        let loud: Vec<OsString> = args.iter().filter(|a| *a != "--quiet").cloned().collect();
+        for _ in 0..5 {
+            let out = String::from_utf8(run(&loud)).expect("utf-8");
+            let times = out.lines().find(|l| l.starts_with("time")).unwrap_or("");
+            eprintln!("cli_render {vis}: {times}");
+        }
     }
     g.finish();
     let _ = std::fs::remove_dir_all(&dir);
