@@ -2,9 +2,11 @@
 //! document of `--stats-json`.
 
 use cwisim_isa::{Opcode, TraceHeader};
-use cwisim_xproc::{Machine, RunStats, Timing};
+use cwisim_xproc::{LineStats, Machine, RunStats, Timing};
 use serde::Serialize;
-use std::io::{self, Write};
+use std::fs::File;
+use std::io::{self, BufWriter, Write};
+use std::path::{Path, PathBuf};
 
 /// The name of a timing model on the command line and in reports.
 pub fn timing_name(timing: Timing) -> &'static str {
@@ -56,6 +58,125 @@ impl StatsReport<'_> {
     pub fn write_json(&self, out: &mut dyn std::io::Write) -> std::io::Result<()> {
         serde_json::to_writer_pretty(&mut *out, self)?;
         out.write_all(b"\n")
+    }
+
+    /// [`Self::write_json`] with the per-scanline records taken from `spill` (written
+    /// there as the run made them) in place of `stats.lines` (which must be empty): the
+    /// same bytes as [`Self::write_json`] on the kept records, with memory flat in
+    /// their number.
+    pub fn write_json_spilled(
+        &self,
+        out: &mut dyn std::io::Write,
+        spill: &mut LineSpill,
+    ) -> std::io::Result<()> {
+        assert!(
+            self.stats.lines.is_empty(),
+            "the records are in the spill, not kept"
+        );
+        let doc = serde_json::to_vec_pretty(self)?;
+        // `lines` is the last field of `stats`, the last of the document
+        const TAIL: &[u8] = b"\"lines\": []\n  }\n}";
+        assert!(doc.ends_with(TAIL), "the document ends with the records");
+        if spill.count == 0 {
+            out.write_all(&doc)?;
+            return out.write_all(b"\n");
+        }
+        out.write_all(&doc[..doc.len() - TAIL.len()])?;
+        out.write_all(b"\"lines\": [\n")?;
+        spill.copy_to(out)?;
+        out.write_all(b"\n    ]\n  }\n}\n")
+    }
+}
+
+/// The per-scanline records of `--stats-json`, written to a hidden file beside the output
+/// (`.NAME.lines.partial`) as each scanline completes, in their final form: pretty JSON
+/// objects indented as the elements of `stats.lines`, separated by `,\n`. Removed when
+/// dropped.
+pub struct LineSpill {
+    path: PathBuf,
+    out: Option<BufWriter<File>>,
+    count: u64,
+    error: Option<io::Error>,
+    buf: Vec<u8>,
+}
+
+impl LineSpill {
+    /// A spill beside `output` (the `--stats-json` path).
+    pub fn beside(output: &Path) -> io::Result<LineSpill> {
+        let name = output.file_name().ok_or_else(|| {
+            io::Error::new(io::ErrorKind::InvalidInput, "the output path names no file")
+        })?;
+        let mut hidden = std::ffi::OsString::from(".");
+        hidden.push(name);
+        hidden.push(".lines.partial");
+        let path = output.with_file_name(hidden);
+        let file = File::create(&path)?;
+        Ok(LineSpill {
+            path,
+            out: Some(BufWriter::new(file)),
+            count: 0,
+            error: None,
+            buf: Vec::new(),
+        })
+    }
+
+    /// Appends one record (a write error is kept and reported by [`Self::copy_to`]).
+    pub fn push(&mut self, line: &LineStats) {
+        if self.error.is_some() {
+            return;
+        }
+        if let Err(e) = self.write_record(line) {
+            self.error = Some(e);
+        }
+    }
+
+    fn write_record(&mut self, line: &LineStats) -> io::Result<()> {
+        let out = self.out.as_mut().expect("open until copied");
+        self.buf.clear();
+        serde_json::to_writer_pretty(&mut self.buf, line)?;
+        if self.count > 0 {
+            out.write_all(b",\n")?;
+        }
+        // an element of `stats.lines` is three levels deep: six spaces before each of
+        // its lines (the record holds no string with a newline)
+        for (k, row) in self.buf.split(|&b| b == b'\n').enumerate() {
+            if k > 0 {
+                out.write_all(b"\n")?;
+            }
+            out.write_all(b"      ")?;
+            out.write_all(row)?;
+        }
+        self.count += 1;
+        Ok(())
+    }
+
+    /// The records written so far.
+    pub fn count(&self) -> u64 {
+        self.count
+    }
+
+    /// Copies the records to `out` (once, after the run).
+    fn copy_to(&mut self, out: &mut dyn Write) -> io::Result<()> {
+        if let Some(e) = self.error.take() {
+            return Err(e);
+        }
+        let file = self
+            .out
+            .take()
+            .expect("copied once")
+            .into_inner()
+            .map_err(|e| e.into_error())?;
+        drop(file);
+        let mut file = File::open(&self.path)?;
+        io::copy(&mut file, out)?;
+        Ok(())
+    }
+}
+
+impl Drop for LineSpill {
+    fn drop(&mut self) {
+        self.out = None;
+        let _ = std::fs::remove_file(&self.path);
     }
 }
 
@@ -185,5 +306,70 @@ mod tests {
         assert_eq!(v["timing"], "stepped");
         assert_eq!(v["machine"]["hop_cycles"], 1);
         assert_eq!(v["stats"]["totals"]["unrefreshed_instructions"], 1);
+    }
+
+    /// The records spilled as the run makes them give the bytes of the document with
+    /// the records kept, for none, one and many scanlines, on both engines.
+    #[test]
+    fn spilled_records_give_the_same_bytes() {
+        let dir = std::env::temp_dir().join(format!("cwisim-spill-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("dir");
+        let h = TraceHeader::new(8, 3, 1).expect("header");
+        for lines in [0u32, 1, 7] {
+            let mut trace = vec![Instruction::nop()];
+            for k in 0..lines {
+                trace.push(Instruction::eval1(k % 8, 1, Intensity::grey(0.25)));
+                trace.push(Instruction::refresh());
+            }
+            trace.push(Instruction::nop());
+            for timing in [Timing::Fast, Timing::Stepped] {
+                let m = Machine::default();
+                fn report<'a>(
+                    h: &TraceHeader,
+                    m: &'a Machine,
+                    timing: Timing,
+                    stats: &'a RunStats,
+                ) -> StatsReport<'a> {
+                    StatsReport {
+                        trace: h.into(),
+                        machine: m,
+                        timing: timing_name(timing),
+                        stats,
+                    }
+                }
+                let (_, kept) = cwisim_xproc::run::<f64>(&h, &trace, &m, timing).expect("run");
+                let mut expected = Vec::new();
+                report(&h, &m, timing, &kept)
+                    .write_json(&mut expected)
+                    .expect("writes");
+
+                let path = dir.join("stats.json");
+                let spill = std::sync::Arc::new(std::sync::Mutex::new(
+                    LineSpill::beside(&path).expect("spill"),
+                ));
+                let to = spill.clone();
+                let mut e = cwisim_xproc::engine::<f64>(&h, &m, timing).expect("engine");
+                e.line_records(cwisim_xproc::LineRecords::Send(Box::new(move |l| {
+                    to.lock().expect("lock").push(&l)
+                })));
+                for i in &trace {
+                    e.execute(i, &mut cwisim_xproc::NullSink);
+                }
+                let streamed = e.finish(&mut cwisim_xproc::NullSink);
+                assert!(streamed.lines.is_empty());
+                let mut spill = spill.lock().expect("lock");
+                assert_eq!(spill.count(), u64::from(lines));
+                let mut got = Vec::new();
+                report(&h, &m, timing, &streamed)
+                    .write_json_spilled(&mut got, &mut spill)
+                    .expect("writes");
+                assert_eq!(
+                    String::from_utf8(got).expect("utf-8"),
+                    String::from_utf8(expected).expect("utf-8"),
+                    "{lines} lines, {timing:?}"
+                );
+            }
+        }
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }

@@ -24,7 +24,7 @@ use crate::instruction::{Instruction, Intensity};
 use crate::io::{TraceRead, TraceWrite};
 use crate::opcode::{Opcode, OperandKind};
 use crate::text::header_from_u64;
-use std::io::{self, Read, Write};
+use std::io::{self, BufRead, Read, Write};
 
 /// The first eight bytes of every `.cwb` file.
 pub const MAGIC: &[u8; 8] = b"CWBTRACE";
@@ -80,7 +80,7 @@ impl<W: Write> TraceWrite for BinaryWriter<W> {
                 OperandKind::X => put_varint(&mut self.record, instr.x),
                 OperandKind::Count | OperandKind::Period => put_varint(&mut self.record, instr.dx),
                 _ => {
-                    for v in instr.values[kind.value_slot().expect("value")].as_slice() {
+                    for v in instr.value(kind.value_slot().expect("value")) {
                         self.record.extend_from_slice(&v.to_le_bytes());
                     }
                 }
@@ -101,7 +101,11 @@ impl<W: Write> TraceWrite for BinaryWriter<W> {
 }
 
 /// Reads a `.cwb` trace.
-pub struct BinaryReader<R: Read> {
+///
+/// A record that lies whole in the input's buffer is decoded from it in place
+/// ([`Self::decode_buffered`]); anything else — a record across the buffer's end, the end
+/// marker, a fault of any kind — takes the byte-by-byte path, which locates every fault.
+pub struct BinaryReader<R: BufRead> {
     input: R,
     header: TraceHeader,
     offset: u64,
@@ -109,9 +113,11 @@ pub struct BinaryReader<R: Read> {
     count: u64,
     crc: crc32fast::Hasher,
     done: bool,
+    /// Bytes of the input's buffer decoded in place, not yet checksummed or consumed.
+    pending: usize,
 }
 
-impl<R: Read> BinaryReader<R> {
+impl<R: BufRead> BinaryReader<R> {
     /// Opens a trace: reads and checks the fixed header.
     pub fn new(mut input: R) -> Result<Self, TraceError> {
         let mut head = [0u8; HEADER_BYTES as usize];
@@ -164,6 +170,7 @@ impl<R: Read> BinaryReader<R> {
             count: 0,
             crc: crc32fast::Hasher::new(),
             done: false,
+            pending: 0,
         })
     }
 
@@ -274,7 +281,138 @@ fn read_full<R: Read>(r: &mut R, buf: &mut [u8]) -> io::Result<usize> {
     Ok(n)
 }
 
-impl<R: Read> TraceRead for BinaryReader<R> {
+/// A canonical varint of at most 5 bytes, fitting in 32 bits, at the start of `b`: the
+/// value and its length; `None` for anything else (a short slice included).
+#[inline]
+fn varint_at(b: &[u8]) -> Option<(u32, usize)> {
+    let mut v: u64 = 0;
+    for (i, &byte) in b.iter().take(5).enumerate() {
+        v |= u64::from(byte & 0x7F) << (7 * i);
+        if byte & 0x80 == 0 {
+            if i > 0 && byte == 0 {
+                return None;
+            }
+            return Some((u32::try_from(v).ok()?, i + 1));
+        }
+    }
+    None
+}
+
+impl<R: BufRead> BinaryReader<R> {
+    /// The next record decoded straight from the input's buffer, if it lies there whole
+    /// and is sound (a known opcode, canonical varints, operands that pass
+    /// [`Instruction::check`]); `None` leaves it for the byte-by-byte path, which then
+    /// finds the same record (or the end marker, or the fault and where it is).
+    ///
+    /// Records decoded here stay in the buffer (`self.pending` bytes of it) until the
+    /// buffer is used up or the byte-by-byte path needs the input: then they go into
+    /// the checksum in one piece and are consumed ([`Self::settle`]).
+    #[inline]
+    fn decode_buffered(&mut self) -> Option<Instruction> {
+        if let Some(i) = self.decode_at_pending() {
+            return Some(i);
+        }
+        if self.pending == 0 {
+            return None;
+        }
+        // the buffer is used up (or the next record lies across its end): refill
+        self.settle();
+        self.decode_at_pending()
+    }
+
+    /// Checksums and consumes the records decoded in place.
+    fn settle(&mut self) {
+        if self.pending > 0 {
+            if let Ok(buf) = self.input.fill_buf() {
+                self.crc.update(&buf[..self.pending]);
+            }
+            self.input.consume(self.pending);
+            self.pending = 0;
+        }
+    }
+
+    #[inline(always)]
+    fn decode_at_pending(&mut self) -> Option<Instruction> {
+        if self.header.channel_count() == 1 {
+            self.decode_record::<true>()
+        } else {
+            self.decode_record::<false>()
+        }
+    }
+
+    /// [`Self::decode_at_pending`] for a grey trace (`GREY`) or any other.
+    #[inline(always)]
+    fn decode_record<const GREY: bool>(&mut self) -> Option<Instruction> {
+        let width = self.header.width;
+        let channels = if GREY { 1 } else { self.header.channel_count() };
+        let buf = self.input.fill_buf().ok()?.get(self.pending..)?;
+        let op = Opcode::from_code(*buf.first()?)?;
+        let mut at = 1;
+        let (mut x, mut dx) = (0u32, 0u32);
+        let (mut grey, mut present) = ([0.0; 3], 0u8);
+        let mut wide = if GREY {
+            None
+        } else {
+            Some([Intensity::NONE; 3])
+        };
+        for kind in op.operands() {
+            match kind {
+                OperandKind::X => {
+                    let (v, n) = varint_at(&buf[at..])?;
+                    if v >= width {
+                        return None;
+                    }
+                    (x, at) = (v, at + n);
+                }
+                OperandKind::Count | OperandKind::Period => {
+                    let (v, n) = varint_at(&buf[at..])?;
+                    let bad = if *kind == OperandKind::Count {
+                        u64::from(x) + u64::from(v) > u64::from(width)
+                    } else {
+                        v == 0
+                    };
+                    if bad {
+                        return None;
+                    }
+                    (dx, at) = (v, at + n);
+                }
+                _ => {
+                    let slot = kind.value_slot().expect("value");
+                    let raw = buf.get(at..at + 8 * channels)?;
+                    let mut vals = [0.0; MAX_CHANNELS];
+                    for (v, b) in vals.iter_mut().zip(raw.chunks_exact(8)) {
+                        *v = f64::from_le_bytes(b.try_into().expect("8 bytes"));
+                        if !v.is_finite() {
+                            return None;
+                        }
+                    }
+                    match &mut wide {
+                        None => {
+                            grey[slot] = vals[0];
+                            present |= 1 << slot;
+                        }
+                        Some(w) => w[slot] = Intensity::new(&vals[..channels]),
+                    }
+                    at += 8 * channels;
+                }
+            }
+        }
+        // the operands in range and finite, the channel count the header's: what
+        // `Instruction::check` asks
+        let instr = match wide {
+            None => Instruction::grey(op, x, dx, present, grey),
+            Some(w) => Instruction::from_parts(op, x, dx, w),
+        };
+        debug_assert!(instr.check(&self.header).is_ok());
+        self.pending += at;
+        self.record_start = self.offset;
+        self.offset += at as u64;
+        self.count += 1;
+        Some(instr)
+    }
+}
+
+impl<R: BufRead> TraceRead for BinaryReader<R> {
     fn header(&self) -> &TraceHeader {
         &self.header
     }
@@ -283,6 +421,10 @@ impl<R: Read> TraceRead for BinaryReader<R> {
         if self.done {
             return Ok(None);
         }
+        if let Some(instr) = self.decode_buffered() {
+            return Ok(Some(instr));
+        }
+        self.settle();
         self.record_start = self.offset;
         let mut code = [0u8];
         let got = read_full(&mut self.input, &mut code)
@@ -312,17 +454,13 @@ impl<R: Read> TraceRead for BinaryReader<R> {
                 ),
             ));
         };
-        let mut instr = Instruction {
-            op,
-            x: 0,
-            dx: 0,
-            values: [Intensity::NONE; 3],
-        };
+        let (mut x, mut dx) = (0, 0);
+        let mut values = [Intensity::NONE; 3];
         let channels = self.header.channel_count();
         for kind in op.operands() {
             match kind {
-                OperandKind::X => instr.x = self.varint("x")?,
-                OperandKind::Count | OperandKind::Period => instr.dx = self.varint("dx")?,
+                OperandKind::X => x = self.varint("x")?,
+                OperandKind::Count | OperandKind::Period => dx = self.varint("dx")?,
                 _ => {
                     let mut raw = [0u8; 8 * MAX_CHANNELS];
                     let what = format!("the operand `{}` of {op}", kind.name());
@@ -331,11 +469,11 @@ impl<R: Read> TraceRead for BinaryReader<R> {
                     for (k, v) in vals.iter_mut().take(channels).enumerate() {
                         *v = f64::from_le_bytes(raw[8 * k..8 * k + 8].try_into().expect("8 bytes"));
                     }
-                    instr.values[kind.value_slot().expect("value")] =
-                        Intensity::new(&vals[..channels]);
+                    values[kind.value_slot().expect("value")] = Intensity::new(&vals[..channels]);
                 }
             }
         }
+        let instr = Instruction::from_parts(op, x, dx, values);
         instr
             .check(&self.header)
             .map_err(|e| operand_error(e, Location::Byte(self.record_start), op))?;
@@ -349,6 +487,21 @@ impl<R: Read> TraceRead for BinaryReader<R> {
 
     fn bytes_read(&self) -> u64 {
         self.offset
+    }
+
+    fn read_batch(&mut self, out: &mut Vec<Instruction>, max: usize) -> Result<usize, TraceError> {
+        let mut n = 0;
+        while n < max.max(1) {
+            if let Some(i) = self.decode_buffered() {
+                out.push(i);
+            } else if let Some(i) = self.next_instruction()? {
+                out.push(i);
+            } else {
+                break;
+            }
+            n += 1;
+        }
+        Ok(n)
     }
 }
 
@@ -383,6 +536,45 @@ mod tests {
         // header 20 + (1 + 1 + 2 + 16) + 1 + footer 13
         assert_eq!(bytes.len(), 20 + 20 + 1 + 13);
         assert_eq!(decode(&bytes).unwrap(), v);
+    }
+
+    /// The in-buffer path and the byte-by-byte one give the same instructions and the
+    /// same faults at the same offsets, whatever the buffer's size (a record across its
+    /// end takes the byte-by-byte path).
+    #[test]
+    fn any_buffer_size_reads_the_same() {
+        let bytes = encode(&[
+            Instruction::eval3(
+                200,
+                50,
+                Intensity::grey(1.0),
+                Intensity::grey(-0.5),
+                Intensity::grey(0.25),
+            ),
+            Instruction::set_pi(3, 7, Intensity::grey(2.0)),
+            Instruction::dis(0, 256),
+            Instruction::refresh(),
+        ]);
+        let outcome = |r: Result<Vec<Instruction>, TraceError>| {
+            r.map_err(|e| (e.kind, e.location, e.to_string()))
+        };
+        let mut variants = vec![bytes.clone()];
+        for at in 0..bytes.len() {
+            for bit in [0x01, 0x80] {
+                let mut b = bytes.clone();
+                b[at] ^= bit;
+                variants.push(b);
+            }
+            variants.push(bytes[..at].to_vec());
+        }
+        for v in &variants {
+            let whole = outcome(decode(v));
+            for cap in [1, 2, 5, 13] {
+                let r = BinaryReader::new(io::BufReader::with_capacity(cap, &v[..]))
+                    .and_then(|mut r| read_all(&mut r));
+                assert_eq!(outcome(r), whole, "buffer {cap}");
+            }
+        }
     }
 
     #[test]

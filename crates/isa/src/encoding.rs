@@ -119,6 +119,15 @@ impl TraceRead for FileReader {
     fn bytes_read(&self) -> u64 {
         self.inner.bytes_read()
     }
+    fn read_batch(
+        &mut self,
+        out: &mut Vec<crate::Instruction>,
+        max: usize,
+    ) -> Result<usize, TraceError> {
+        self.inner
+            .read_batch(out, max)
+            .map_err(|e| e.in_file(&self.path))
+    }
 }
 
 /// Creates `path` and a writer of the encoding its extension names.

@@ -28,10 +28,9 @@ impl Serialize for Instruction {
             match kind {
                 OperandKind::X => m.serialize_entry("x", &self.x)?,
                 OperandKind::Count | OperandKind::Period => m.serialize_entry("dx", &self.dx)?,
-                _ => m.serialize_entry(
-                    kind.name(),
-                    self.values[kind.value_slot().expect("value")].as_slice(),
-                )?,
+                _ => {
+                    m.serialize_entry(kind.name(), self.value(kind.value_slot().expect("value")))?
+                }
             }
         }
         m.end()
@@ -232,16 +231,16 @@ fn parse_record(line: &str, line_no: u64, header: &TraceHeader) -> Result<Instru
             Some(v) => Ok(Intensity::new(&v)),
         }
     };
-    let instr = Instruction {
+    let instr = Instruction::from_parts(
         op,
-        x: narrow("x", rec.x)?,
-        dx: narrow("dx", rec.dx)?,
-        values: [
+        narrow("x", rec.x)?,
+        narrow("dx", rec.dx)?,
+        [
             vector("I", rec.i)?,
             vector("dI", rec.di)?,
             vector("ddI", rec.ddi)?,
         ],
-    };
+    );
     instr.check(header).map_err(|e| operand_error(e, at, op))?;
     Ok(instr)
 }

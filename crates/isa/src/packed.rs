@@ -1,10 +1,9 @@
 //! [`PackedStream`]: instructions held compactly in memory.
 //!
-//! An [`Instruction`] is 132 bytes (three intensity slots of [`MAX_CHANNELS`](crate::MAX_CHANNELS)
-//! values each), most of them unused: a grey `Eval2` carries two values. A stream that is
-//! buffered before it is replayed — a band of scanlines emitted on one thread and fed to
-//! the array on another — moves through memory at that size, and the copies cost more
-//! than the work. A packed stream keeps a 12-byte head per instruction (opcode, operand
+//! An [`Instruction`] is 48 bytes (three inline `f64` slots, colour boxed), whatever it
+//! carries: a grey `Refresh` carries none of them. A stream that is buffered before it is
+//! replayed — a band of scanlines emitted on one thread and fed to the array on another —
+//! moves through memory at that size. A packed stream keeps a 12-byte head per instruction (opcode, operand
 //! lengths, `x`, `dx`) and only the values the instruction carries, bit for bit: the
 //! instructions read back equal the ones written.
 
@@ -54,9 +53,10 @@ impl PackedStream {
     /// Appends `instr`.
     pub fn push(&mut self, instr: &Instruction) {
         let mut lens = [0u8; 3];
-        for (len, v) in lens.iter_mut().zip(&instr.values) {
+        for (s, len) in lens.iter_mut().enumerate() {
+            let v = instr.value(s);
             *len = v.len() as u8;
-            self.values.extend_from_slice(v.as_slice());
+            self.values.extend_from_slice(v);
         }
         self.heads.push(Head {
             op: instr.op,
@@ -79,12 +79,7 @@ impl PackedStream {
                 v
             };
             let values = [slot(h.lens[0]), slot(h.lens[1]), slot(h.lens[2])];
-            Instruction {
-                op: h.op,
-                x: h.x,
-                dx: h.dx,
-                values,
-            }
+            Instruction::from_parts(h.op, h.x, h.dx, values)
         })
     }
 }
@@ -120,12 +115,7 @@ mod tests {
             any::<u32>(),
             [intensity(), intensity(), intensity()],
         )
-            .prop_map(|(op, x, dx, values)| Instruction {
-                op: Opcode::ALL[op],
-                x,
-                dx,
-                values,
-            })
+            .prop_map(|(op, x, dx, values)| Instruction::from_parts(Opcode::ALL[op], x, dx, values))
     }
 
     proptest! {
@@ -144,7 +134,7 @@ mod tests {
                 // bit for bit: NaN payloads and signed zeros too
                 prop_assert_eq!(a.op, b.op);
                 prop_assert_eq!((a.x, a.dx), (b.x, b.dx));
-                for (p, q) in a.values.iter().zip(&b.values) {
+                for (p, q) in a.values().iter().zip(&b.values()) {
                     let bits = |v: &Intensity| v.as_slice().iter().map(|f| f.to_bits()).collect::<Vec<_>>();
                     prop_assert_eq!(bits(p), bits(q));
                 }

@@ -61,7 +61,7 @@ pub fn format_instruction(instr: &Instruction) -> String {
                 let _ = write!(s, "{}", instr.dx);
             }
             _ => s.push_str(&format_intensity(
-                &instr.values[kind.value_slot().expect("value")],
+                &instr.intensity(kind.value_slot().expect("value")),
             )),
         }
     }
@@ -305,12 +305,8 @@ pub fn parse_instruction(
             ),
         ));
     }
-    let mut instr = Instruction {
-        op,
-        x: 0,
-        dx: 0,
-        values: [Intensity::NONE; 3],
-    };
+    let (mut x, mut dx) = (0, 0);
+    let mut values = [Intensity::NONE; 3];
     let channels = header.channel_count();
     for (kind, tok) in kinds.iter().zip(&toks[1..]) {
         match kind {
@@ -318,9 +314,9 @@ pub fn parse_instruction(
                 let v = parse_u32(tok.text, kind.name())
                     .map_err(|m| TraceError::new(ErrorKind::Syntax, at(tok.column), m))?;
                 if *kind == OperandKind::X {
-                    instr.x = v;
+                    x = v;
                 } else {
-                    instr.dx = v;
+                    dx = v;
                 }
             }
             _ => {
@@ -344,10 +340,11 @@ pub fn parse_instruction(
                         .map_err(|(kind, m)| TraceError::new(kind, at(col), m))?;
                     col += p.len() as u64 + 1;
                 }
-                instr.values[kind.value_slot().expect("value")] = Intensity::new(&vals[..channels]);
+                values[kind.value_slot().expect("value")] = Intensity::new(&vals[..channels]);
             }
         }
     }
+    let instr = Instruction::from_parts(op, x, dx, values);
     instr
         .check(header)
         .map_err(|e| operand_error(e, at(toks[1].column), op))?;

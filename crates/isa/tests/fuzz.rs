@@ -403,9 +403,9 @@ proptest! {
             i.x = x;
             i.dx = dx;
             let c = header.channel_count();
-            for (s, slot) in i.values.iter_mut().enumerate() {
-                if slot.as_slice().len() == c {
-                    *slot = cwisim_isa::Intensity::new(&vals[4 * s..4 * s + c]);
+            for s in 0..3 {
+                if i.value(s).len() == c {
+                    i.set_value(s, cwisim_isa::Intensity::new(&vals[4 * s..4 * s + c]));
                 }
             }
         }

@@ -6,7 +6,8 @@
 //!   and two (`render --threads 2`).
 //! * `stages_1024` — the same stages one by one: host preparation (project + visibility),
 //!   the Y-processor alone (trapezium rows per second), the array alone replaying the
-//!   stream (instructions per second).
+//!   stream (instructions per second; `array_instructions` with no output,
+//!   `array_image` into the `f64` image as `cwisim render`'s array stage).
 //! * `scaling` — a fixed polygon set (the pot's visible fragments at 256×256) in images
 //!   from 256² to 4096²: the cost follows the work in the scene plus one `Refresh` per
 //!   scanline, not the image's area.
@@ -145,6 +146,21 @@ fn stages_1024(c: &mut Criterion) {
                 }
                 a.finish().expect("finish");
                 black_box(a.into_stats())
+            })
+        });
+        // the same into the `f64` image, as `cwisim render`'s array stage does
+        g.bench_function(BenchmarkId::new("array_image", name), |b| {
+            b.iter(|| {
+                let mut sink = ImageSink::new(h.width as usize, h.channel_count(), 1 << 34);
+                let mut a =
+                    EngineWriter::<f64>::new(&h, &Machine::default(), Timing::Fast, &mut sink)
+                        .expect("machine");
+                for i in &stream {
+                    a.write(i).expect("valid");
+                }
+                a.finish().expect("finish");
+                black_box(a.into_stats());
+                black_box(sink.finish().expect("within the limit"))
             })
         });
         eprintln!(

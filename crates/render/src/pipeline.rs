@@ -258,7 +258,7 @@ impl TraceWrite for ScanlineFeed<'_, '_> {
             let r = also.write(instr);
             self.own(r)?;
         }
-        self.buffer.push(*instr);
+        self.buffer.push(instr.clone());
         if instr.op == Opcode::Refresh {
             let r = self.flush();
             self.own(r)?;

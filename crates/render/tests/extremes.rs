@@ -418,7 +418,7 @@ fn format_bound(stream: &[Instruction], numeric: &Numeric, w: usize, h: usize) -
             | Opcode::SetPI
             | Opcode::SetPdI
             | Opcode::SetPddI => {
-                preload = preload.max(magnitude(&i.values[0]));
+                preload = preload.max(magnitude(&i.i()));
                 continue;
             }
             _ => continue,
@@ -426,7 +426,7 @@ fn format_bound(stream: &[Instruction], numeric: &Numeric, w: usize, h: usize) -
         if line >= h {
             break;
         }
-        let [a, d, dd] = i.values.map(|v| magnitude(&v));
+        let [a, d, dd] = i.values().map(|v| magnitude(&v));
         let end = (i.x as usize + i.dx as usize).min(w);
         for p in (i.x as usize)..end {
             let k = (p - i.x as usize) as f64;

@@ -64,8 +64,9 @@ fn run(r: &dyn Renderer, threads: usize) -> Run {
     let mut streams = vec![Vec::new()];
     let mut refreshes = 0;
     for i in stream {
+        let refresh = i.op == Opcode::Refresh;
         streams.last_mut().unwrap().push(i);
-        if i.op == Opcode::Refresh {
+        if refresh {
             refreshes += 1;
             if refreshes % h.lines == 0 {
                 streams.push(Vec::new());

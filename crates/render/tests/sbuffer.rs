@@ -317,7 +317,7 @@ fn overdraw_undoes_with_acc_mode_in_pairs() {
             Opcode::AccMode => on = !on,
             Opcode::Refresh => assert!(!on),
             Opcode::Eval1 | Opcode::Eval2 => {
-                let v = i.values[0].as_slice()[0];
+                let v = i.value(0)[0];
                 assert_eq!(on, v < 0.0, "{i:?}");
             }
             _ => {}

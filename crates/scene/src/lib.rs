@@ -13,6 +13,8 @@
 //! * [`predicates`] — exact orientation, segment intersection, polygon simplicity.
 //! * [`settings`] — [`Shading`] and [`Antialias`], the drawing settings every renderer
 //!   and command names the same way.
+//! * [`grid`] — a generated tessellated surface (`N × N` warped quads, every edge
+//!   shared), the benchmarks' scene.
 //!
 //! The limits are declared here once, from `cwisim-isa`'s trace header: a scene is
 //! drawn into a trace, so it can be no larger than a trace can carry.
@@ -35,6 +37,7 @@
 #![warn(missing_docs)]
 
 pub mod error;
+pub mod grid;
 pub mod locate;
 pub mod predicates;
 pub mod screen;

@@ -19,6 +19,10 @@ pub fn two_product(a: f64, b: f64) -> (f64, f64) {
 /// nonoverlapping expansion (Shewchuk's grow-expansion), whose largest component has the
 /// sign of the exact sum.
 pub fn orient(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> i8 {
+    // two equal points: exactly collinear (the filter below cannot prove a zero)
+    if a == b || b == c || c == a {
+        return 0;
+    }
     // Shewchuk's filter: the rounded determinant when its error bound proves the sign
     let left = (a[0] - c[0]) * (b[1] - c[1]);
     let right = (a[1] - c[1]) * (b[0] - c[0]);

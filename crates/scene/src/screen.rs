@@ -134,6 +134,22 @@ impl Scene {
 ///
 /// [`validate`]: ScreenScene::validate
 pub fn parse_scene(text: &str) -> Result<Scene, SceneError> {
+    // One typed pass over the text: a sound scene is read and validated in it. Any fault
+    // sends the text to the passes below, which find it and locate it (the messages do
+    // not depend on which path found the scene sound).
+    if let Ok(fast) = serde_json::from_str::<FastScreen>(text) {
+        if let Ok(scene) = fast.0.into_scene() {
+            if scene.validate().is_ok() {
+                return Ok(Scene::Screen(scene));
+            }
+        }
+    }
+    parse_located(text)
+}
+
+/// [`parse_scene`] without its fast path: a scene read in up to three passes, each
+/// fault located.
+fn parse_located(text: &str) -> Result<Scene, SceneError> {
     let kind = read_kind(text, SCENE_KINDS)?;
     let locate = |e: SceneError| {
         let located = locate_error(text, e);
@@ -211,6 +227,59 @@ pub fn read_scene_text(path: &Path) -> Result<String, SceneError> {
         )
         .in_file(path)
     })
+}
+
+/// A screen scene as the fast path of [`parse_scene`] reads it: [`RawScreen`] whose
+/// `kind` is `"screen"` and whose polygons are JSON objects (serde would also take a
+/// struct from an array, which the located reading refuses).
+struct FastScreen(RawScreen);
+
+impl<'de> Deserialize<'de> for FastScreen {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        #[derive(Deserialize)]
+        #[serde(deny_unknown_fields)]
+        struct Fields {
+            kind: String,
+            width: u64,
+            height: u64,
+            channels: u64,
+            polygons: Vec<ObjectPolygon>,
+        }
+        let f = Fields::deserialize(d)?;
+        if f.kind != "screen" {
+            return Err(serde::de::Error::custom("not a screen scene"));
+        }
+        Ok(FastScreen(RawScreen {
+            kind: f.kind,
+            width: f.width,
+            height: f.height,
+            channels: f.channels,
+            polygons: f.polygons.into_iter().map(|p| p.0).collect(),
+        }))
+    }
+}
+
+/// A [`Polygon`] read from a JSON object only.
+struct ObjectPolygon(Polygon);
+
+impl<'de> Deserialize<'de> for ObjectPolygon {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Visit;
+        impl<'de> serde::de::Visitor<'de> for Visit {
+            type Value = ObjectPolygon;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str("a polygon object")
+            }
+            fn visit_map<M: serde::de::MapAccess<'de>>(
+                self,
+                map: M,
+            ) -> Result<Self::Value, M::Error> {
+                Polygon::deserialize(serde::de::value::MapAccessDeserializer::new(map))
+                    .map(ObjectPolygon)
+            }
+        }
+        d.deserialize_map(Visit)
+    }
 }
 
 /// The screen kind as it is read: sizes as `u64` so that a too-large one gets the

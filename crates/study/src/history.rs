@@ -154,7 +154,7 @@ impl Probe for Watch {
             self.visits.push(Visit {
                 cycle,
                 index,
-                instr: *instr,
+                instr: instr.clone(),
                 addressed,
                 before: before.clone(),
                 after: after.clone(),

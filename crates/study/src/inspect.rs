@@ -194,7 +194,7 @@ impl Probe for Collector {
     }
 
     fn issue(&mut self, cycle: u64, index: u64, line: u64, instr: &Instruction) {
-        self.pending.push_back((index, line, cycle, *instr));
+        self.pending.push_back((index, line, cycle, instr.clone()));
     }
 
     fn enter(&mut self, cycle: u64, _index: u64) {
@@ -234,7 +234,7 @@ impl Probe for Collector {
             let v = Visit {
                 cycle,
                 index,
-                instr: *instr,
+                instr: instr.clone(),
                 addressed,
                 before: before.clone(),
                 after: after.clone(),

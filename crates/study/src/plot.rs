@@ -255,10 +255,8 @@ pub fn issue_costs(timeline: &Timeline) -> [u64; Opcode::COUNT] {
     for op in Opcode::ALL {
         // The cost depends on the opcode only (and on the trace's channel count, which
         // the timeline holds).
-        let instr = Instruction {
-            op: *op,
-            ..Instruction::nop()
-        };
+        let mut instr = Instruction::nop();
+        instr.op = *op;
         cost[op.index()] = timeline.issue_cycles(&instr);
     }
     cost

@@ -129,7 +129,7 @@ impl TraceWrite for Tap<'_> {
         if self.bytes.len() <= frame {
             self.bytes.resize(frame + 1, 0);
         }
-        let values: usize = i.values.iter().map(|v| v.len()).sum();
+        let values: usize = (0..3).map(|slot| i.value(slot).len()).sum();
         self.bytes[frame] += HEAD_BYTES + VALUE_BYTES * values as u64;
         if let Some(maps) = &mut self.maps {
             if maps.len() <= frame {

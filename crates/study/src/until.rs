@@ -36,7 +36,7 @@ impl TraceRead for UntilLine<'_> {
             return Ok(None);
         }
         let next = self.inner.next_instruction()?;
-        if next.is_some_and(|i| i.op == Opcode::Refresh) {
+        if next.as_ref().is_some_and(|i| i.op == Opcode::Refresh) {
             self.refreshes += 1;
         }
         Ok(next)

@@ -471,7 +471,7 @@ impl Probe for Recorder {
         sets.push((xs, Val::Word(x)));
         sets.push((dxs, Val::Word(dx)));
         for slot in 0..3 {
-            let v = instr.values[slot].as_slice();
+            let v = instr.value(slot);
             for k in 0..c {
                 sets.push((
                     l.bus_value(slot, k),

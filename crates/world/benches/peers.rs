@@ -1,8 +1,10 @@
 //! cwisim's anti-aliased polygon fill against peer rasterizers, on the same polygons at
 //! 1024×1024: `cargo bench -p cwisim-world --bench peers`.
 //!
-//! Groups `peers_pot_1024` (the embedded pot's 2D visible fragments: disjoint) and
-//! `peers_random_1024` (200 random overlapping triangles and quads, seeded). Throughput:
+//! Groups `peers_pot_1024` (the embedded pot's 2D visible fragments: disjoint),
+//! `peers_random_1024` (200 random overlapping triangles and quads, seeded) and
+//! `peers_mesh_1024` (the tessellated surface of 2048 triangles, every edge shared:
+//! `cwisim_scene::grid::warped_grid(32, 1024)`). Throughput:
 //! polygons per second. Each benchmark starts from the screen-space polygons and ends with a
 //! full 1024×1024 coverage image (or, for `ypipe_flat`, the counted stream):
 //!
@@ -69,6 +71,12 @@ fn bench(c: &mut Criterion) {
         "random",
         &peers::random(SIZE, 200, 0x5EED_CAFE),
         &[Mode::PerPolygon],
+    );
+    set(
+        c,
+        "mesh",
+        &cwisim_scene::grid::warped_grid(32, SIZE),
+        &[Mode::PerPolygon, Mode::OnePath],
     );
 }
 

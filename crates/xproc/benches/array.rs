@@ -7,12 +7,14 @@
 //!
 //! Group `numeric_frame_1024x1024`: the fast engine on the same frame in each numeric
 //! format, throughput in processor updates per second. Group `wave_4096`: the 4096 values
-//! of a wrapping fixed-point wave, by the adder chain and by the closed form.
+//! of a wrapping fixed-point wave, by the adder chain and by the closed form. Group
+//! `replay_overhead_1024x1024`: what an instruction costs beyond its updates.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use cwisim_isa::{Instruction, Intensity, TraceHeader};
+use cwisim_isa::{Instruction, Intensity, TraceHeader, TraceWrite};
 use cwisim_xproc::{
-    engine, numeric_engine, wave_closed_form, Arith, FixedArith, Machine, NullSink, Numeric, Timing,
+    engine, numeric_engine, wave_closed_form, Arith, EngineWriter, FixedArith, Machine, NullSink,
+    Numeric, Timing,
 };
 use std::hint::black_box;
 
@@ -95,6 +97,7 @@ fn bench(c: &mut Criterion) {
         &header,
         &short_span_trace(1024, 1024),
     );
+    overhead(c, &header);
 
     let Numeric::Fixed(f) = "fixed:I=8.24,dI=8.24,ddI=8.24,overflow=wrap"
         .parse()
@@ -179,6 +182,41 @@ fn short_span_trace(width: u32, lines: u32) -> Vec<Instruction> {
         out.push(Instruction::refresh());
     }
     out
+}
+
+/// What an instruction costs beyond its processor updates: the short-span frame with
+/// every span emptied (`dx = 0`: issued, timed and counted, no processor touched),
+/// replayed by the engine alone (`engine`, as `cwisim run` after its decoder's check)
+/// and through [`EngineWriter`] (`checked`, as a renderer feeds the array: each
+/// instruction checked against the header first). Throughput in instructions.
+fn overhead(c: &mut Criterion, header: &TraceHeader) {
+    let trace: Vec<Instruction> = short_span_trace(header.width, header.lines)
+        .into_iter()
+        .map(|mut i| {
+            i.dx = 0;
+            i
+        })
+        .collect();
+    let mut group = c.benchmark_group("replay_overhead_1024x1024");
+    group.sample_size(10);
+    group.throughput(Throughput::Elements(trace.len() as u64));
+    group.bench_function("engine", |b| {
+        b.iter(|| black_box(replay(header, black_box(&trace), Timing::Fast)))
+    });
+    group.bench_function("checked", |b| {
+        b.iter(|| {
+            let mut sink = NullSink;
+            let mut w =
+                EngineWriter::<f64>::new(header, &Machine::default(), Timing::Fast, &mut sink)
+                    .expect("default machine");
+            for i in black_box(&trace) {
+                w.write(i).expect("fits");
+            }
+            w.finish().expect("finish");
+            black_box(w.into_stats())
+        })
+    });
+    group.finish();
 }
 
 /// The fast engine on `trace` in `numeric`; the totals.

@@ -15,7 +15,7 @@
 
 use crate::numeric::{sign_extend, FixedFormat, NumericError, Overflow, Register};
 use crate::sample::Sample;
-use cwisim_isa::{Intensity, MAX_CHANNELS};
+use cwisim_isa::MAX_CHANNELS;
 use std::fmt::Debug;
 use std::marker::PhantomData;
 
@@ -128,12 +128,12 @@ pub fn chain_steps<A: Arith + ?Sized, const ORDER: usize, const C: usize>(
 pub(crate) fn vector<A: Arith>(
     arith: &A,
     reg: Register,
-    v: &Intensity,
+    v: &[f64],
     channels: usize,
     overflows: &mut u64,
 ) -> [A::Reg; MAX_CHANNELS] {
     let mut out = [A::ZERO; MAX_CHANNELS];
-    for (o, x) in out.iter_mut().zip(v.as_slice()).take(channels) {
+    for (o, x) in out.iter_mut().zip(v).take(channels) {
         *o = arith.operand(reg, *x, overflows);
     }
     out

@@ -7,7 +7,7 @@ use crate::numeric::Numeric;
 use crate::output::{Image, ImageSink, LineSink};
 use crate::probe::Probe;
 use crate::sample::Sample;
-use crate::stats::RunStats;
+use crate::stats::{LineRecords, RunStats};
 use crate::stepped::SteppedEngine;
 use cwisim_isa::{Instruction, TraceError, TraceHeader, TraceRead};
 
@@ -17,10 +17,19 @@ pub trait Engine<T: Sample> {
     fn execute(&mut self, instr: &Instruction, sink: &mut dyn LineSink<T>);
     /// Drains the array and returns the statistics.
     fn finish(self: Box<Self>, sink: &mut dyn LineSink<T>) -> RunStats;
-    /// Whether [`RunStats::lines`] gets every scanline's record (the default) or stays
-    /// empty, so that memory stays flat however long the trace (the totals are the
-    /// same). Call before the first instruction.
-    fn keep_line_stats(&mut self, keep: bool);
+    /// Where every scanline's record goes: into [`RunStats::lines`] (the default),
+    /// nowhere, or to a function as each scanline completes ([`LineRecords`]); the
+    /// totals are the same. Call before the first instruction.
+    fn line_records(&mut self, to: LineRecords);
+    /// [`Self::line_records`]: [`LineRecords::Keep`] or [`LineRecords::Drop`], so that
+    /// memory stays flat however long the trace.
+    fn keep_line_stats(&mut self, keep: bool) {
+        self.line_records(if keep {
+            LineRecords::Keep
+        } else {
+            LineRecords::Drop
+        });
+    }
 }
 
 /// Which implementation of the timing model to run. Both give identical scanlines and
@@ -118,24 +127,32 @@ pub fn replay_numeric(
     sink: &mut dyn LineSink<f64>,
     progress: &mut dyn FnMut(u64),
 ) -> Result<RunStats, ReplayError> {
-    replay_streaming(reader, machine, timing, numeric, true, sink, progress)
+    replay_streaming(
+        reader,
+        machine,
+        timing,
+        numeric,
+        LineRecords::Keep,
+        sink,
+        progress,
+    )
 }
 
-/// [`replay_numeric`], choosing whether the statistics keep a record per scanline
-/// (`keep_line_stats`; [`Engine::keep_line_stats`]). Without them the replay holds one
-/// scanline of array state and the scanlines in flight, whatever the trace's length.
+/// [`replay_numeric`], choosing where the per-scanline records go (`lines`;
+/// [`Engine::line_records`]). Unless they are kept, the replay holds one scanline of
+/// array state and the scanlines in flight, whatever the trace's length.
 pub fn replay_streaming(
     reader: &mut dyn TraceRead,
     machine: &Machine,
     timing: Timing,
     numeric: &Numeric,
-    keep_line_stats: bool,
+    lines: LineRecords,
     sink: &mut dyn LineSink<f64>,
     progress: &mut dyn FnMut(u64),
 ) -> Result<RunStats, ReplayError> {
     let header = *reader.header();
     let mut eng = numeric_engine(&header, machine, timing, numeric)?;
-    eng.keep_line_stats(keep_line_stats);
+    eng.line_records(lines);
     drive(reader, eng, sink, progress)
 }
 

@@ -11,8 +11,8 @@ use crate::machine::Timeline;
 use crate::numeric::Register;
 use crate::output::{LineOut, LineSink};
 use crate::sample::Sample;
-use crate::stats::{Recorder, RunStats, Work};
-use cwisim_isa::{Instruction, Intensity, Opcode, TraceHeader, MAX_CHANNELS};
+use crate::stats::{LineRecords, Recorder, RunStats, Work};
+use cwisim_isa::{Instruction, Opcode, TraceHeader, MAX_CHANNELS};
 
 const HAS_I: u8 = 1;
 const HAS_DI: u8 = 2;
@@ -28,11 +28,11 @@ const LOCKED: u8 = 8;
 fn operands<A: Arith, const C: usize>(
     arith: &A,
     reg: Register,
-    v: &Intensity,
+    v: &[f64],
     overflows: &mut u64,
 ) -> [A::Reg; MAX_CHANNELS] {
     let mut out = [A::ZERO; MAX_CHANNELS];
-    for (o, x) in out[..C].iter_mut().zip(v.as_slice()) {
+    for (o, x) in out[..C].iter_mut().zip(v) {
         *o = arith.operand(reg, *x, overflows);
     }
     out
@@ -191,14 +191,14 @@ impl<A: Arith> FastEngine<A> {
         let (x, dx) = (instr.x as usize, instr.dx as usize);
         let ar = &self.arith;
         let (mut dropped, mut suppressed, mut ovf) = (0u64, 0u64, 0u64);
-        let mut v = operands::<A, C>(ar, Register::I, instr.i(), &mut ovf);
+        let mut v = operands::<A, C>(ar, Register::I, instr.value(0), &mut ovf);
         let mut d = [A::ZERO; MAX_CHANNELS];
         if ORDER >= 2 {
-            d = operands::<A, C>(ar, Register::DI, instr.di(), &mut ovf);
+            d = operands::<A, C>(ar, Register::DI, instr.value(1), &mut ovf);
         }
         let mut dd = [A::ZERO; MAX_CHANNELS];
         if ORDER >= 3 {
-            dd = operands::<A, C>(ar, Register::DDI, instr.ddi(), &mut ovf);
+            dd = operands::<A, C>(ar, Register::DDI, instr.value(2), &mut ovf);
         }
         let c = C;
         let neg_ok = self.negative_enabled;
@@ -288,8 +288,8 @@ impl<A: Arith> FastEngine<A> {
 }
 
 impl<A: Arith> Engine<A::Out> for FastEngine<A> {
-    fn keep_line_stats(&mut self, keep: bool) {
-        self.recorder.keep_lines(keep);
+    fn line_records(&mut self, to: LineRecords) {
+        self.recorder.line_records(to);
     }
 
     fn execute(&mut self, instr: &Instruction, sink: &mut dyn LineSink<A::Out>) {
@@ -303,7 +303,7 @@ impl<A: Arith> Engine<A::Out> for FastEngine<A> {
                 let v = vector(
                     &self.arith,
                     Register::of_slot(slot),
-                    &instr.values[slot],
+                    instr.value(slot),
                     c,
                     &mut w.overflows,
                 );
@@ -317,7 +317,7 @@ impl<A: Arith> Engine<A::Out> for FastEngine<A> {
                 let v = vector(
                     &self.arith,
                     Register::of_slot(slot),
-                    &instr.values[slot],
+                    instr.value(slot),
                     c,
                     &mut w.overflows,
                 );
@@ -332,7 +332,13 @@ impl<A: Arith> Engine<A::Out> for FastEngine<A> {
                 self.touch(x, last + 1);
             }
             Opcode::Eval0 => {
-                let v = vector(&self.arith, Register::Acc, instr.i(), c, &mut w.overflows);
+                let v = vector(
+                    &self.arith,
+                    Register::Acc,
+                    instr.value(0),
+                    c,
+                    &mut w.overflows,
+                );
                 w.suppressed = self.eval0(x, dx, &v);
                 w.updates = dx as u64;
                 self.touch(x, x + dx);

@@ -61,4 +61,4 @@ pub use numeric::{
 pub use output::{Image, ImageLimit, ImageSink, LineOut, LineSink, NullSink};
 pub use probe::{NoProbe, Probe, ProcessorState};
 pub use sample::Sample;
-pub use stats::{LineStats, OpcodeCounts, RunStats, Totals};
+pub use stats::{LineRecords, LineStats, OpcodeCounts, RunStats, Totals};

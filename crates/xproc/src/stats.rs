@@ -119,6 +119,29 @@ pub struct RunStats {
     pub lines: Vec<LineStats>,
 }
 
+/// Where the per-scanline records of a run go ([`crate::Engine::line_records`]).
+pub enum LineRecords {
+    /// Into [`RunStats::lines`] (the default): memory grows with the trace.
+    Keep,
+    /// Nowhere: only the totals, memory flat however long the trace.
+    Drop,
+    /// To a function, one call per scanline output, in scanline order, as soon as the
+    /// scanline is complete (a few scanlines late: [`Recorder::MARGIN`]); the records
+    /// are those [`Self::Keep`] collects, and [`RunStats::lines`] stays empty. Memory
+    /// stays flat.
+    Send(Box<dyn FnMut(LineStats) + Send>),
+}
+
+impl std::fmt::Debug for LineRecords {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            LineRecords::Keep => "Keep",
+            LineRecords::Drop => "Drop",
+            LineRecords::Send(_) => "Send(..)",
+        })
+    }
+}
+
 /// What one instruction did in the processors.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct Work {
@@ -139,14 +162,14 @@ pub(crate) struct Work {
 /// Memory is bounded: a scanline's record is folded into the totals once the scanline is
 /// complete (a margin of [`Recorder::MARGIN`] complete scanlines stays open), so only the
 /// scanlines in flight are held — unless the per-scanline records are kept for
-/// [`RunStats::lines`] ([`Recorder::keep_lines`], the default).
+/// [`RunStats::lines`] ([`Recorder::line_records`]; [`LineRecords::Keep`] is the default).
 pub(crate) struct Recorder {
     /// Open records, from scanline `base` on.
     open: std::collections::VecDeque<LineStats>,
     base: u64,
     /// Scanlines whose `ready` has been recorded (they complete in order).
     ready_lines: u64,
-    keep: bool,
+    records: LineRecords,
     kept: Vec<LineStats>,
     folded: Totals,
     lines_per_frame: u64,
@@ -163,7 +186,7 @@ impl Recorder {
             open: std::collections::VecDeque::new(),
             base: 0,
             ready_lines: 0,
-            keep: true,
+            records: LineRecords::Keep,
             kept: Vec::new(),
             folded: Totals::default(),
             lines_per_frame: timeline.lines_per_frame,
@@ -176,13 +199,31 @@ impl Recorder {
         }
     }
 
-    /// Whether to keep every scanline's record for [`RunStats::lines`] (memory grows with
-    /// the trace) or only the totals (memory stays flat). Set before the first event.
-    pub(crate) fn keep_lines(&mut self, keep: bool) {
-        self.keep = keep;
+    /// Where every scanline's record goes ([`LineRecords`]). Set before the first event.
+    pub(crate) fn line_records(&mut self, to: LineRecords) {
+        self.records = to;
     }
 
+    /// A complete, output scanline's record, to where [`Self::line_records`] said.
+    fn output(&mut self, l: LineStats) {
+        match &mut self.records {
+            LineRecords::Keep => self.kept.push(l),
+            LineRecords::Drop => {}
+            LineRecords::Send(f) => f(l),
+        }
+    }
+
+    #[inline]
     fn line_mut(&mut self, line: u64) -> &mut LineStats {
+        // the common case: the scanline being issued, the last one open
+        if self.open.back().is_some_and(|l| l.line == line) {
+            return self.open.back_mut().expect("just seen");
+        }
+        self.open_line(line)
+    }
+
+    #[cold]
+    fn open_line(&mut self, line: u64) -> &mut LineStats {
         assert!(
             line >= self.base,
             "an event for scanline {line}, folded already (the margin is too small)"
@@ -228,15 +269,14 @@ impl Recorder {
                 break;
             };
             Self::fold(&mut self.folded, &l, true);
-            if self.keep {
-                self.kept.push(l);
-            }
+            self.output(l);
             self.base += 1;
         }
     }
 
     /// An instruction of scanline `line` started issuing at `begin` and entered the first
     /// processor at `entry` after `cost` bus cycles.
+    #[inline]
     pub(crate) fn issue(&mut self, line: u64, op: Opcode, begin: u64, entry: u64, cost: u64) {
         let stall = entry - self.last_entry - cost;
         self.last_entry = entry;
@@ -273,14 +313,14 @@ impl Recorder {
     /// The totals, once every token has left the array at cycle `end`; `refreshed` is
     /// the number of scanlines output.
     pub(crate) fn finish(mut self, refreshed: u64, end: u64) -> RunStats {
-        let mut t = self.folded;
+        let mut t = std::mem::take(&mut self.folded);
         t.cycles = end;
         let open = std::mem::take(&mut self.open);
         for l in open {
             let output = l.line < refreshed;
             Self::fold(&mut t, &l, output);
-            if self.keep && output {
-                self.kept.push(l);
+            if output {
+                self.output(l);
             }
         }
         t.lines = refreshed;

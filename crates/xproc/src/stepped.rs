@@ -14,7 +14,7 @@ use crate::numeric::Register;
 use crate::output::{LineOut, LineSink};
 use crate::probe::{NoProbe, Probe, ProcessorState};
 use crate::sample::Sample;
-use crate::stats::{Recorder, RunStats, Work};
+use crate::stats::{LineRecords, Recorder, RunStats, Work};
 use cwisim_isa::{Instruction, Opcode, TraceHeader, MAX_CHANNELS};
 
 type Vector<T> = [T; MAX_CHANNELS];
@@ -216,7 +216,7 @@ impl<'p, A: Arith> SteppedEngine<'p, A> {
                 out[slot] = vector(
                     &self.arith,
                     reg,
-                    &instr.values[slot],
+                    instr.value(slot),
                     self.channels,
                     overflows,
                 );
@@ -385,8 +385,8 @@ impl<'p, A: Arith> SteppedEngine<'p, A> {
 }
 
 impl<A: Arith> Engine<A::Out> for SteppedEngine<'_, A> {
-    fn keep_line_stats(&mut self, keep: bool) {
-        self.recorder.keep_lines(keep);
+    fn line_records(&mut self, to: LineRecords) {
+        self.recorder.line_records(to);
     }
 
     fn execute(&mut self, instr: &Instruction, sink: &mut dyn LineSink<A::Out>) {
@@ -406,7 +406,7 @@ impl<A: Arith> Engine<A::Out> for SteppedEngine<'_, A> {
                 let cost = self.timeline.issue_cycles(instr);
                 self.probe.issue(self.t, self.issued, line, instr);
                 self.bus = Some(Bus {
-                    instr: *instr,
+                    instr: instr.clone(),
                     index: self.issued,
                     line,
                     begin: self.t,

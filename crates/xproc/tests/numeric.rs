@@ -152,11 +152,7 @@ fn reference<M: Model>(m: &M, w: usize, c: usize, trace: &[In]) -> RefRun {
     for i in trace {
         let (x, dx) = (i.x as usize, i.dx as usize);
         let conv = |r: usize, slot: usize, ovf: &mut u64| -> Vec<M::R> {
-            i.values[slot]
-                .as_slice()
-                .iter()
-                .map(|&v| m.conv(r, v, ovf))
-                .collect()
+            i.value(slot).iter().map(|&v| m.conv(r, v, ovf)).collect()
         };
         match i.op {
             Opcode::SetI | Opcode::SetdI | Opcode::SetddI => {
@@ -572,7 +568,7 @@ proptest! {
         if acc_mode {
             trace.push(In::acc_mode());
         }
-        trace.extend(evals.iter().map(|(_, e)| *e));
+        trace.extend(evals.iter().map(|(_, e)| e.clone()));
         trace.push(In::refresh());
         let h = TraceHeader::new(64, 1, 1).unwrap();
         let (exact, _) = run_numeric(&h, &trace, &Machine::default(), Timing::Fast, &Numeric::F64).unwrap();

@@ -327,11 +327,7 @@ fn nothing_outside_the_polygons_pixels() {
     struct Spans(Vec<(u32, u32)>);
     impl cwisim_isa::TraceWrite for Spans {
         fn write(&mut self, i: &cwisim_isa::Instruction) -> std::io::Result<()> {
-            assert!(i
-                .values
-                .iter()
-                .flat_map(|v| v.as_slice())
-                .all(|v| v.is_finite()));
+            assert!((0..3).flat_map(|s| i.value(s)).all(|v| v.is_finite()));
             if let Some(span) = i.span() {
                 self.0.push(span);
             } else {

@@ -127,7 +127,8 @@ fn compare_traces(
         }
         if first.is_none() && ia != ib {
             let show = |i: &Option<cwisim_isa::Instruction>| {
-                i.map_or("(end of trace)".to_string(), |i| i.to_string())
+                i.as_ref()
+                    .map_or("(end of trace)".to_string(), |i| i.to_string())
             };
             first = Some(format!(
                 "first difference: instruction #{index}, scanline {line}\n  A: {}\n  B: {}",
@@ -135,7 +136,7 @@ fn compare_traces(
                 show(&ib)
             ));
         }
-        if ia.is_some_and(|i| i.op == Opcode::Refresh) {
+        if ia.as_ref().is_some_and(|i| i.op == Opcode::Refresh) {
             line += 1;
         }
         index += 1;

@@ -51,7 +51,7 @@ struct Printer<'o> {
 
 impl Probe for Printer<'_> {
     fn issue(&mut self, cycle: u64, index: u64, line: u64, instr: &Instruction) {
-        self.pending.push_back((index, line, cycle, *instr));
+        self.pending.push_back((index, line, cycle, instr.clone()));
     }
 
     fn enter(&mut self, cycle: u64, index: u64) {

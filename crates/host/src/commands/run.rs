@@ -6,15 +6,17 @@ use crate::demo;
 use crate::error::CliError;
 use crate::files::{check_outputs, write_atomic};
 use crate::progress::Progress;
-use crate::report::{timing_name, unrefreshed_warning, write_summary, StatsReport};
+use crate::report::{timing_name, unrefreshed_warning, write_summary, LineSpill, StatsReport};
 use clap::{Args, ValueEnum};
 use cwisim_isa::{Encoding, FileReader, TraceRead};
 use cwisim_study::cost::{CostMap, CostReader};
 use cwisim_xproc::{
-    replay_streaming, Image, ImageSink, NullSink, Numeric, ReplayError, RunStats, Timing,
+    replay_streaming, Image, ImageSink, LineRecords, NullSink, Numeric, ReplayError, RunStats,
+    Timing,
 };
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
 
 /// The timing model, as chosen on the command line.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
@@ -120,6 +122,12 @@ pub fn run(
         .cost
         .wanted()
         .then(|| CostMap::new(header.width as usize));
+    let spill = match &args.stats_json {
+        Some(path) => Some(Arc::new(Mutex::new(
+            LineSpill::beside(path).map_err(|e| CliError::write(path, e))?,
+        ))),
+        None => None,
+    };
     let replayed = {
         let mut bar = Progress::new(size, progress);
         let want_image = args.image.wanted();
@@ -131,9 +139,18 @@ pub fn run(
             }
             None => &mut *reader,
         };
-        // per-scanline records only when asked for: otherwise memory stays flat however
+        // per-scanline records only when asked for, and then written out as each
+        // scanline completes (to a file beside the output): memory stays flat however
         // long the trace
-        let keep_lines = args.stats_json.is_some();
+        let keep_lines = match &spill {
+            Some(spill) => {
+                let spill = Arc::clone(spill);
+                LineRecords::Send(Box::new(move |l| {
+                    spill.lock().expect("not poisoned").push(&l)
+                }))
+            }
+            None => LineRecords::Drop,
+        };
         if args.keep_partial && want_image {
             let mut sink = ImageSink::new(
                 header.width as usize,
@@ -203,8 +220,12 @@ before the error (a frame has {})",
             timing: timing_name(timing),
             stats,
         };
+        let spill = spill.as_ref().expect("made with --stats-json");
+        let mut spill = spill.lock().expect("not poisoned");
         write_atomic(path, |w| {
-            report.write_json(w).map_err(|e| CliError::write(path, e))
+            report
+                .write_json_spilled(w, &mut spill)
+                .map_err(|e| CliError::write(path, e))
         })?;
     }
     if let Some(warning) = unrefreshed_warning(stats) {
@@ -261,17 +282,25 @@ pub fn replay_file(
     want_image: bool,
     progress: &mut dyn FnMut(u64),
 ) -> Result<Replayed, CliError> {
-    replay_file_streaming(reader, machine, timing, numeric, want_image, true, progress)
+    replay_file_streaming(
+        reader,
+        machine,
+        timing,
+        numeric,
+        want_image,
+        LineRecords::Keep,
+        progress,
+    )
 }
 
-/// [`replay_file`], keeping a record per scanline only when `keep_lines`.
+/// [`replay_file`], the record of each scanline going where `keep_lines` says.
 pub fn replay_file_streaming(
     reader: &mut dyn TraceRead,
     machine: &cwisim_xproc::Machine,
     timing: Timing,
     numeric: &Numeric,
     want_image: bool,
-    keep_lines: bool,
+    keep_lines: LineRecords,
     progress: &mut dyn FnMut(u64),
 ) -> Result<Replayed, CliError> {
     let header = *reader.header();

@@ -1,0 +1,65 @@
+//! What the user runs: the whole `cwisim render` command as a library function
+//! ([`cwisim_host::cli::run_cli_with`]: argument parsing, scene loading, preparation,
+//! the Y-processor and the array, the PNG written), so that the suite measures the
+//! command-line path and not only its stages (`cargo bench -p cwisim-render --bench
+//! pipeline -- stages_1024`).
+//!
+//! * `cli_render/pot_1024/exact`, `cli_render/pot_1024/eval0` — `cwisim render pot
+//!   --size 1024x1024 --visibility V -o pot.png --quiet`, one thread. After each, five
+//!   runs without `--quiet` print the command's own stage times (its summary's `time`
+//!   line) to standard error.
+//!
+//! The figures are in docs/PERFORMANCE.md.
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+use cwisim_host::cli::run_cli_with;
+use std::ffi::OsString;
+use std::hint::black_box;
+use std::time::Duration;
+
+fn cli_render(c: &mut Criterion) {
+    let dir = std::env::temp_dir().join(format!("cwisim-bench-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temporary directory");
+    let png = dir.join("pot.png");
+    let mut g = c.benchmark_group("cli_render");
+    g.sample_size(20).measurement_time(Duration::from_secs(6));
+    for vis in ["exact", "eval0"] {
+        let args: Vec<OsString> = [
+            "cwisim",
+            "render",
+            "pot",
+            "--size",
+            "1024x1024",
+            "--visibility",
+            vis,
+            "--quiet",
+            "-o",
+        ]
+        .iter()
+        .map(OsString::from)
+        .chain([png.clone().into_os_string()])
+        .collect();
+        let run = |args: &[OsString]| {
+            let (mut out, mut err) = (Vec::new(), Vec::new());
+            let code = run_cli_with(args.to_vec(), &mut out, &mut err, false);
+            assert_eq!(code, 0, "{}", String::from_utf8_lossy(&err));
+            out
+        };
+        g.bench_function(BenchmarkId::new("pot_1024", vis), |b| {
+            b.iter(|| black_box(run(&args)))
+        });
+        // the command's own account of its stages, in this process after the warm-up
+        // (the figures to hold against `stages_1024`)
+        let loud: Vec<OsString> = args.iter().filter(|a| *a != "--quiet").cloned().collect();
+        for _ in 0..5 {
+            let out = String::from_utf8(run(&loud)).expect("utf-8");
+            let times = out.lines().find(|l| l.starts_with("time")).unwrap_or("");
+            eprintln!("cli_render {vis}: {times}");
+        }
+    }
+    g.finish();
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+criterion_group!(benches, cli_render);
+criterion_main!(benches);
