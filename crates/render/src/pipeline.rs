@@ -300,7 +300,8 @@ impl TraceWrite for ScanlineFeed<'_, '_> {
 }
 
 /// One frame in bands: `threads − 1` workers emit bands of rows (taking the next band as
-/// they finish one) while this thread feeds the finished bands to the array in order.
+/// they finish one) while this thread feeds the finished bands to the array in order,
+/// emitting the next untaken band itself whenever the band it wants is not there yet.
 fn feed_parallel(
     plan: &dyn FramePlan,
     rows: u32,
@@ -346,13 +347,18 @@ fn feed_parallel(
             });
         }
         drop(tx);
-        // feed the bands in order as they arrive
+        // feed the bands in order as they arrive; with nothing to feed, emit the next
+        // band here rather than wait (the array is idle most of a frame: this thread
+        // would otherwise leave its core to the workers' one band at a time)
         let mut counters = Counters::default();
         let mut waiting = BTreeMap::new();
         let mut want = 0usize;
-        for (k, band) in rx {
-            waiting.insert(k, band);
-            while let Some(band) = waiting.remove(&want) {
+        let mut open = true;
+        while want < n as usize {
+            while let Ok((k, band)) = rx.try_recv() {
+                waiting.insert(k, band);
+            }
+            if let Some(band) = waiting.remove(&want) {
                 let (instructions, band_counters) = band.map_err(&fault)?;
                 counters.merge(&band_counters);
                 for instr in instructions.iter() {
@@ -362,6 +368,28 @@ fn feed_parallel(
                     s.push(instructions);
                 }
                 want += 1;
+                continue;
+            }
+            let k = next_band.fetch_add(1, Ordering::Relaxed);
+            if k < n as usize {
+                let reused = spare.lock().ok().and_then(|mut s| s.pop());
+                let mut band = reused.unwrap_or_default();
+                band.clear();
+                let r = plan
+                    .emit_rows(band_rows(k as u32), &mut band)
+                    .map(|counters| (band, counters));
+                waiting.insert(k, r);
+                continue;
+            }
+            // every band is taken: wait for the workers'
+            match open.then(|| rx.recv().ok()).flatten() {
+                Some((k, band)) => {
+                    waiting.insert(k, band);
+                }
+                // the workers are done: every band is here
+                None if waiting.contains_key(&want) => open = false,
+                // a worker panicked without sending its band: the scope raises it
+                None => break,
             }
         }
         Ok(counters)
