@@ -4,7 +4,9 @@
 //!
 //! With `threads > 1`, `threads − 1` workers each take the next band of rows of the frame
 //! and emit it into a [`PackedStream`]; the calling thread feeds the finished bands to the
-//! array in band order and hands their buffers back for reuse. The renderer and the array
+//! array in band order and hands their buffers back for reuse, and while the band it wants
+//! is not ready it emits the next untaken band itself (the array is idle most of a frame,
+//! so with two threads both cores emit). The renderer and the array
 //! overlap, and the array sees exactly the serial stream: output, trace and statistics
 //! are byte-identical at any thread count.
 
