@@ -415,14 +415,24 @@ impl DrawArgs {
             gouraud_threshold: self.gouraud_threshold,
             aa_threshold: self.aa_threshold,
             phong_angle: self.phong_angle,
+            threads: 1,
         }
     }
 
     /// Reads the scene SCENE names (a file, an embedded name, or none: the default) and
     /// builds the renderer for it.
     pub fn draw(&self, scene: Option<&Path>) -> Result<Drawn, CliError> {
+        self.draw_on(scene, 1)
+    }
+
+    /// [`DrawArgs::draw`], preparing the scene on `threads` threads (exact visibility;
+    /// 0: one per core): the renderer is the same at any count.
+    pub fn draw_on(&self, scene: Option<&Path>, threads: usize) -> Result<Drawn, CliError> {
         let entry = registry::find(&self.renderer)?;
-        let settings = self.settings();
+        let settings = Settings {
+            threads,
+            ..self.settings()
+        };
         settings.check().map_err(CliError::Usage)?;
         let loaded = Source::resolve(scene)?.load_for(&settings)?;
         Ok(build(entry, loaded, &settings)?)

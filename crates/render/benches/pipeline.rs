@@ -3,8 +3,9 @@
 //! * `pot_1024` — the embedded pot at 1024×1024, end to end from the parsed scene:
 //!   transform and lighting, visibility, the Y-processor, and the array with its timing
 //!   model (fast engine, f64) into an image; `exact` and `eval0` visibility, one thread
-//!   and two (`render --threads 2`).
-//! * `stages_1024` — the same stages one by one: host preparation (project + visibility),
+//!   and two (`render --threads 2`: exact visibility and the pipeline on two threads).
+//! * `stages_1024` — the same stages one by one: host preparation (project + visibility;
+//!   `exact_2threads`: exact visibility on two threads),
 //!   the Y-processor alone (trapezium rows per second), the array alone replaying the
 //!   stream (instructions per second; `array_instructions` with no output,
 //!   `array_image` into the `f64` image as `cwisim render`'s array stage).
@@ -24,7 +25,7 @@ use cwisim_render::{
 };
 use cwisim_scene::ScreenScene;
 use cwisim_world::embedded::embedded;
-use cwisim_world::{parse_any, project::project, resolve, AnyScene, Visibility, WorldScene};
+use cwisim_world::{parse_any, project::project, resolve_on, AnyScene, Visibility, WorldScene};
 use cwisim_xproc::{EngineWriter, ImageSink, Machine, NullSink, Timing};
 use cwisim_ypipe::{emit, header, Claim, Options, Shading};
 use std::hint::black_box;
@@ -53,10 +54,10 @@ fn options(visibility: Visibility) -> Options {
     }
 }
 
-/// Host preparation: the screen scene of `w`.
-fn prepare(w: &WorldScene, visibility: Visibility) -> ScreenScene {
+/// Host preparation: the screen scene of `w`, exact visibility on `threads` threads.
+fn prepare(w: &WorldScene, visibility: Visibility, threads: usize) -> ScreenScene {
     let (tris, _) = project(w, Shading::Gouraud).expect("projects");
-    let (polygons, _) = resolve(&tris, w.channels(), visibility);
+    let (polygons, _) = resolve_on(&tris, w.channels(), visibility, threads);
     w.screen(polygons)
 }
 
@@ -107,7 +108,7 @@ fn pot_1024(c: &mut Criterion) {
         for threads in [1usize, 2] {
             g.bench_function(BenchmarkId::new(name, format!("{threads}thread")), |b| {
                 b.iter(|| {
-                    let screen = prepare(black_box(&w), vis);
+                    let screen = prepare(black_box(&w), vis, threads);
                     black_box(render(screen, vis, threads, true))
                 })
             });
@@ -122,9 +123,15 @@ fn stages_1024(c: &mut Criterion) {
     g.sample_size(20).measurement_time(Duration::from_secs(5));
     for (name, vis) in [("exact", Visibility::Exact), ("eval0", Visibility::Eval0)] {
         g.bench_function(BenchmarkId::new("host_prepare", name), |b| {
-            b.iter(|| black_box(prepare(black_box(&w), vis)))
+            b.iter(|| black_box(prepare(black_box(&w), vis, 1)))
         });
-        let screen = prepare(&w, vis);
+        if vis == Visibility::Exact {
+            // exact visibility on two threads (`render --threads 2`)
+            g.bench_function(BenchmarkId::new("host_prepare", "exact_2threads"), |b| {
+                b.iter(|| black_box(prepare(black_box(&w), vis, 2)))
+            });
+        }
+        let screen = prepare(&w, vis, 1);
         let opts = options(vis);
         let stats = emit(&screen, &opts, &mut Count(0)).expect("emit");
         g.throughput(Throughput::Elements(stats.rows_filled));
@@ -177,7 +184,7 @@ fn stages_1024(c: &mut Criterion) {
 
 fn scaling(c: &mut Criterion) {
     // the pot's visible fragments at 256×256, the same polygons in every image
-    let fixed = prepare(&pot(256), Visibility::Exact);
+    let fixed = prepare(&pot(256), Visibility::Exact, 1);
     let mut g = c.benchmark_group("scaling");
     g.sample_size(20).measurement_time(Duration::from_secs(4));
     for side in [256u32, 512, 1024, 2048, 4096] {
@@ -194,7 +201,7 @@ fn scaling(c: &mut Criterion) {
 }
 
 fn decode(c: &mut Criterion) {
-    let screen = prepare(&pot(1024), Visibility::Exact);
+    let screen = prepare(&pot(1024), Visibility::Exact, 1);
     let h = header(&screen);
     let mut g = c.benchmark_group("decode");
     g.sample_size(20).measurement_time(Duration::from_secs(4));

@@ -4,7 +4,9 @@
 //!
 //! With `threads > 1`, `threads − 1` workers each take the next band of rows of the frame
 //! and emit it into a [`PackedStream`]; the calling thread feeds the finished bands to the
-//! array in band order and hands their buffers back for reuse. The renderer and the array
+//! array in band order and hands their buffers back for reuse, and while the band it wants
+//! is not ready it emits the next untaken band itself (the array is idle most of a frame,
+//! so with two threads both cores emit). The renderer and the array
 //! overlap, and the array sees exactly the serial stream: output, trace and statistics
 //! are byte-identical at any thread count.
 
@@ -300,7 +302,8 @@ impl TraceWrite for ScanlineFeed<'_, '_> {
 }
 
 /// One frame in bands: `threads − 1` workers emit bands of rows (taking the next band as
-/// they finish one) while this thread feeds the finished bands to the array in order.
+/// they finish one) while this thread feeds the finished bands to the array in order,
+/// emitting the next untaken band itself whenever the band it wants is not there yet.
 fn feed_parallel(
     plan: &dyn FramePlan,
     rows: u32,
@@ -346,13 +349,18 @@ fn feed_parallel(
             });
         }
         drop(tx);
-        // feed the bands in order as they arrive
+        // feed the bands in order as they arrive; with nothing to feed, emit the next
+        // band here rather than wait (the array is idle most of a frame: this thread
+        // would otherwise leave its core to the workers' one band at a time)
         let mut counters = Counters::default();
         let mut waiting = BTreeMap::new();
         let mut want = 0usize;
-        for (k, band) in rx {
-            waiting.insert(k, band);
-            while let Some(band) = waiting.remove(&want) {
+        let mut open = true;
+        while want < n as usize {
+            while let Ok((k, band)) = rx.try_recv() {
+                waiting.insert(k, band);
+            }
+            if let Some(band) = waiting.remove(&want) {
                 let (instructions, band_counters) = band.map_err(&fault)?;
                 counters.merge(&band_counters);
                 for instr in instructions.iter() {
@@ -362,6 +370,28 @@ fn feed_parallel(
                     s.push(instructions);
                 }
                 want += 1;
+                continue;
+            }
+            let k = next_band.fetch_add(1, Ordering::Relaxed);
+            if k < n as usize {
+                let reused = spare.lock().ok().and_then(|mut s| s.pop());
+                let mut band = reused.unwrap_or_default();
+                band.clear();
+                let r = plan
+                    .emit_rows(band_rows(k as u32), &mut band)
+                    .map(|counters| (band, counters));
+                waiting.insert(k, r);
+                continue;
+            }
+            // every band is taken: wait for the workers'
+            match open.then(|| rx.recv().ok()).flatten() {
+                Some((k, band)) => {
+                    waiting.insert(k, band);
+                }
+                // the workers are done: every band is here
+                None if waiting.contains_key(&want) => open = false,
+                // a worker panicked without sending its band: the scope raises it
+                None => break,
             }
         }
         Ok(counters)

@@ -144,7 +144,11 @@ impl PolygonScene {
                 let start = Instant::now();
                 let (polygons, vis) = if phong {
                     let (fragments, stats) =
-                        cwisim_world::visibility::exact_fragments(&tris, w.channels());
+                        cwisim_world::visibility::exact_fragments_on(
+                            &tris,
+                            w.channels(),
+                            settings.threads,
+                        );
                     let sources = fragments.iter().map(|f| f.source).collect();
                     prepared.phong = Some(PhongSurfaces {
                         triangles: tris,
@@ -153,7 +157,7 @@ impl PolygonScene {
                     });
                     (fragments.into_iter().map(|f| f.polygon).collect(), Some(stats))
                 } else {
-                    cwisim_world::resolve(&tris, w.channels(), settings.visibility)
+                    cwisim_world::resolve_on(&tris, w.channels(), settings.visibility, settings.threads)
                 };
                 prepared.visibility_time = start.elapsed();
                 prepared.screen = w.screen(polygons);

@@ -102,6 +102,10 @@ pub struct Settings {
     /// Adaptive refinement: a polygon is Phong-shaded when the angle (degrees) between a
     /// corner's highlight vector and the direction to the eye is within this.
     pub phong_angle: Threshold,
+    /// Threads the host-side preparation may use (exact visibility; 0: one per core).
+    /// The polygons are the same, bit for bit, at any count. `render --threads N` sets
+    /// it with the pipeline's.
+    pub threads: usize,
 }
 
 /// A refinement threshold: `all` (everything passes), `none` (nothing does), or a
@@ -266,6 +270,7 @@ impl Default for Settings {
             gouraud_threshold: Threshold::Above(DEFAULT_GOURAUD_THRESHOLD),
             aa_threshold: Threshold::Above(DEFAULT_AA_THRESHOLD),
             phong_angle: Threshold::Above(DEFAULT_PHONG_ANGLE),
+            threads: 1,
         }
     }
 }

@@ -210,9 +210,22 @@ pub fn resolve(
     channels: usize,
     visibility: Visibility,
 ) -> (Vec<Polygon>, Option<VisibilityStats>) {
+    resolve_on(tris, channels, visibility, 1)
+}
+
+/// [`resolve`] with exact visibility on `threads` threads
+/// ([`visibility::exact_fragments_on`]; 0: one per core): the same polygons and
+/// statistics, bit for bit, at any thread count. Front-to-back order is a sort, on one
+/// thread.
+pub fn resolve_on(
+    tris: &[face::ScreenTriangle],
+    channels: usize,
+    visibility: Visibility,
+    threads: usize,
+) -> (Vec<Polygon>, Option<VisibilityStats>) {
     match visibility {
         Visibility::Exact => {
-            let (fragments, stats) = visibility::exact_fragments(tris, channels);
+            let (fragments, stats) = visibility::exact_fragments_on(tris, channels, threads);
             (
                 fragments.into_iter().map(|f| f.polygon).collect(),
                 Some(stats),

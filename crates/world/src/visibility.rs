@@ -54,6 +54,17 @@
 //!
 //! Output order is deterministic: by source index, then in `i_overlay`'s order.
 //!
+//! ## Threads
+//!
+//! Each triangle's fragments depend only on the triangle, its candidates and what is
+//! built once for all (the `1/depth` planes, the grid, the box index, the first of each
+//! exact copy), all read-only: [`exact_fragments_on`] cuts the triangles into contiguous
+//! chunks (eight per thread, so that chunks of uneven cost balance out), which the threads
+//! take one at a time, and joins the chunks' fragments in triangle order. The counts are
+//! summed; the dropped slivers' areas are kept per chunk and added in triangle order, as
+//! one thread adds them, so the statistics too are the same bit for bit at any thread
+//! count. Each thread holds one triangle's candidates and pieces at a time, as below.
+//!
 //! ## Depth complexity
 //!
 //! Memory is the index (one entry per triangle and cell it covers) plus one triangle's
@@ -107,6 +118,8 @@ use i_overlay::i_float::adapter::FloatPointAdapter;
 use i_overlay::i_float::float::rect::FloatRect;
 use std::collections::HashMap;
 use std::hash::{Hash, Hasher};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
 
 /// A screen point `[x, y]`.
 type Pt = [f64; 2];
@@ -186,13 +199,31 @@ pub fn exact_fragments(
     tris: &[ScreenTriangle],
     channels: usize,
 ) -> (Vec<Fragment>, VisibilityStats) {
+    exact_fragments_on(tris, channels, 1)
+}
+
+/// [`exact_fragments`] on `threads` threads (0: one per core; 1: on the calling thread,
+/// as [`exact_fragments`]). The output and the statistics are the same for any thread
+/// count, bit for bit: the triangles are cut into contiguous chunks, which threads take
+/// one at a time (the calling thread among them), and the chunks' fragments are joined
+/// in triangle order and their statistics summed in that order (see "Threads" in the
+/// [module docs](self)).
+///
+/// # Panics
+///
+/// If `channels` exceeds the length of an intensity [`Vector`].
+pub fn exact_fragments_on(
+    tris: &[ScreenTriangle],
+    channels: usize,
+    threads: usize,
+) -> (Vec<Fragment>, VisibilityStats) {
     assert!(
         channels <= MAX_CHANNELS,
         "{channels} channels; an intensity vector holds at most {MAX_CHANNELS}"
     );
-    let mut stats = VisibilityStats {
-        triangles: tris.len() as u64,
-        ..VisibilityStats::default()
+    let threads = match threads {
+        0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
+        n => n,
     };
     let usable: Vec<bool> = tris.iter().map(drawable).collect();
     let planes: Vec<Plane> = tris.iter().map(Plane::of).collect();
@@ -202,9 +233,9 @@ pub fn exact_fragments(
             .filter(|(_, &u)| u)
             .flat_map(|(t, _)| t.points),
     );
-
     // Triangle by triangle, so that memory holds one triangle's occluders at a time
-    // whatever the depth complexity (see "Depth complexity" in the module docs).
+    // (per thread) whatever the depth complexity (see "Depth complexity" in the module
+    // docs).
     let index = BoxIndex::new(tris, &usable);
     // the first usable triangle of each exact geometry
     let mut copies: HashMap<[u64; 9], usize> = HashMap::new();
@@ -213,84 +244,192 @@ pub fn exact_fragments(
             copies.entry(copy_key(t)).or_insert(k);
         }
     }
-    let mut seen: HashMap<u64, usize> = HashMap::new();
-    let mut stamp = Vec::new();
-    let mut candidates = Vec::new();
-    let mut pieces: Vec<Contour> = Vec::new();
-    let mut fragments = Vec::new();
-    let mut contours = Vec::new();
-    for (k, tri) in tris.iter().enumerate() {
-        let before = fragments.len();
-        if usable[k] {
-            // An exact copy of an earlier triangle (the same vertices and `1/depth`, in any
-            // order) is coplanar with it over all of it, and the lower index wins: hidden,
-            // without looking at anything else (coincident layers are made of these).
-            if let Some(&first) = copies.get(&copy_key(tri)) {
-                if first != k && area(&tri.points) > PIECE_AREA {
-                    stats.occluding_pairs += 1;
-                    stats.hidden += 1;
-                    stats.copies_hidden += 1;
-                    continue;
-                }
+    let shared = Shared {
+        tris,
+        channels,
+        usable: &usable,
+        planes: &planes,
+        grid: &grid,
+        index: &index,
+        copies: &copies,
+    };
+    let n = tris.len();
+    let chunks = if threads > 1 {
+        (threads * CHUNKS_PER_THREAD).clamp(1, n.max(1))
+    } else {
+        1
+    };
+    let tallies: Vec<Tally> = if chunks == 1 {
+        vec![shared.chunk(0..n)]
+    } else {
+        let range = |c: usize| c * n / chunks..(c + 1) * n / chunks;
+        let next = AtomicUsize::new(0);
+        let slots: Vec<Mutex<Option<Tally>>> = (0..chunks).map(|_| Mutex::new(None)).collect();
+        let work = || loop {
+            let c = next.fetch_add(1, Ordering::Relaxed);
+            if c >= chunks {
+                break;
             }
-            index.candidates(k, &mut candidates, &mut stamp);
-            seen.clear();
-            pieces.clear();
-            let mut covered = false;
-            for (n, &c) in candidates.iter().enumerate() {
-                let Some(piece) = piece_hiding(tris, &planes, c, k) else {
-                    continue;
-                };
-                stats.occluding_pairs += 1;
-                // one piece holding all of the triangle hides it: no boolean, and the
-                // remaining candidates cannot change that
-                if contains_triangle(&piece, &tri.points) {
-                    covered = true;
-                    stats.candidates_skipped += (candidates.len() - n - 1) as u64;
-                    break;
-                }
-                // a piece equal to one already taken adds nothing (coincident layers
-                // give many)
-                let first = *seen.entry(bits_hash(&piece)).or_insert(pieces.len());
-                if first == pieces.len() || !same_bits(&pieces[first], &piece) {
-                    pieces.push(piece);
-                }
+            let tally = shared.chunk(range(c));
+            *slots[c].lock().unwrap_or_else(|e| e.into_inner()) = Some(tally);
+        };
+        std::thread::scope(|scope| {
+            for _ in 1..threads.min(chunks) {
+                scope.spawn(work);
             }
-            let cut = if covered {
-                Some(Vec::new())
-            } else if pieces.is_empty() {
-                None
-            } else {
-                let subject = vec![positive(tri.points.to_vec())];
-                Some(overlay(&grid, &subject, &pieces, OverlayRule::Difference))
-            };
-            let shapes = cut.unwrap_or_else(|| vec![vec![tri.points.to_vec()]]);
-            contours.clear();
-            for shape in shapes {
-                settle(&grid, shape, usize::MAX, &mut contours, &mut stats);
-            }
-            for c in contours.drain(..) {
-                let intensity = c
-                    .iter()
-                    .map(|&p| {
-                        let v = tri
-                            .intensity_at(p, channels)
-                            .expect("a drawable triangle has nonzero area");
-                        v[..channels].to_vec()
-                    })
-                    .collect();
-                fragments.push(Fragment {
-                    source: k,
-                    polygon: Polygon::new(c, intensity),
-                });
-            }
+            work();
+        });
+        slots
+            .into_iter()
+            .map(|s| {
+                s.into_inner()
+                    .unwrap_or_else(|e| e.into_inner())
+                    .expect("every chunk is taken")
+            })
+            .collect()
+    };
+    let mut stats = VisibilityStats {
+        triangles: n as u64,
+        ..VisibilityStats::default()
+    };
+    let mut fragments = Vec::with_capacity(tallies.iter().map(|t| t.fragments.len()).sum());
+    for t in tallies {
+        stats.occluding_pairs += t.stats.occluding_pairs;
+        stats.hidden += t.stats.hidden;
+        stats.copies_hidden += t.stats.copies_hidden;
+        stats.candidates_skipped += t.stats.candidates_skipped;
+        stats.hole_cuts += t.stats.hole_cuts;
+        stats.dropped_slivers += t.stats.dropped_slivers;
+        // in triangle order, one at a time, as one thread adds them
+        for a in t.dropped {
+            stats.dropped_area += a;
         }
-        if fragments.len() == before {
-            stats.hidden += 1;
-        }
+        fragments.extend(t.fragments);
     }
     stats.fragments = fragments.len() as u64;
     (fragments, stats)
+}
+
+/// Chunks of triangles per thread: enough that chunks of uneven cost balance out.
+const CHUNKS_PER_THREAD: usize = 8;
+
+/// What every chunk of [`exact_fragments_on`] reads.
+struct Shared<'a> {
+    tris: &'a [ScreenTriangle],
+    channels: usize,
+    usable: &'a [bool],
+    planes: &'a [Plane],
+    grid: &'a Grid,
+    index: &'a BoxIndex,
+    /// The first usable triangle of each exact geometry ([`copy_key`]).
+    copies: &'a HashMap<[u64; 9], usize>,
+}
+
+/// What one chunk of triangles gave: its fragments in order, its counts, and the areas of
+/// the slivers it dropped, in order (summed by the caller, in triangle order, so that the
+/// total does not depend on how the triangles were chunked).
+struct Tally {
+    fragments: Vec<Fragment>,
+    stats: VisibilityStats,
+    dropped: Vec<f64>,
+}
+
+impl Shared<'_> {
+    /// The fragments of the triangles `range`.
+    fn chunk(&self, range: std::ops::Range<usize>) -> Tally {
+        let Shared {
+            tris,
+            channels,
+            usable,
+            planes,
+            grid,
+            index,
+            copies,
+        } = *self;
+        let mut tally = Tally {
+            fragments: Vec::new(),
+            stats: VisibilityStats::default(),
+            dropped: Vec::new(),
+        };
+        let mut seen: HashMap<u64, usize> = HashMap::new();
+        let mut stamp = Vec::new();
+        let mut candidates = Vec::new();
+        let mut pieces: Vec<Contour> = Vec::new();
+        let mut contours = Vec::new();
+        for k in range {
+            let tri = &tris[k];
+            let before = tally.fragments.len();
+            if usable[k] {
+                // An exact copy of an earlier triangle (the same vertices and `1/depth`, in
+                // any order) is coplanar with it over all of it, and the lower index wins:
+                // hidden, without looking at anything else (coincident layers are made of
+                // these).
+                if let Some(&first) = copies.get(&copy_key(tri)) {
+                    if first != k && area(&tri.points) > PIECE_AREA {
+                        tally.stats.occluding_pairs += 1;
+                        tally.stats.hidden += 1;
+                        tally.stats.copies_hidden += 1;
+                        continue;
+                    }
+                }
+                index.candidates(k, &mut candidates, &mut stamp);
+                seen.clear();
+                pieces.clear();
+                let mut covered = false;
+                for (n, &c) in candidates.iter().enumerate() {
+                    let Some(piece) = piece_hiding(tris, planes, c, k) else {
+                        continue;
+                    };
+                    tally.stats.occluding_pairs += 1;
+                    // one piece holding all of the triangle hides it: no boolean, and the
+                    // remaining candidates cannot change that
+                    if contains_triangle(&piece, &tri.points) {
+                        covered = true;
+                        tally.stats.candidates_skipped += (candidates.len() - n - 1) as u64;
+                        break;
+                    }
+                    // a piece equal to one already taken adds nothing (coincident layers
+                    // give many)
+                    let first = *seen.entry(bits_hash(&piece)).or_insert(pieces.len());
+                    if first == pieces.len() || !same_bits(&pieces[first], &piece) {
+                        pieces.push(piece);
+                    }
+                }
+                let cut = if covered {
+                    Some(Vec::new())
+                } else if pieces.is_empty() {
+                    None
+                } else {
+                    let subject = vec![positive(tri.points.to_vec())];
+                    Some(overlay(grid, &subject, &pieces, OverlayRule::Difference))
+                };
+                let shapes = cut.unwrap_or_else(|| vec![vec![tri.points.to_vec()]]);
+                contours.clear();
+                for shape in shapes {
+                    settle(grid, shape, usize::MAX, &mut contours, &mut tally);
+                }
+                for c in contours.drain(..) {
+                    let intensity = c
+                        .iter()
+                        .map(|&p| {
+                            let v = tri
+                                .intensity_at(p, channels)
+                                .expect("a drawable triangle has nonzero area");
+                            v[..channels].to_vec()
+                        })
+                        .collect();
+                    tally.fragments.push(Fragment {
+                        source: k,
+                        polygon: Polygon::new(c, intensity),
+                    });
+                }
+            }
+            if tally.fragments.len() == before {
+                tally.stats.hidden += 1;
+            }
+        }
+        tally
+    }
 }
 
 /// The piece of triangle `front` that hides part of triangle `back`, or `None` where it
@@ -755,29 +894,23 @@ fn overlay(grid: &Grid, subject: &Shape, clip: &Shape, rule: OverlayRule) -> Vec
 /// Turns one result shape (outline, then holes) into hole-free contours in `out`:
 /// drops slivers, cuts holes away, tidies the outlines. `max_holes` is what a part of a
 /// cut may still have (the safeguard against endless recursion).
-fn settle(
-    grid: &Grid,
-    shape: Shape,
-    max_holes: usize,
-    out: &mut Vec<Contour>,
-    stats: &mut VisibilityStats,
-) {
+fn settle(grid: &Grid, shape: Shape, max_holes: usize, out: &mut Vec<Contour>, tally: &mut Tally) {
     let mut contours = shape.into_iter();
     let Some(outline) = contours.next() else {
         return;
     };
     let outline_area = area(&outline);
     if outline_area < SLIVER_AREA {
-        stats.dropped_slivers += 1;
-        stats.dropped_area += outline_area;
+        tally.stats.dropped_slivers += 1;
+        tally.dropped.push(outline_area);
         return;
     }
     let mut holes = Vec::new();
     for h in contours {
         let a = area(&h);
         if a < SLIVER_AREA {
-            stats.dropped_slivers += 1;
-            stats.dropped_area += a;
+            tally.stats.dropped_slivers += 1;
+            tally.dropped.push(a);
         } else {
             holes.push(h);
         }
@@ -785,22 +918,22 @@ fn settle(
     if holes.len() > max_holes {
         // never observed: the cut did not remove a hole
         for h in holes.drain(..) {
-            stats.dropped_slivers += 1;
-            stats.dropped_area += area(&h);
+            tally.stats.dropped_slivers += 1;
+            tally.dropped.push(area(&h));
         }
     }
     if holes.is_empty() {
         let outline = tidy(outline);
         let a = area(&outline);
         if outline.len() < 3 || a < SLIVER_AREA {
-            stats.dropped_slivers += 1;
-            stats.dropped_area += a;
+            tally.stats.dropped_slivers += 1;
+            tally.dropped.push(a);
         } else {
             out.push(outline);
         }
         return;
     }
-    stats.hole_cuts += 1;
+    tally.stats.hole_cuts += 1;
     let (lo, hi) = holes[0]
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
@@ -813,7 +946,7 @@ fn settle(
     for (top, bottom) in [(-m, cut), (cut, m)] {
         let half = vec![vec![[-m, top], [m, top], [m, bottom], [-m, bottom]]];
         for part in overlay(grid, &whole, &half, OverlayRule::Intersect) {
-            settle(grid, part, left, out, stats);
+            settle(grid, part, left, out, tally);
         }
     }
 }

@@ -75,9 +75,10 @@ pub struct RenderArgs {
     /// Print nothing (errors still go to standard error).
     #[arg(short, long)]
     pub quiet: bool,
-    /// Threads: with N > 1, N − 1 threads emit bands of scanlines while one feeds them,
-    /// in order, to the array (0: one per core). The output, trace and statistics
-    /// are identical to the serial run's, byte for byte.
+    /// Threads: with N > 1, exact visibility runs on N threads, then N − 1 threads emit
+    /// bands of scanlines while one feeds them, in order, to the array (0: one per core).
+    /// The output, trace and statistics are identical to the serial run's, byte for
+    /// byte.
     #[arg(long, default_value_t = 1, value_name = "N")]
     pub threads: usize,
 }
@@ -143,7 +144,7 @@ pub fn run_render(
         ],
     )?;
     args.cost.check()?;
-    let drawn = args.draw.draw(args.scene.as_deref())?;
+    let drawn = args.draw.draw_on(args.scene.as_deref(), args.threads)?;
     let mut image_args = args.image.clone();
     if let Some(png) = default_png(args, &drawn) {
         image_args.output = Some(png);
