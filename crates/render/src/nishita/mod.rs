@@ -289,7 +289,8 @@ impl Nishita {
         let start = Instant::now();
         let channels = w.channels();
         let (polygons, vis, surfaces) = if phong {
-            let (fragments, stats) = cwisim_world::visibility::exact_fragments(&tris, channels);
+            let (fragments, stats) =
+                cwisim_world::visibility::exact_fragments_on(&tris, channels, settings.threads);
             let sources = fragments.iter().map(|f| f.source).collect();
             let polygons = fragments.into_iter().map(|f| f.polygon).collect();
             (
@@ -302,7 +303,8 @@ impl Nishita {
                 }),
             )
         } else {
-            let (p, s) = cwisim_world::resolve(&tris, channels, settings.visibility);
+            let (p, s) =
+                cwisim_world::resolve_on(&tris, channels, settings.visibility, settings.threads);
             (p, s, None)
         };
         let visibility_time = start.elapsed();
