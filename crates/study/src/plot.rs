@@ -230,6 +230,56 @@ where
     Ok(())
 }
 
+/// Whole decades around `lo..=hi` (both > 0), at least one: the ends of a log axis.
+pub fn decades(lo: f64, hi: f64) -> (f64, f64) {
+    let a = 10f64.powf(lo.log10().floor());
+    let b = 10f64.powf((hi * 1.0001).log10().ceil()).max(a * 10.0);
+    (a, b)
+}
+
+/// The direction of a log axis's decade grid.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LogAxis {
+    /// Horizontal: vertical grid lines, labels below the panel.
+    X,
+    /// Vertical: horizontal grid lines, labels left of the panel.
+    Y,
+}
+
+/// The decade grid of a log axis from `lo` to `hi` (as [`decades`] gives them): for every
+/// power of ten a grey line across the panel, from `across.0` to `across.1` pixels, and a
+/// `1e3`-style label beyond the panel's edge (below `across.1`, or left of `across.0`);
+/// `at(v)` is the pixel of value `v` along the axis.
+pub fn decade_grid(
+    root: &DrawingArea<BitMapBackend<'_>, Shift>,
+    labels: &mut Vec<Label>,
+    axis: LogAxis,
+    (lo, hi): (f64, f64),
+    at: impl Fn(f64) -> i32,
+    across: (i32, i32),
+) -> Result<(), String> {
+    let grid = RGBColor(228, 228, 228);
+    let mut v = lo;
+    while v <= hi * 1.0001 {
+        let p = at(v);
+        let text = format!("{v:.0e}");
+        let (line, label) = match axis {
+            LogAxis::X => (
+                vec![(p, across.0), (p, across.1)],
+                Label::new(text, (p, across.1 + 8), 13.0).align(Align::Center, Align::Start),
+            ),
+            LogAxis::Y => (
+                vec![(across.0, p), (across.1, p)],
+                Label::new(text, (across.0 - 8, p), 13.0).align(Align::End, Align::Center),
+            ),
+        };
+        root.draw(&PathElement::new(line, grid)).map_err(err)?;
+        labels.push(label);
+        v *= 10.0;
+    }
+    Ok(())
+}
+
 /// Turns a plotting error into a message.
 pub fn err<E: std::fmt::Display>(e: E) -> String {
     format!("cannot draw the plot: {e}")

@@ -5,7 +5,7 @@
 //! vertical axes and the cycles axis are logarithmic; errors below [`ERROR_FLOOR`] (an
 //! image equal to the full-quality one) sit on the floor.
 
-use crate::plot::{draw_on, err, rgb, Align, Label, Rgb, OVERRUN};
+use crate::plot::{decade_grid, decades, draw_on, err, rgb, Align, Label, LogAxis, Rgb, OVERRUN};
 use crate::refine::{PhaseRow, RefineRun};
 use plotters::prelude::*;
 
@@ -25,13 +25,6 @@ const PALETTE: [[u8; 3]; 7] = [
     [23, 190, 207],
 ];
 const NAIVE: [u8; 3] = [127, 127, 127];
-
-/// Decades around `lo..hi` (both > 0).
-fn decades(lo: f64, hi: f64) -> (f64, f64) {
-    let a = 10f64.powf(lo.log10().floor());
-    let b = 10f64.powf((hi * 1.0001).log10().ceil()).max(a * 10.0);
-    (a, b)
-}
 
 /// Draws the chart of `runs` (each with its label: the sweep value, or none).
 pub fn render_refine_plot(runs: &[(Option<String>, RefineRun)]) -> Result<Rgb, String> {
@@ -105,7 +98,6 @@ pub fn render_refine_plot(runs: &[(Option<String>, RefineRun)]) -> Result<Rgb, S
             (16, 44),
             14.0,
         ));
-        let grid = RGBColor(228, 228, 228);
         // the upper panel
         let area = root.clone().shrink(
             (left as u32, top_upper as u32),
@@ -114,31 +106,23 @@ pub fn render_refine_plot(runs: &[(Option<String>, RefineRun)]) -> Result<Rgb, S
         let mut chart = ChartBuilder::on(&area)
             .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
             .map_err(err)?;
-        let mut y = y0;
-        while y <= y1 * 1.0001 {
-            let (_, py) = chart.backend_coord(&(x0, y));
-            root.draw(&PathElement::new(vec![(left, py), (right, py)], grid))
-                .map_err(err)?;
-            labels.push(
-                Label::new(format!("{y:.0e}"), (left - 8, py), 13.0)
-                    .align(Align::End, Align::Center),
-            );
-            y *= 10.0;
-        }
-        let mut x = x0;
-        while x <= x1 * 1.0001 {
-            let (px, _) = chart.backend_coord(&(x, y0));
-            root.draw(&PathElement::new(
-                vec![(px, top_upper), (px, top_lower)],
-                grid,
-            ))
-            .map_err(err)?;
-            labels.push(
-                Label::new(format!("{x:.0e}"), (px, top_lower + 6), 13.0)
-                    .align(Align::Center, Align::Start),
-            );
-            x *= 10.0;
-        }
+        let at = |x: f64, y: f64| chart.backend_coord(&(x, y));
+        decade_grid(
+            root,
+            labels,
+            LogAxis::Y,
+            (y0, y1),
+            |y| at(x0, y).1,
+            (left, right),
+        )?;
+        decade_grid(
+            root,
+            labels,
+            LogAxis::X,
+            (x0, x1),
+            |x| at(x, y0).0,
+            (top_upper, top_lower),
+        )?;
         labels.push(
             Label::new(
                 "cumulative bus-busy cycles",
@@ -198,17 +182,14 @@ pub fn render_refine_plot(runs: &[(Option<String>, RefineRun)]) -> Result<Rgb, S
         let mut chart = ChartBuilder::on(&area)
             .build_cartesian_2d(0f64..lines, (b0..b1).log_scale())
             .map_err(err)?;
-        let mut y = b0;
-        while y <= b1 * 1.0001 {
-            let (_, py) = chart.backend_coord(&(0.0, y));
-            root.draw(&PathElement::new(vec![(left, py), (right, py)], grid))
-                .map_err(err)?;
-            labels.push(
-                Label::new(format!("{y:.0e}"), (left - 8, py), 13.0)
-                    .align(Align::End, Align::Center),
-            );
-            y *= 10.0;
-        }
+        decade_grid(
+            root,
+            labels,
+            LogAxis::Y,
+            (b0, b1),
+            |y| chart.backend_coord(&(0.0, y)).1,
+            (left, right),
+        )?;
         let (_, py) = chart.backend_coord(&(0.0, first.line_period.max(1) as f64));
         root.draw(&PathElement::new(
             vec![(left, py), (right, py)],

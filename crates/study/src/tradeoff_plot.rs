@@ -7,7 +7,7 @@
 //! report's), a hollow one point sampling; a circle is exact visibility, a square eval0 (or a screen scene). Errors
 //! below [`ERROR_FLOOR`] (an exact image) are drawn on the floor.
 
-use crate::plot::{draw_on, err, rgb, Align, Label, Rgb};
+use crate::plot::{decade_grid, decades, draw_on, err, rgb, Align, Label, LogAxis, Rgb};
 use crate::tradeoff::Row;
 use plotters::prelude::*;
 
@@ -46,11 +46,8 @@ pub fn render_tradeoff_plot(rows: &[Row], name: &str) -> Result<Rgb, String> {
     let (emin, emax) = rows.iter().fold((f64::INFINITY, 0.0f64), |(a, b), r| {
         (a.min(y_of(r)), b.max(y_of(r)))
     });
-    // decades around the data
-    let x0 = 10f64.powf((cmin as f64).log10().floor());
-    let x1 = 10f64.powf(((cmax as f64) * 1.0001).log10().ceil());
-    let y0 = 10f64.powf(emin.log10().floor());
-    let y1 = 10f64.powf((emax * 1.0001).log10().ceil()).max(y0 * 10.0);
+    let (x0, x1) = decades(cmin as f64, cmax as f64);
+    let (y0, y1) = decades(emin, emax);
 
     let (w, h) = TRADEOFF_PLOT_SIZE;
     let (left, right, upper, lower) = (90i32, w as i32 - 330, 80i32, h as i32 - 60);
@@ -73,30 +70,23 @@ pub fn render_tradeoff_plot(rows: &[Row], name: &str) -> Result<Rgb, String> {
         let mut chart = ChartBuilder::on(&area)
             .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
             .map_err(err)?;
-        let grid = RGBColor(228, 228, 228);
-        // decade grid lines and ticks
-        let mut y = y0;
-        while y <= y1 * 1.0001 {
-            let (_, py) = chart.backend_coord(&(x0, y));
-            root.draw(&PathElement::new(vec![(left, py), (right, py)], grid))
-                .map_err(err)?;
-            labels.push(
-                Label::new(format!("{y:.0e}"), (left - 8, py), 13.0)
-                    .align(Align::End, Align::Center),
-            );
-            y *= 10.0;
-        }
-        let mut x = x0;
-        while x <= x1 * 1.0001 {
-            let (px, _) = chart.backend_coord(&(x, y0));
-            root.draw(&PathElement::new(vec![(px, upper), (px, lower)], grid))
-                .map_err(err)?;
-            labels.push(
-                Label::new(format!("{x:.0e}"), (px, lower + 8), 13.0)
-                    .align(Align::Center, Align::Start),
-            );
-            x *= 10.0;
-        }
+        let at = |x: f64, y: f64| chart.backend_coord(&(x, y));
+        decade_grid(
+            root,
+            labels,
+            LogAxis::Y,
+            (y0, y1),
+            |y| at(x0, y).1,
+            (left, right),
+        )?;
+        decade_grid(
+            root,
+            labels,
+            LogAxis::X,
+            (x0, x1),
+            |x| at(x, y0).0,
+            (upper, lower),
+        )?;
         labels.push(
             Label::new(
                 "bus-busy cycles per frame",
