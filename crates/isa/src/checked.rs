@@ -34,6 +34,33 @@ impl CheckedStream {
         &self.header
     }
 
+    /// `instrs` as a stream for `header`, checked in one pass; or, if one does not fit,
+    /// the first that does not ([`Unfit`], with the instructions handed back).
+    pub fn from_vec(
+        header: &TraceHeader,
+        instrs: Vec<Instruction>,
+    ) -> Result<CheckedStream, Unfit> {
+        match instrs.iter().position(|i| i.check(header).is_err()) {
+            None => Ok(CheckedStream {
+                header: *header,
+                instrs,
+            }),
+            Some(index) => {
+                let error = instrs[index].check(header).expect_err("just refused");
+                Err(Unfit {
+                    instructions: instrs,
+                    index,
+                    error,
+                })
+            }
+        }
+    }
+
+    /// The instructions, given back (to reuse their memory).
+    pub fn into_vec(self) -> Vec<Instruction> {
+        self.instrs
+    }
+
     /// Appends `instr` if it fits the header; otherwise appends nothing and says why.
     #[inline]
     pub fn push(&mut self, instr: Instruction) -> Result<(), OperandError> {
@@ -60,6 +87,24 @@ impl CheckedStream {
     /// Empties the stream, keeping its memory for reuse.
     pub fn clear(&mut self) {
         self.instrs.clear();
+    }
+}
+
+/// Instructions of which one does not fit the header ([`CheckedStream::from_vec`]).
+#[derive(Clone, Debug)]
+pub struct Unfit {
+    /// The instructions offered, unchanged.
+    pub instructions: Vec<Instruction>,
+    /// The first that does not fit.
+    pub index: usize,
+    /// Why.
+    pub error: OperandError,
+}
+
+impl Unfit {
+    /// The refusal of the instruction that does not fit ([`refusal`]).
+    pub fn refusal(&self) -> io::Error {
+        refusal(&self.instructions[self.index], &self.error)
     }
 }
 
@@ -116,5 +161,29 @@ mod tests {
         assert_eq!(s.header(), &h);
         s.clear();
         assert!(s.is_empty());
+    }
+
+    #[test]
+    fn a_vector_is_checked_whole_and_refused_at_its_first_unfit_instruction() {
+        let h = TraceHeader::new(4, 1, 1).unwrap();
+        let g = Intensity::grey;
+        let good = vec![Instruction::eval1(0, 4, g(0.5)), Instruction::refresh()];
+        let s = CheckedStream::from_vec(&h, good.clone()).unwrap();
+        assert_eq!(s.instructions(), &good[..]);
+        assert_eq!(s.into_vec(), good);
+        let bad = Instruction::set_i(4, g(0.5));
+        let mixed = vec![
+            good[0].clone(),
+            bad.clone(),
+            Instruction::eval1(3, 2, g(1.0)),
+        ];
+        let u = CheckedStream::from_vec(&h, mixed.clone()).unwrap_err();
+        assert_eq!((u.index, &u.instructions), (1, &mixed));
+        assert_eq!(u.error, bad.check(&h).unwrap_err());
+        let mut one = CheckedStream::new(&h);
+        assert_eq!(
+            u.refusal().to_string(),
+            one.write(&bad).unwrap_err().to_string()
+        );
     }
 }

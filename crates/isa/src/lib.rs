@@ -48,7 +48,7 @@ pub mod opcode;
 pub mod packed;
 pub mod text;
 
-pub use checked::{refusal, CheckedStream};
+pub use checked::{refusal, CheckedStream, Unfit};
 pub use encoding::{create_trace, Encoding, FileReader};
 pub use error::{printable, ErrorKind, Location, TraceError};
 pub use header::{HeaderFault, TraceHeader, FORMAT_VERSION, MAX_CHANNELS, MAX_LINES, MAX_WIDTH};
