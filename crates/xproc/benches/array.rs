@@ -190,7 +190,10 @@ fn short_span_trace(width: u32, lines: u32) -> Vec<Instruction> {
 /// and through [`EngineWriter`]: `checked`, one `write` per instruction, each checked
 /// against the header first; `prechecked`, the stream checked once as it was buffered
 /// (a [`CheckedStream`], as the pipeline buffers a renderer's scanlines: the check is
-/// paid there) and executed by `write_checked` without a second check. Throughput in
+/// paid there) and executed by `write_checked` without a second check; `prechecked_dx1`,
+/// the same with every span one processor long instead of empty (one update each: an
+/// empty span takes a shorter path, without the dispatch on the `Eval`'s order, so this
+/// is the overhead of an instruction that does work, plus one update). Throughput in
 /// instructions.
 fn overhead(c: &mut Criterion, header: &TraceHeader) {
     let trace: Vec<Instruction> = short_span_trace(header.width, header.lines)
@@ -219,21 +222,30 @@ fn overhead(c: &mut Criterion, header: &TraceHeader) {
             black_box(w.into_stats())
         })
     });
-    let mut stream = CheckedStream::new(header);
-    for i in &trace {
-        stream.write(i).expect("fits");
-    }
-    group.bench_function("prechecked", |b| {
-        b.iter(|| {
-            let mut sink = NullSink;
-            let mut w =
-                EngineWriter::<f64>::new(header, &Machine::default(), Timing::Fast, &mut sink)
-                    .expect("default machine");
-            w.write_checked(black_box(&stream)).expect("fits");
-            w.finish().expect("finish");
-            black_box(w.into_stats())
+    let one: Vec<Instruction> = trace
+        .iter()
+        .map(|i| {
+            let mut i = i.clone();
+            if i.op != cwisim_isa::Opcode::Refresh {
+                i.dx = 1;
+            }
+            i
         })
-    });
+        .collect();
+    for (name, trace) in [("prechecked", &trace), ("prechecked_dx1", &one)] {
+        let stream = CheckedStream::from_vec(header, trace.clone()).expect("fits");
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                let mut sink = NullSink;
+                let mut w =
+                    EngineWriter::<f64>::new(header, &Machine::default(), Timing::Fast, &mut sink)
+                        .expect("default machine");
+                w.write_checked(black_box(&stream)).expect("fits");
+                w.finish().expect("finish");
+                black_box(w.into_stats())
+            })
+        });
+    }
     group.finish();
 }
 
