@@ -369,33 +369,33 @@ impl Instruction {
     }
 
     /// [`Self::check`]'s verdict without its message, from the opcode's shape in a table:
-    /// the test every sound instruction of a replay passes.
+    /// the test every sound instruction of a replay passes. The conditions are combined
+    /// with `&` and `|`, not `&&` and `||`: in a stream of mixed opcodes, a branch per
+    /// condition would be mispredicted at every change of shape.
     #[inline]
     fn fits(&self, header: &TraceHeader) -> bool {
         let shape = SHAPES[self.op.index()];
         let width = header.width;
-        if shape & HAS_X != 0 && self.x >= width {
-            return false;
-        }
-        if shape & HAS_COUNT != 0 && u64::from(self.x) + u64::from(self.dx) > u64::from(width) {
-            return false;
-        }
-        if shape & HAS_PERIOD != 0 && self.dx == 0 {
-            return false;
-        }
+        let x_outside = (shape & HAS_X != 0) & (self.x >= width);
+        let past_end =
+            (shape & HAS_COUNT != 0) & (u64::from(self.x) + u64::from(self.dx) > u64::from(width));
+        let no_period = (shape & HAS_PERIOD != 0) & (self.dx == 0);
+        let in_range = !(x_outside | past_end | no_period);
         let slots = shape >> SLOT_SHIFT;
-        match &self.values {
-            Values::Grey { present, v } => {
-                (slots == 0 || header.channels == 1)
-                    && present & slots == slots
-                    && (0..3).all(|s| slots & (1 << s) == 0 || v[s].is_finite())
+        in_range
+            & match &self.values {
+                Values::Grey { present, v } => {
+                    let finite = (0..3).fold(true, |ok, s| {
+                        ok & ((slots & (1 << s) == 0) | v[s].is_finite())
+                    });
+                    ((slots == 0) | (header.channels == 1)) & (present & slots == slots) & finite
+                }
+                Values::Wide(w) => (0..3).all(|s| {
+                    slots & (1 << s) == 0
+                        || (w[s].len() == header.channel_count()
+                            && w[s].as_slice().iter().all(|f| f.is_finite()))
+                }),
             }
-            Values::Wide(w) => (0..3).all(|s| {
-                slots & (1 << s) == 0
-                    || (w[s].len() == header.channel_count()
-                        && w[s].as_slice().iter().all(|f| f.is_finite()))
-            }),
-        }
     }
 
     /// [`Self::check`] operand by operand, saying what is wrong.

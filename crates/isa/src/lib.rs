@@ -13,6 +13,8 @@
 //!   (`.jsonl`), [`binary`] (`.cwb`). All are lossless (f64 bit-exact) and interconvert.
 //! * [`PackedStream`] — instructions buffered in memory at the size of the values they
 //!   carry (a band of scanlines handed from one thread to another).
+//! * [`CheckedStream`] — instructions checked once against a header as they are
+//!   appended, so that the array executes them without checking them again.
 //! * [`TraceError`] — every decoding fault is typed ([`ErrorKind`]), located
 //!   ([`Location`]: line and column, or byte offset) and says what was expected.
 //!
@@ -35,6 +37,7 @@
 #![warn(missing_docs)]
 
 pub mod binary;
+pub mod checked;
 pub mod encoding;
 pub mod error;
 pub mod header;
@@ -45,6 +48,7 @@ pub mod opcode;
 pub mod packed;
 pub mod text;
 
+pub use checked::{refusal, CheckedStream, Unfit};
 pub use encoding::{create_trace, Encoding, FileReader};
 pub use error::{printable, ErrorKind, Location, TraceError};
 pub use header::{HeaderFault, TraceHeader, FORMAT_VERSION, MAX_CHANNELS, MAX_LINES, MAX_WIDTH};

@@ -9,7 +9,7 @@
 //! * [`registry`] — the renderers by name ([`REGISTRY`]); adding one is its module plus
 //!   one line there.
 //! * [`pipeline`] — [`render`]: a renderer's frames, in bands on threads, fed to the
-//!   simulated array ([`ArrayConfig`]) scanline by scanline, byte-identical at any thread
+//!   simulated array ([`ArrayConfig`]) in batches of whole scanlines, byte-identical at any thread
 //!   count, with the renderer's and the array's wall time; [`emit`](fn@emit): the stream
 //!   alone, into a trace.
 //! * [`source`] — which scene ([`Source`]: a file or an embedded name) and reading it.

@@ -1,6 +1,6 @@
 //! The pipeline: a renderer's frames, emitted (in bands, on threads when asked) and fed
-//! to the simulated X-processor array scanline by scanline, with the wall time of each
-//! side measured.
+//! to the simulated X-processor array in batches of whole scanlines (checked once, then
+//! executed in one call), with the wall time of each side measured.
 //!
 //! With `threads > 1`, `threads − 1` workers each take the next band of rows of the frame
 //! and emit it into a [`PackedStream`]; the calling thread feeds the finished bands to the
@@ -12,7 +12,7 @@
 
 use crate::error::RenderError;
 use crate::renderer::{Counters, FramePlan, Renderer};
-use cwisim_isa::{Instruction, Opcode, PackedStream, TraceHeader, TraceWrite};
+use cwisim_isa::{CheckedStream, Instruction, Opcode, PackedStream, TraceHeader, TraceWrite};
 use cwisim_xproc::{EngineWriter, Image, LineOut, LineSink, Machine, Numeric, RunStats, Timing};
 use std::cell::RefCell;
 use std::io;
@@ -114,6 +114,9 @@ pub fn render(
             })?
         };
         counters.merge(&band);
+        // the frame's last scanlines reach the array (and the kept frame) before the
+        // next frame is planned
+        feed.flush().map_err(RenderError::Array)?;
         drop(plan);
         if let Some(frame) = &frame_image {
             previous = Some(frame.replace(empty_image(&header)));
@@ -177,13 +180,21 @@ impl LineSink<f64> for FrameKeeper<'_> {
     }
 }
 
-/// The array, fed one scanline at a time: instructions are buffered up to each
-/// `Refresh`, so that the array's share of the wall time is measured per scanline rather
-/// than per instruction. Every instruction also goes to the taps as it comes.
+/// The array, fed a batch of whole scanlines at a time: instructions are buffered up to
+/// the first `Refresh` past [`ScanlineFeed::BATCH`] instructions, then checked in one
+/// pass ([`CheckedStream::from_vec`]: once, not again by the array) and executed in one
+/// call — so that the array's state, the image rows and the renderer's each stay in
+/// cache for a while rather than alternating every scanline, and the array's share of
+/// the wall time (its check included) is measured per batch rather than per instruction.
+/// Every instruction also goes to the taps as it comes; the progress tap hears of each
+/// scanline once the array has output it.
 struct ScanlineFeed<'a, 's> {
     array: EngineWriter<'s, f64>,
+    header: TraceHeader,
     taps: Taps<'a>,
     buffer: Vec<Instruction>,
+    /// Scanlines ended (`Refresh`) in the buffer.
+    buffered_lines: u64,
     array_time: Duration,
     lines: u64,
     /// The array's (or a tap's) own failure, told apart from the renderer's.
@@ -191,6 +202,10 @@ struct ScanlineFeed<'a, 's> {
 }
 
 impl<'a, 's> ScanlineFeed<'a, 's> {
+    /// Instructions buffered before the array runs them (at the next `Refresh`): about
+    /// 200 KB, a few dozen scanlines of a busy frame.
+    const BATCH: usize = 4096;
+
     fn open(
         header: &TraceHeader,
         array: &ArrayConfig,
@@ -205,8 +220,10 @@ impl<'a, 's> ScanlineFeed<'a, 's> {
                 &array.numeric,
                 sink,
             )?,
+            header: *header,
             taps,
             buffer: Vec::new(),
+            buffered_lines: 0,
             array_time: Duration::ZERO,
             lines: 0,
             fault: None,
@@ -234,13 +251,32 @@ impl<'a, 's> ScanlineFeed<'a, 's> {
         })
     }
 
+    /// Checks the buffered instructions and runs them through the array, then tells the
+    /// progress tap of each scanline they completed.
     fn flush(&mut self) -> io::Result<()> {
         let start = Instant::now();
-        for instr in self.buffer.drain(..) {
-            self.array.write(&instr)?;
-        }
+        let r = self.run_buffer();
         self.array_time += start.elapsed();
+        r?;
+        for _ in 0..std::mem::take(&mut self.buffered_lines) {
+            self.lines += 1;
+            if let Some(p) = self.taps.progress.as_deref_mut() {
+                p(self.lines);
+            }
+        }
         Ok(())
+    }
+
+    /// The buffer checked (an instruction that does not fit is refused as
+    /// [`EngineWriter`]'s `write` refuses it, and nothing of the batch runs) and run
+    /// through the array; the buffer emptied for reuse.
+    fn run_buffer(&mut self) -> io::Result<()> {
+        let raw = std::mem::take(&mut self.buffer);
+        let stream = CheckedStream::from_vec(&self.header, raw).map_err(|u| u.refusal())?;
+        let r = self.array.write_checked(&stream);
+        self.buffer = stream.into_vec();
+        self.buffer.clear();
+        r
     }
 
     /// Notes an error of the array's or a tap's own, so that it is not blamed on the
@@ -262,11 +298,10 @@ impl TraceWrite for ScanlineFeed<'_, '_> {
         }
         self.buffer.push(instr.clone());
         if instr.op == Opcode::Refresh {
-            let r = self.flush();
-            self.own(r)?;
-            self.lines += 1;
-            if let Some(p) = self.taps.progress.as_deref_mut() {
-                p(self.lines);
+            self.buffered_lines += 1;
+            if self.buffer.len() >= Self::BATCH {
+                let r = self.flush();
+                self.own(r)?;
             }
         }
         Ok(())

@@ -192,3 +192,104 @@ fn a_renderers_bad_instruction_is_an_internal_fault() {
         assert!(e.to_string().contains("the array failed"), "{e}");
     }
 }
+
+/// One frame of many scanlines, each of many instructions: the array is fed in several
+/// batches.
+struct Stripes;
+
+impl Stripes {
+    const WIDTH: u32 = 64;
+    const LINES: u32 = 300;
+}
+
+impl FramePlan for Stripes {
+    fn emit_rows(&self, rows: Range<u32>, sink: &mut dyn TraceWrite) -> io::Result<Counters> {
+        for y in rows {
+            for k in 0..20 {
+                let x = (y * 7 + k * 3) % (Self::WIDTH - 4);
+                sink.write(&Instruction::eval1(
+                    x,
+                    4,
+                    Intensity::grey(f64::from(k) / 32.0),
+                ))?;
+            }
+            sink.write(&Instruction::refresh())?;
+        }
+        Ok(Counters::default())
+    }
+}
+
+impl Renderer for Stripes {
+    fn name(&self) -> &'static str {
+        "stripes"
+    }
+
+    fn header(&self) -> TraceHeader {
+        TraceHeader::new(Self::WIDTH, Self::LINES, 1).unwrap()
+    }
+
+    fn frame<'a>(
+        &'a self,
+        _: u32,
+        _: Option<&'a Image>,
+    ) -> Result<Box<dyn FramePlan + 'a>, RenderError> {
+        Ok(Box::new(Stripes))
+    }
+
+    fn settings_phrase(&self) -> String {
+        "stripes".into()
+    }
+}
+
+/// Counts the scanlines the array outputs.
+struct Counting<'c>(&'c std::cell::Cell<u64>);
+
+impl cwisim_xproc::LineSink<f64> for Counting<'_> {
+    fn line(&mut self, _: cwisim_xproc::LineOut<'_, f64>) {
+        self.0.set(self.0.get() + 1);
+    }
+}
+
+#[test]
+fn the_taps_hear_every_instruction_and_every_scanline_once_it_is_output() {
+    let mut emitted: Vec<Instruction> = Vec::new();
+    emit(&Stripes, &mut emitted).unwrap();
+    for threads in [1, 2] {
+        let output = std::cell::Cell::new(0);
+        let mut heard: Vec<Instruction> = Vec::new();
+        let mut told = Vec::new();
+        let mut progress = |n: u64| {
+            assert!(
+                output.get() >= n,
+                "told of scanline {n} before the array output it"
+            );
+            told.push(n);
+        };
+        let done = render(
+            &Stripes,
+            &ArrayConfig::default(),
+            threads,
+            &mut Counting(&output),
+            Taps {
+                also: Some(&mut heard),
+                progress: Some(&mut progress),
+            },
+        )
+        .unwrap();
+        assert_eq!(heard, emitted, "{threads} threads");
+        assert_eq!(told, (1..=u64::from(Stripes::LINES)).collect::<Vec<_>>());
+        assert_eq!(output.get(), u64::from(Stripes::LINES));
+        assert_eq!(done.stats.totals.instructions, emitted.len() as u64);
+    }
+}
+
+#[test]
+fn the_arrays_refusal_of_a_renderers_instruction_is_its_own_message() {
+    for threads in [1, 2] {
+        let e = run(&Broken, threads).expect_err("refused");
+        assert_eq!(
+            e.to_string(),
+            "the array failed: Eval1 6 2 1.0: range [x, x+dx) = [6, 8) reaches past the array's end (7)"
+        );
+    }
+}

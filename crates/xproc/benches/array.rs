@@ -11,7 +11,7 @@
 //! `replay_overhead_1024x1024`: what an instruction costs beyond its updates.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use cwisim_isa::{Instruction, Intensity, TraceHeader, TraceWrite};
+use cwisim_isa::{CheckedStream, Instruction, Intensity, TraceHeader, TraceWrite};
 use cwisim_xproc::{
     engine, numeric_engine, wave_closed_form, Arith, EngineWriter, FixedArith, Machine, NullSink,
     Numeric, Timing,
@@ -187,8 +187,14 @@ fn short_span_trace(width: u32, lines: u32) -> Vec<Instruction> {
 /// What an instruction costs beyond its processor updates: the short-span frame with
 /// every span emptied (`dx = 0`: issued, timed and counted, no processor touched),
 /// replayed by the engine alone (`engine`, as `cwisim run` after its decoder's check)
-/// and through [`EngineWriter`] (`checked`, as a renderer feeds the array: each
-/// instruction checked against the header first). Throughput in instructions.
+/// and through [`EngineWriter`]: `checked`, one `write` per instruction, each checked
+/// against the header first; `prechecked`, the stream checked once as it was buffered
+/// (a [`CheckedStream`], as the pipeline buffers a renderer's scanlines: the check is
+/// paid there) and executed by `write_checked` without a second check; `prechecked_dx1`,
+/// the same with every span one processor long instead of empty (one update each: an
+/// empty span takes a shorter path, without the dispatch on the `Eval`'s order, so this
+/// is the overhead of an instruction that does work, plus one update). Throughput in
+/// instructions.
 fn overhead(c: &mut Criterion, header: &TraceHeader) {
     let trace: Vec<Instruction> = short_span_trace(header.width, header.lines)
         .into_iter()
@@ -216,6 +222,30 @@ fn overhead(c: &mut Criterion, header: &TraceHeader) {
             black_box(w.into_stats())
         })
     });
+    let one: Vec<Instruction> = trace
+        .iter()
+        .map(|i| {
+            let mut i = i.clone();
+            if i.op != cwisim_isa::Opcode::Refresh {
+                i.dx = 1;
+            }
+            i
+        })
+        .collect();
+    for (name, trace) in [("prechecked", &trace), ("prechecked_dx1", &one)] {
+        let stream = CheckedStream::from_vec(header, trace.clone()).expect("fits");
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                let mut sink = NullSink;
+                let mut w =
+                    EngineWriter::<f64>::new(header, &Machine::default(), Timing::Fast, &mut sink)
+                        .expect("default machine");
+                w.write_checked(black_box(&stream)).expect("fits");
+                w.finish().expect("finish");
+                black_box(w.into_stats())
+            })
+        });
+    }
     group.finish();
 }
 

@@ -27,6 +27,9 @@ pub trait Arith: Send + Sync + 'static {
     type Out: Sample;
     /// The reset value of every register.
     const ZERO: Self::Reg;
+    /// Whether [`Self::operand`] may count an overflow; when false, converting an operand
+    /// has no effect but its value (an engine may skip an unused conversion).
+    const OPERAND_OVERFLOWS: bool = true;
 
     /// Converts an operand for register `reg`.
     fn operand(&self, reg: Register, x: f64, overflows: &mut u64) -> Self::Reg;
@@ -174,6 +177,7 @@ impl<T: Sample> Arith for Native<T> {
     type Reg = T;
     type Out = T;
     const ZERO: T = T::ZERO;
+    const OPERAND_OVERFLOWS: bool = false;
 
     #[inline]
     fn operand(&self, _reg: Register, x: f64, _overflows: &mut u64) -> T {

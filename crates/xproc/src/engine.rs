@@ -15,6 +15,14 @@ use cwisim_isa::{Instruction, TraceError, TraceHeader, TraceRead};
 pub trait Engine<T: Sample> {
     /// Issues one instruction (already checked against the trace header).
     fn execute(&mut self, instr: &Instruction, sink: &mut dyn LineSink<T>);
+    /// Issues instructions in order (each already checked against the trace header): the
+    /// same as one [`Self::execute`] each, in one call (an engine may decide per batch
+    /// what it would otherwise decide per instruction).
+    fn execute_all(&mut self, instrs: &[Instruction], sink: &mut dyn LineSink<T>) {
+        for instr in instrs {
+            self.execute(instr, sink);
+        }
+    }
     /// Drains the array and returns the statistics.
     fn finish(self: Box<Self>, sink: &mut dyn LineSink<T>) -> RunStats;
     /// Where every scanline's record goes: into [`RunStats::lines`] (the default),

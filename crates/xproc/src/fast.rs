@@ -5,13 +5,13 @@
 //! the span of processors touched since the previous one, and an empty scanline costs
 //! O(1). State is one scanline: registers and flags per processor, nothing per frame.
 
-use crate::arith::{vector, Arith, Native, Wave};
+use crate::arith::{Arith, Native, Wave};
 use crate::engine::Engine;
 use crate::machine::Timeline;
 use crate::numeric::Register;
 use crate::output::{LineOut, LineSink};
 use crate::sample::Sample;
-use crate::stats::{LineRecords, Recorder, RunStats, Work};
+use crate::stats::{IssueTally, LineRecords, Recorder, RunStats, Work};
 use cwisim_isa::{Instruction, Opcode, TraceHeader, MAX_CHANNELS};
 
 const HAS_I: u8 = 1;
@@ -21,7 +21,7 @@ const LOCKED: u8 = 8;
 
 /// Up to [`MAX_CHANNELS`] operand values for register `reg` on an array of `C` channels
 /// (a constant, so the loop unrolls and the values stay in machine registers); channels
-/// from `C` on stay zero. The same values and counts as [`vector`]. Always inlined: an
+/// from `C` on stay zero. The same values and counts as `arith::vector`. Always inlined: an
 /// array returned through memory, written element by element and read back whole,
 /// stalls store-to-load forwarding.
 #[inline(always)]
@@ -68,6 +68,8 @@ pub struct FastEngine<A: Arith> {
     /// The work of the current scanline's instructions so far, recorded at its `Refresh`
     /// (or at the end): one record per scanline instead of one per instruction.
     line_work: Work,
+    /// The current scanline's instructions so far, handed to the recorder with its work.
+    line_issue: IssueTally,
     last_entry: Option<u64>,
     /// Scratch space for a scanline converted for output.
     out: Vec<A::Out>,
@@ -106,14 +108,18 @@ impl<A: Arith> FastEngine<A> {
             touched: None,
             line: 0,
             line_work: Work::default(),
+            line_issue: IssueTally::default(),
             last_entry: None,
             out: Vec::new(),
         }
     }
 
-    /// Records the current scanline's work so far (nothing if there was none, so that
-    /// no record is opened for a scanline without instructions).
+    /// Records the current scanline's instructions and work so far (nothing if there
+    /// were none, so that no record is opened for a scanline without instructions).
     fn flush_work(&mut self) {
+        let tally = std::mem::take(&mut self.line_issue);
+        self.recorder
+            .issued(self.line, &tally, self.last_entry.unwrap_or(0));
         let w = std::mem::take(&mut self.line_work);
         if w.updates | w.dropped | w.suppressed | w.overflows != 0 {
             self.recorder.work(self.line, w);
@@ -139,10 +145,11 @@ impl<A: Arith> FastEngine<A> {
         } else {
             0
         };
-        let begin = self.last_entry.unwrap_or(0).max(gate);
+        let before = self.last_entry.unwrap_or(0);
+        let begin = before.max(gate);
         let cost = self.timeline.issue_cycles(instr);
         let entry = (begin + cost).max(self.last_entry.map_or(0, |e| e + self.timeline.hop));
-        self.recorder.issue(self.line, instr.op, begin, entry, cost);
+        self.line_issue.count(instr.op, begin, before);
         self.last_entry = Some(entry);
         entry
     }
@@ -167,18 +174,6 @@ impl<A: Arith> FastEngine<A> {
         }
         self.any_flags |= dx > 0;
         suppressed
-    }
-
-    /// [`Self::eval`] for the array's channel count, a constant there: the per-channel
-    /// loops unroll and the operands and running registers stay in machine registers.
-    fn eval_order<const ORDER: usize>(&mut self, instr: &Instruction) {
-        const { assert!(MAX_CHANNELS == 4) };
-        match self.channels {
-            1 => self.eval::<ORDER, 1>(instr),
-            2 => self.eval::<ORDER, 2>(instr),
-            3 => self.eval::<ORDER, 3>(instr),
-            _ => self.eval::<ORDER, 4>(instr),
-        }
     }
 
     /// Eval1 (`ORDER` 1), Eval2 (2) and Eval3 (3) on an array of `C` channels: the
@@ -287,24 +282,34 @@ impl<A: Arith> FastEngine<A> {
     }
 }
 
-impl<A: Arith> Engine<A::Out> for FastEngine<A> {
-    fn line_records(&mut self, to: LineRecords) {
-        self.recorder.line_records(to);
+impl<A: Arith> FastEngine<A> {
+    /// The instructions in order, on an array of `C` channels: the channel count is a
+    /// constant here, decided once per batch rather than once per instruction.
+    fn run<const C: usize>(&mut self, instrs: &[Instruction], sink: &mut dyn LineSink<A::Out>) {
+        debug_assert_eq!(C, self.channels);
+        for instr in instrs {
+            self.step::<C>(instr, sink);
+        }
     }
 
-    fn execute(&mut self, instr: &Instruction, sink: &mut dyn LineSink<A::Out>) {
+    /// One instruction on an array of `C` channels: issued (timed and counted), then
+    /// executed over its range; its work is added to the scanline's.
+    #[inline(always)]
+    fn step<const C: usize>(&mut self, instr: &Instruction, sink: &mut dyn LineSink<A::Out>) {
         let entry = self.issue(instr);
         let (x, dx) = (instr.x as usize, instr.dx as usize);
-        let c = self.channels;
+        if dx == 0 && is_eval(instr.op) {
+            self.empty_eval::<C>(instr);
+            return;
+        }
         let mut w = Work::default();
         match instr.op {
             Opcode::SetI | Opcode::SetdI | Opcode::SetddI => {
                 let slot = instr.op as usize - Opcode::SetI as usize;
-                let v = vector(
+                let v = operands::<A, C>(
                     &self.arith,
                     Register::of_slot(slot),
                     instr.value(slot),
-                    c,
                     &mut w.overflows,
                 );
                 self.set(slot, x, &v);
@@ -314,11 +319,10 @@ impl<A: Arith> Engine<A::Out> for FastEngine<A> {
             }
             Opcode::SetPI | Opcode::SetPdI | Opcode::SetPddI => {
                 let slot = instr.op as usize - Opcode::SetPI as usize;
-                let v = vector(
+                let v = operands::<A, C>(
                     &self.arith,
                     Register::of_slot(slot),
                     instr.value(slot),
-                    c,
                     &mut w.overflows,
                 );
                 let width = self.flags.len();
@@ -332,23 +336,19 @@ impl<A: Arith> Engine<A::Out> for FastEngine<A> {
                 self.touch(x, last + 1);
             }
             Opcode::Eval0 => {
-                let v = vector(
-                    &self.arith,
-                    Register::Acc,
-                    instr.value(0),
-                    c,
-                    &mut w.overflows,
-                );
+                let v =
+                    operands::<A, C>(&self.arith, Register::Acc, instr.value(0), &mut w.overflows);
                 w.suppressed = self.eval0(x, dx, &v);
                 w.updates = dx as u64;
                 self.touch(x, x + dx);
                 self.evals += 1;
+                self.dis_pending = false;
             }
             Opcode::Eval1 | Opcode::Eval2 | Opcode::Eval3 => {
                 match instr.op {
-                    Opcode::Eval1 => self.eval_order::<1>(instr),
-                    Opcode::Eval2 => self.eval_order::<2>(instr),
-                    _ => self.eval_order::<3>(instr),
+                    Opcode::Eval1 => self.eval::<1, C>(instr),
+                    Opcode::Eval2 => self.eval::<2, C>(instr),
+                    _ => self.eval::<3, C>(instr),
                 };
                 self.touch(x, x + dx);
                 self.evals += 1;
@@ -371,14 +371,66 @@ impl<A: Arith> Engine<A::Out> for FastEngine<A> {
             }
             Opcode::Nop => {}
         }
-        if instr.op == Opcode::Eval0 {
-            self.dis_pending = false;
-        }
         let l = &mut self.line_work;
         l.updates += w.updates;
         l.dropped += w.dropped;
         l.suppressed += w.suppressed;
         l.overflows += w.overflows;
+    }
+
+    /// An `Eval` of an empty range: it addresses no processor, but it is an Eval (it
+    /// consumes a pending `Dis` mask) and its operands are converted (a narrow format
+    /// counts their overflows) — the general path's effect, without its dispatch on the
+    /// order.
+    #[inline(always)]
+    fn empty_eval<const C: usize>(&mut self, instr: &Instruction) {
+        if A::OPERAND_OVERFLOWS {
+            let mut ovf = 0;
+            for slot in 0..instr.op.value_operands() {
+                let reg = match instr.op {
+                    Opcode::Eval0 => Register::Acc,
+                    _ => Register::of_slot(slot),
+                };
+                operands::<A, C>(&self.arith, reg, instr.value(slot), &mut ovf);
+            }
+            self.line_work.overflows += ovf;
+        }
+        self.evals += 1;
+        self.dis_pending = false;
+    }
+}
+
+/// `Eval0` to `Eval3`.
+#[inline(always)]
+fn is_eval(op: Opcode) -> bool {
+    matches!(
+        op,
+        Opcode::Eval0 | Opcode::Eval1 | Opcode::Eval2 | Opcode::Eval3
+    )
+}
+
+impl<A: Arith> Engine<A::Out> for FastEngine<A> {
+    fn line_records(&mut self, to: LineRecords) {
+        self.recorder.line_records(to);
+    }
+
+    fn execute(&mut self, instr: &Instruction, sink: &mut dyn LineSink<A::Out>) {
+        match self.channels {
+            1 => self.step::<1>(instr, sink),
+            2 => self.step::<2>(instr, sink),
+            3 => self.step::<3>(instr, sink),
+            _ => self.step::<4>(instr, sink),
+        }
+    }
+
+    fn execute_all(&mut self, instrs: &[Instruction], sink: &mut dyn LineSink<A::Out>) {
+        const { assert!(MAX_CHANNELS == 4) };
+        match self.channels {
+            1 => self.run::<1>(instrs, sink),
+            2 => self.run::<2>(instrs, sink),
+            3 => self.run::<3>(instrs, sink),
+            _ => self.run::<4>(instrs, sink),
+        }
     }
 
     fn finish(mut self: Box<Self>, _sink: &mut dyn LineSink<A::Out>) -> RunStats {

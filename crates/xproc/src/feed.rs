@@ -8,7 +8,7 @@ use crate::numeric::Numeric;
 use crate::output::LineSink;
 use crate::sample::Sample;
 use crate::stats::RunStats;
-use cwisim_isa::{Instruction, TraceHeader, TraceWrite};
+use cwisim_isa::{refusal, CheckedStream, Instruction, TraceHeader, TraceWrite};
 use std::io;
 
 /// An array simulator that takes instructions through [`TraceWrite`].
@@ -39,6 +39,37 @@ impl<'a, T: Sample> EngineWriter<'a, T> {
     pub fn into_stats(self) -> Option<RunStats> {
         self.stats
     }
+
+    /// Executes a stream whose instructions were checked as they were appended, without
+    /// checking them again: what [`TraceWrite::write`] of each would do. A stream
+    /// checked against another header is refused whole (`InvalidInput`), nothing
+    /// executed.
+    pub fn write_checked(&mut self, stream: &CheckedStream) -> io::Result<()> {
+        if stream.header() != &self.header {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidInput,
+                format!(
+                    "a stream checked against a {}-wide, {}-channel header, fed to a {}-wide, {}-channel array",
+                    stream.header().width,
+                    stream.header().channels,
+                    self.header.width,
+                    self.header.channels
+                ),
+            ));
+        }
+        let (engine, sink) = self.parts()?;
+        engine.execute_all(stream.instructions(), sink);
+        Ok(())
+    }
+
+    /// The engine (until [`TraceWrite::finish`]) and the sink it hands scanlines to.
+    fn parts(&mut self) -> io::Result<(&mut (dyn Engine<T> + 'static), &mut dyn LineSink<T>)> {
+        let engine = self
+            .engine
+            .as_deref_mut()
+            .ok_or_else(|| io::Error::other("instruction after finish"))?;
+        Ok((engine, &mut *self.sink))
+    }
 }
 
 impl<'a> EngineWriter<'a, f64> {
@@ -66,17 +97,9 @@ impl<T: Sample> TraceWrite for EngineWriter<'_, T> {
     /// Executes the instruction; one that does not fit the header is an error
     /// (`InvalidInput`), not executed.
     fn write(&mut self, instr: &Instruction) -> io::Result<()> {
-        instr.check(&self.header).map_err(|e| {
-            io::Error::new(
-                io::ErrorKind::InvalidInput,
-                format!("{instr}: {}", e.message()),
-            )
-        })?;
-        let engine = self
-            .engine
-            .as_mut()
-            .ok_or_else(|| io::Error::other("instruction after finish"))?;
-        engine.execute(instr, self.sink);
+        instr.check(&self.header).map_err(|e| refusal(instr, &e))?;
+        let (engine, sink) = self.parts()?;
+        engine.execute(instr, sink);
         Ok(())
     }
 
@@ -109,6 +132,72 @@ mod tests {
         w.finish().unwrap();
         assert_eq!(w.into_stats().unwrap().totals.lines, 1);
         assert_eq!(sink.finish().unwrap().data, [0.0, 0.5, 0.5, 0.0]);
+    }
+
+    #[test]
+    fn a_checked_stream_drives_the_array_as_its_instructions_do() {
+        let h = TraceHeader::new(8, 2, 1).unwrap();
+        let g = Intensity::grey;
+        let trace = [
+            Instruction::set_i(2, g(0.25)),
+            Instruction::eval2(0, 6, g(0.5), g(-0.125)),
+            Instruction::dis(1, 2),
+            Instruction::eval0(0, 3, g(0.75)),
+            Instruction::refresh(),
+            Instruction::acc_mode(),
+            Instruction::eval3(1, 7, g(-0.5), g(0.25), g(0.0625)),
+            Instruction::refresh(),
+            Instruction::eval1(4, 4, g(1.0)),
+        ];
+        let run = |checked: bool| {
+            let mut sink = ImageSink::new(8, 1, 1 << 20);
+            let mut w =
+                EngineWriter::<f64>::new(&h, &Machine::default(), Timing::Fast, &mut sink).unwrap();
+            if checked {
+                let mut stream = CheckedStream::new(&h);
+                for i in &trace {
+                    stream.write(i).unwrap();
+                }
+                w.write_checked(&stream).unwrap();
+            } else {
+                for i in &trace {
+                    w.write(i).unwrap();
+                }
+            }
+            w.finish().unwrap();
+            (w.into_stats().unwrap(), sink.finish().unwrap().data)
+        };
+        assert_eq!(run(true), run(false));
+    }
+
+    #[test]
+    fn a_stream_checked_against_another_header_is_refused() {
+        let h = TraceHeader::new(8, 2, 1).unwrap();
+        let mut sink = ImageSink::new(8, 1, 1 << 20);
+        let mut w =
+            EngineWriter::<f64>::new(&h, &Machine::default(), Timing::Fast, &mut sink).unwrap();
+        let mut wide = CheckedStream::new(&TraceHeader::new(16, 2, 1).unwrap());
+        wide.push(Instruction::eval1(10, 6, Intensity::grey(0.5)))
+            .unwrap();
+        let e = w.write_checked(&wide).unwrap_err();
+        assert_eq!(e.kind(), io::ErrorKind::InvalidInput);
+        assert_eq!(
+            e.to_string(),
+            "a stream checked against a 16-wide, 1-channel header, fed to a 8-wide, 1-channel array"
+        );
+        w.finish().unwrap();
+        assert_eq!(w.into_stats().unwrap().totals.instructions, 0);
+    }
+
+    #[test]
+    fn a_checked_stream_after_finish_is_refused() {
+        let h = TraceHeader::new(4, 1, 1).unwrap();
+        let mut sink = ImageSink::new(4, 1, 1 << 20);
+        let mut w =
+            EngineWriter::<f64>::new(&h, &Machine::default(), Timing::Fast, &mut sink).unwrap();
+        w.finish().unwrap();
+        let e = w.write_checked(&CheckedStream::new(&h)).unwrap_err();
+        assert_eq!(e.to_string(), "instruction after finish");
     }
 
     #[test]

@@ -246,6 +246,11 @@ impl Timeline {
         self.cost[instr.op.index()]
     }
 
+    /// Bus cycles per opcode, indexed by [`Opcode::index`].
+    pub(crate) fn cost_table(&self) -> [u64; Opcode::COUNT] {
+        self.cost
+    }
+
     /// The cycle at which the display takes scanline `n` (counted over the whole trace):
     /// the end of the line period before its display slot. It must be ready by then.
     pub fn deadline(&self, n: u64) -> u64 {
