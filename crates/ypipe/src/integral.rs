@@ -6,9 +6,10 @@
 //!   the row's middle height (value and x-gradient, as the report's mode takes them) and
 //!   the y-gradient along the edges. For intensities that are planar over the polygon
 //!   (triangles, the fragments of exact visibility) it *is* the Gouraud function.
-//! * [`RowPlane::pixel`] — the exact integral over one pixel: the row's quadrilateral
-//!   clipped to the pixel's column, its area and first moments by the shoelace formulas,
-//!   taken relative to the pixel's corner.
+//! * [`RowPlane::pixel`] — the exact integral over one pixel: the area and first
+//!   moments of the row's quadrilateral within the pixel's column, taken relative to the
+//!   pixel's corner, in closed form (what lies left of the right edge less what lies left
+//!   of the left edge, each the integral of a clamped linear function).
 //! * [`forward_differences`] — the `Eval3` operands of a run whose exact values are a
 //!   quadratic in the pixel index (every sequence and share-sequence: docs/ERRATA.md,
 //!   "The exact box filter"), from the values at its first, middle and last pixel.
@@ -128,67 +129,89 @@ impl RowPlane {
 
     /// Area and first moments `∫∫ (x − x0) dA`, `∫∫ (y − y0) dA` of the row's
     /// quadrilateral clipped to the column `[x0, x0 + 1]`, with the coordinates taken
-    /// relative to `(x0, y0)` (so that far-away pixels lose no precision).
+    /// relative to `(x0, y0)` (so that far-away pixels lose no precision): what lies left
+    /// of the right edge less what lies left of the left edge ([`left_of`]).
     fn moments(&self, x0: f64) -> (f64, f64, f64) {
         let h = self.y1 - self.y0;
-        let quad = [
-            [self.left.0 - x0, 0.0],
-            [self.right.0 - x0, 0.0],
-            [self.right.1 - x0, h],
-            [self.left.1 - x0, h],
-        ];
-        let mut a = [[0.0; 2]; 8];
-        let mut b = [[0.0; 2]; 8];
-        let n = clip_x(&quad, 0.0, true, &mut a);
-        let n = clip_x(&a[..n], 1.0, false, &mut b);
-        let v = &b[..n];
-        if n < 3 {
+        let r = left_of(self.right.0 - x0, self.right.1 - x0, h);
+        let l = left_of(self.left.0 - x0, self.left.1 - x0, h);
+        let area = r[0] - l[0];
+        // edges that cross by a rounding (an apex) leave no negative area
+        if area <= 0.0 {
             return (0.0, 0.0, 0.0);
         }
-        let (mut area, mut mx, mut my) = (0.0, 0.0, 0.0);
-        for k in 0..n {
-            let (p, q) = (v[k], v[(k + 1) % n]);
-            let cross = p[0] * q[1] - q[0] * p[1];
-            area += cross;
-            mx += (p[0] + q[0]) * cross;
-            my += (p[1] + q[1]) * cross;
-        }
-        // the quadrilateral's orientation is fixed, but a clipped sliver may round either
-        // way: take the moments with the area's sign
-        let s = if area < 0.0 { -1.0 } else { 1.0 };
-        (s * area / 2.0, s * mx / 6.0, s * my / 6.0)
+        (area, r[1] - l[1], r[2] - l[2])
     }
 }
 
-/// Clips the convex polygon `v` to `x ≥ bound` (`keep_ge`) or `x ≤ bound` into `out`;
-/// returns its number of vertices (a convex polygon gains at most one per clip).
-fn clip_x(v: &[[f64; 2]], bound: f64, keep_ge: bool, out: &mut [[f64; 2]; 8]) -> usize {
-    let inside = |p: &[f64; 2]| {
-        if keep_ge {
-            p[0] >= bound
+/// Area and first moments `[∫∫ dA, ∫∫ x dA, ∫∫ t dA]` of the part of the unit column
+/// `0 ≤ x ≤ 1` over the band `0 ≤ t ≤ h` that lies left of an edge running straight
+/// from `x = u0` at `t = 0` to `x = u1` at `t = h`.
+///
+/// At height `t` that part is `[0, c(t)]` with `c` the edge's x clamped to `[0, 1]`, so
+/// the three are `∫ c`, `∫ c²/2` and `∫ t·c` over the band: closed forms over at most
+/// three pieces, where `c` is 0, the edge's linear x, or 1.
+fn left_of(u0: f64, u1: f64, h: f64) -> [f64; 3] {
+    let d = u1 - u0;
+    if d == 0.0 || !d.is_finite() {
+        // vertical (or not a number: nothing to integrate)
+        let c = u0.clamp(0.0, 1.0);
+        return if c.is_nan() {
+            [0.0; 3]
         } else {
-            p[0] <= bound
-        }
-    };
-    let mut n = 0;
-    let len = v.len();
-    for k in 0..len {
-        let (a, b) = (v[(k + len - 1) % len], v[k]);
-        let (a_in, b_in) = (inside(&a), inside(&b));
-        if a_in != b_in && n < out.len() {
-            // measured from the end with the smaller x, so that both clips of an edge
-            // agree on its line
-            let (lo, hi) = if a[0] <= b[0] { (a, b) } else { (b, a) };
-            let t = (bound - lo[0]) / (hi[0] - lo[0]);
-            out[n] = [bound, lo[1] + t * (hi[1] - lo[1])];
-            n += 1;
-        }
-        if b_in && n < out.len() {
-            out[n] = b;
-            n += 1;
-        }
+            [h * c, h * c * c / 2.0, c * h * h / 2.0]
+        };
     }
-    n
+    // where the edge crosses x = 0 and x = 1, as heights clamped to the band
+    let (s0, s1) = (h * (-u0 / d), h * ((1.0 - u0) / d));
+    let rising = d > 0.0;
+    let (s_a, s_b) = if rising { (s0, s1) } else { (s1, s0) };
+    // (max then min, not `clamp`: a NaN passes through instead of panicking)
+    let (t_a, t_b) = (s_a.max(0.0).min(h), s_b.max(0.0).min(h));
+    // c at the ends of the linear piece: 0 or 1 where the edge crosses the column's
+    // side within the band, else its (clamped) x at the band's top or bottom
+    let c_a = if s_a > 0.0 {
+        if rising {
+            0.0
+        } else {
+            1.0
+        }
+    } else {
+        u0.clamp(0.0, 1.0)
+    };
+    let c_b = if s_b < h {
+        if rising {
+            1.0
+        } else {
+            0.0
+        }
+    } else {
+        u1.clamp(0.0, 1.0)
+    };
+    let mut m = linear_piece(t_a, t_b, c_a, c_b);
+    // the piece where the whole column lies left of the edge (c = 1)
+    let (f_a, f_b) = if rising { (t_b, h) } else { (0.0, t_a) };
+    let len = f_b - f_a;
+    if len > 0.0 {
+        m[0] += len;
+        m[1] += len / 2.0;
+        m[2] += len * (f_a + f_b) / 2.0;
+    }
+    m
+}
+
+/// `[∫ c, ∫ c²/2, ∫ t·c]` over `[t_a, t_b]` for `c` linear from `c_a` to `c_b` (0 for
+/// an empty piece).
+fn linear_piece(t_a: f64, t_b: f64, c_a: f64, c_b: f64) -> [f64; 3] {
+    let len = t_b - t_a;
+    if len <= 0.0 {
+        return [0.0; 3];
+    }
+    [
+        len * (c_a + c_b) / 2.0,
+        len * (c_a * c_a + c_a * c_b + c_b * c_b) / 6.0,
+        len * (t_a * (2.0 * c_a + c_b) + t_b * (c_a + 2.0 * c_b)) / 6.0,
+    ]
 }
 
 /// The `Eval3` operands `(I, dI, ddI)` of a run of `n` pixels whose values are the
@@ -297,5 +320,216 @@ mod tests {
                 d += dd;
             }
         }
+    }
+
+    /// The clip-based moments this module computed before the closed form, kept as an
+    /// oracle: the row's quadrilateral (coordinates relative to `(x0, y0)`) clipped to
+    /// the column by Sutherland–Hodgman, its area and moments by the shoelace formulas.
+    fn clip_moments(p: &RowPlane, x0: f64) -> (f64, f64, f64) {
+        let h = p.y1 - p.y0;
+        let quad = [
+            [p.left.0 - x0, 0.0],
+            [p.right.0 - x0, 0.0],
+            [p.right.1 - x0, h],
+            [p.left.1 - x0, h],
+        ];
+        let mut a = [[0.0; 2]; 8];
+        let mut b = [[0.0; 2]; 8];
+        let n = clip_x(&quad, 0.0, true, &mut a);
+        let n = clip_x(&a[..n], 1.0, false, &mut b);
+        let v = &b[..n];
+        if n < 3 {
+            return (0.0, 0.0, 0.0);
+        }
+        let (mut area, mut mx, mut my) = (0.0, 0.0, 0.0);
+        for k in 0..n {
+            let (p, q) = (v[k], v[(k + 1) % n]);
+            let cross = p[0] * q[1] - q[0] * p[1];
+            area += cross;
+            mx += (p[0] + q[0]) * cross;
+            my += (p[1] + q[1]) * cross;
+        }
+        let s = if area < 0.0 { -1.0 } else { 1.0 };
+        (s * area / 2.0, s * mx / 6.0, s * my / 6.0)
+    }
+
+    /// The convex polygon `v` clipped to `x ≥ bound` (`keep_ge`) or `x ≤ bound`.
+    fn clip_x(v: &[[f64; 2]], bound: f64, keep_ge: bool, out: &mut [[f64; 2]; 8]) -> usize {
+        let inside = |p: &[f64; 2]| {
+            if keep_ge {
+                p[0] >= bound
+            } else {
+                p[0] <= bound
+            }
+        };
+        let mut n = 0;
+        let len = v.len();
+        for k in 0..len {
+            let (a, b) = (v[(k + len - 1) % len], v[k]);
+            let (a_in, b_in) = (inside(&a), inside(&b));
+            if a_in != b_in && n < out.len() {
+                let (lo, hi) = if a[0] <= b[0] { (a, b) } else { (b, a) };
+                let t = (bound - lo[0]) / (hi[0] - lo[0]);
+                out[n] = [bound, lo[1] + t * (hi[1] - lo[1])];
+                n += 1;
+            }
+            if b_in && n < out.len() {
+                out[n] = b;
+                n += 1;
+            }
+        }
+        n
+    }
+
+    /// The moments by quadrature, independent of both: the band is cut at every height
+    /// where an edge crosses a side of the column, and on each piece — where the covered
+    /// width is linear in `t` — three-point Gauss–Legendre integrates the width and the
+    /// moments (polynomials of degree ≤ 2 there) exactly, up to rounding.
+    fn quadrature_moments(p: &RowPlane, x0: f64) -> (f64, f64, f64) {
+        let h = p.y1 - p.y0;
+        let edge = |e: (f64, f64)| move |t: f64| (e.0 - x0) + (e.1 - e.0) * (t / h);
+        let (l, r) = (edge(p.left), edge(p.right));
+        let mut cuts = vec![0.0, h];
+        for (a, b) in [
+            (p.left.0 - x0, p.left.1 - x0),
+            (p.right.0 - x0, p.right.1 - x0),
+        ] {
+            for side in [0.0, 1.0] {
+                if b != a {
+                    let t = h * ((side - a) / (b - a));
+                    if t > 0.0 && t < h {
+                        cuts.push(t);
+                    }
+                }
+            }
+        }
+        cuts.sort_by(f64::total_cmp);
+        let nodes = [-(0.6f64.sqrt()), 0.0, 0.6f64.sqrt()];
+        let weights = [5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0];
+        let (mut area, mut mx, mut my) = (0.0, 0.0, 0.0);
+        for w in cuts.windows(2) {
+            let (half, mid) = ((w[1] - w[0]) / 2.0, (w[0] + w[1]) / 2.0);
+            for (z, wt) in nodes.iter().zip(&weights) {
+                let t = mid + half * z;
+                let (a, b) = (l(t).clamp(0.0, 1.0), r(t).clamp(0.0, 1.0));
+                let width = (b - a).max(0.0);
+                area += half * wt * width;
+                mx += half * wt * (b * b - a * a).max(0.0) / 2.0;
+                my += half * wt * t * width;
+            }
+        }
+        (area, mx, my)
+    }
+
+    /// A row plane over the band `[y0, y0 + h]` between the left edge from `l0` (top) to
+    /// `l1` (bottom) and the right edge from `r0` to `r1`; intensity 0 (only its
+    /// moments are taken).
+    fn row(y0: f64, h: f64, l: (f64, f64), r: (f64, f64)) -> RowPlane {
+        RowPlane {
+            i_m: [0.0; MAX_CHANNELS],
+            b_x: [0.0; MAX_CHANNELS],
+            b_y: [0.0; MAX_CHANNELS],
+            x_l: 0.5 * (l.0 + l.1),
+            y_m: y0 + h / 2.0,
+            channels: 1,
+            y0,
+            y1: y0 + h,
+            left: l,
+            right: r,
+        }
+    }
+
+    /// Rows that stress the integral: random ones around a pixel, and slivers 1e-12 px
+    /// wide or high, huge coordinates, vertical and near-horizontal edges, edges that
+    /// meet (an apex) or touch a column side, degenerate bands.
+    fn stress_rows() -> Vec<RowPlane> {
+        let mut seed = 0x2545_F491_4F6C_DD1Du64;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut rows = vec![
+            row(0.0, 1.0, (2.3, 2.3), (2.3 + 1e-12, 2.3 + 1e-12)),
+            row(0.0, 1.0, (2.3, 5.7), (2.3 + 1e-12, 5.7 + 1e-12)),
+            row(3.0, 1e-12, (0.2, 0.2 + 3e-12), (4.9, 4.9)),
+            row(3.0, 1e-12, (-10.0, 2.0), (5.0, 2.5)),
+            row(0.0, 1.0, (1e6 + 0.25, 1e6 + 0.75), (1e6 + 3.5, 1e6 + 1.1)),
+            row(7.5e5, 0.5, (2e9 + 0.1, 2e9 + 7.9), (2e9 + 9.0, 2e9 + 9.0)),
+            row(0.0, 1.0, (1.0, 1.0), (2.0, 2.0)),
+            row(0.0, 1.0, (1.5, 1.5), (3.25, 3.25)),
+            row(0.0, 1e-9, (-500.0, 800.0), (900.0, 2000.0)),
+            row(0.0, 1.0, (1.0, 1.0 + 1e-300), (4.0, 4.0 - 1e-15)),
+            row(0.0, 1.0, (2.5, 2.5), (2.5, 2.5)),
+            row(0.0, 0.75, (3.0, 1.0), (3.0, 5.0)),
+            row(0.0, 0.75, (1.0, 3.0), (5.0, 3.0)),
+            row(0.0, 1.0, (0.0, 1.0), (1.0, 2.0)),
+        ];
+        for _ in 0..3000 {
+            let h = [1.0, next(), 1e-6 * next()][(next() * 3.0) as usize];
+            let spread = [1.0, 4.0, 200.0][(next() * 3.0) as usize];
+            let a = (next() * spread, next() * spread);
+            let w = (next() * spread * next(), next() * spread * next());
+            rows.push(row(next() * 100.0, h, a, (a.0 + w.0, a.1 + w.1)));
+        }
+        rows
+    }
+
+    /// The columns a row's moments are checked in: every one it touches and one beyond
+    /// each side.
+    fn columns(p: &RowPlane) -> impl Iterator<Item = f64> {
+        let lo = p.left.0.min(p.left.1).floor() - 1.0;
+        let hi = p.right.0.max(p.right.1).ceil() + 1.0;
+        let n = ((hi - lo) as usize).min(400);
+        (0..=n).map(move |k| lo + k as f64)
+    }
+
+    #[test]
+    fn the_closed_form_moments_agree_with_clipping_and_with_quadrature() {
+        for p in stress_rows() {
+            let h = p.y1 - p.y0;
+            for x0 in columns(&p) {
+                let got = p.moments(x0);
+                for (name, want) in [
+                    ("clipping", clip_moments(&p, x0)),
+                    ("quadrature", quadrature_moments(&p, x0)),
+                ] {
+                    // each value is at most the band's height (times 1 or h): agreement
+                    // to 1e-12 of that scale, which is rounding
+                    let scale = h.max(h * h);
+                    for (g, w) in [(got.0, want.0), (got.1, want.1), (got.2, want.2)] {
+                        assert!(
+                            (g - w).abs() <= 1e-12 * scale,
+                            "{name}: {got:?} vs {want:?} in column {x0} of {p:?}"
+                        );
+                    }
+                }
+                assert!(got.0 >= 0.0 && got.0 <= h * (1.0 + 1e-15), "area {got:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn the_moments_of_full_partial_and_empty_columns() {
+        // a full column: area h, centroid at its centre
+        let p = row(0.0, 0.5, (1.0, 1.0), (3.0, 3.0));
+        assert_eq!(p.moments(1.0), (0.5, 0.25, 0.125));
+        // left of the row, right of it, and the columns the edges only touch
+        assert_eq!(p.moments(-4.0), (0.0, 0.0, 0.0));
+        assert_eq!(p.moments(0.0), (0.0, 0.0, 0.0));
+        assert_eq!(p.moments(3.0), (0.0, 0.0, 0.0));
+        // a triangle's half: the left edge from (0, 0) to (1, 1) in a unit row
+        let p = row(0.0, 1.0, (0.0, 1.0), (5.0, 5.0));
+        let (a, mx, my) = p.moments(0.0);
+        assert!((a - 0.5).abs() < 1e-16);
+        assert!((mx - 1.0 / 3.0).abs() < 1e-16, "{mx}");
+        assert!((my - 1.0 / 6.0).abs() < 1e-16, "{my}");
+        // edges that cross by a rounding leave nothing, not a negative area
+        let p = row(0.0, 1.0, (2.5 + 1e-15, 2.5), (2.5, 2.5 + 1e-15));
+        assert!(p.moments(2.0).0 >= 0.0);
+        // a NaN band is no panic
+        let p = row(0.0, f64::NAN, (0.0, 1.0), (3.0, 2.0));
+        let _ = p.moments(0.0);
     }
 }
