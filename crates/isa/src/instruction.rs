@@ -24,6 +24,7 @@ impl Intensity {
     ///
     /// # Panics
     /// If `values` is empty or longer than [`MAX_CHANNELS`]; parsers check this first.
+    #[inline]
     pub fn new(values: &[f64]) -> Intensity {
         assert!(
             !values.is_empty() && values.len() <= MAX_CHANNELS,
@@ -48,11 +49,13 @@ impl Intensity {
     }
 
     /// The values, one per channel.
+    #[inline]
     pub fn as_slice(&self) -> &[f64] {
         &self.values[..usize::from(self.len)]
     }
 
     /// The number of channels.
+    #[inline]
     pub fn len(&self) -> usize {
         usize::from(self.len)
     }
@@ -130,6 +133,7 @@ impl PartialEq for Values {
 impl Eq for Values {}
 
 impl Values {
+    #[inline]
     fn new(values: [Intensity; 3]) -> Values {
         if values.iter().all(|v| v.len() <= 1) {
             let mut present = 0;
@@ -148,6 +152,7 @@ impl Values {
 }
 
 impl Instruction {
+    #[inline]
     fn with(op: Opcode, x: u32, dx: u32, i: Intensity, di: Intensity, ddi: Intensity) -> Self {
         Self::from_parts(op, x, dx, [i, di, ddi])
     }
@@ -155,6 +160,7 @@ impl Instruction {
     /// An instruction from its fields as they are, the value slots `[I, dI, ddI]` among
     /// them. Nothing is checked (decoders and fuzzers build what they read, then
     /// [`Self::check`] it).
+    #[inline]
     pub fn from_parts(op: Opcode, x: u32, dx: u32, values: [Intensity; 3]) -> Self {
         Instruction {
             op,
@@ -238,18 +244,22 @@ impl Instruction {
         )
     }
     /// `Eval0(x, dx, I)`.
+    #[inline]
     pub fn eval0(x: u32, dx: u32, i: Intensity) -> Self {
         Self::with(Opcode::Eval0, x, dx, i, Intensity::NONE, Intensity::NONE)
     }
     /// `Eval1(x, dx, I)`.
+    #[inline]
     pub fn eval1(x: u32, dx: u32, i: Intensity) -> Self {
         Self::with(Opcode::Eval1, x, dx, i, Intensity::NONE, Intensity::NONE)
     }
     /// `Eval2(x, dx, I, dI)`.
+    #[inline]
     pub fn eval2(x: u32, dx: u32, i: Intensity, di: Intensity) -> Self {
         Self::with(Opcode::Eval2, x, dx, i, di, Intensity::NONE)
     }
     /// `Eval3(x, dx, I, dI, ddI)`.
+    #[inline]
     pub fn eval3(x: u32, dx: u32, i: Intensity, di: Intensity, ddi: Intensity) -> Self {
         Self::with(Opcode::Eval3, x, dx, i, di, ddi)
     }

@@ -105,16 +105,23 @@ impl RowFill {
     }
 }
 
-/// The intensity model of one row: value at a pixel centre and change per pixel.
-struct RowShade {
-    x_left: f64,
-    i_left: Vector,
-    di: Vector,
-    channels: usize,
+/// The intensity model of one row: the scanline function at height `y`, its value at
+/// the left edge and change per pixel (what the report's values take at pixel centres,
+/// and what the exact box filter's [`RowPlane`] is built on).
+pub(crate) struct RowShade {
+    /// The left edge's x at `y` (0 for flat shading).
+    pub(crate) x_left: f64,
+    /// The intensity there.
+    pub(crate) i_left: Vector,
+    /// The change per pixel (0 where the edges meet).
+    pub(crate) di: Vector,
+    /// Channels in use.
+    pub(crate) channels: usize,
 }
 
 impl RowShade {
-    fn new(t: &Trapezium, shade: &Shade, y: f64, channels: usize) -> RowShade {
+    /// The scanline function of `t` at height `y`.
+    pub(crate) fn new(t: &Trapezium, shade: &Shade, y: f64, channels: usize) -> RowShade {
         match shade {
             Shade::Flat(v) => RowShade {
                 x_left: 0.0,
@@ -145,7 +152,12 @@ impl RowShade {
     /// Intensity at the centre of pixel column `i`.
     fn at(&self, i: i64) -> Vector {
         let dx = i as f64 + 0.5 - self.x_left;
-        vector(self.channels, |c| self.i_left[c] + dx * self.di[c])
+        let mut v = [0.0; cwisim_isa::MAX_CHANNELS];
+        let ch = self.channels;
+        for ((v, i), d) in v[..ch].iter_mut().zip(&self.i_left).zip(&self.di) {
+            *v = i + dx * d;
+        }
+        v
     }
 
     fn flat(&self) -> bool {
@@ -206,11 +218,15 @@ fn claim_run(
     }
     let k = i64::from(claim_chunk(&rs.di[..ch], tolerance, n));
     let before = out.len();
+    out.reserve((last - first) as usize / k as usize + 1);
     let mut a = first;
     while a <= last {
         let b = (a + k - 1).min(last);
         let (va, vb) = (rs.at(a), rs.at(b));
-        let centre = vector(ch, |c| 0.5 * (va[c] + vb[c]));
+        let mut centre = [0.0; cwisim_isa::MAX_CHANNELS];
+        for ((m, a), b) in centre[..ch].iter_mut().zip(&va).zip(&vb) {
+            *m = 0.5 * (a + b);
+        }
         out.push((
             Procedure::Claim,
             Instruction::eval0(a as u32, (b - a + 1) as u32, intensity(&centre, ch)),
@@ -268,9 +284,13 @@ pub fn box_row_into(
     let h = s.height();
     let rs = RowShade::new(t, shade, 0.5 * (s.y0 + s.y1), channels);
     // the exact values, where they differ from the report's (a varying intensity)
-    let plane = match value {
-        BoxValue::Exact => Some(RowPlane::new(t, shade, &s, channels)).filter(|p| !p.constant()),
-        BoxValue::Centre => None,
+    let plane_of_row;
+    let plane = match (value, shade) {
+        (BoxValue::Exact, Shade::Gouraud) => {
+            plane_of_row = RowPlane::new(t, &s, &rs);
+            Some(&plane_of_row).filter(|p| !p.constant())
+        }
+        _ => None, // a flat row's values are the report's
     };
     let (l0, l1, r0, r1) = s.edge_pixels();
     let mut specials = [l0, l1, r0, r1];
@@ -321,26 +341,29 @@ pub fn box_row_into(
         if first > last {
             continue;
         }
-        let ac = s.coverage(first);
-        if proc_ == Procedure::Single && ac == 0.0 {
-            continue; // the edge only touches this pixel's border
-        }
-        if let Claim::Eval0 { tolerance } = claim {
-            let full = matches!(proc_, Procedure::Single | Procedure::MiddlePart) && ac == 1.0;
-            if full {
-                push_claim(fill, &rs, first, last, tolerance, notes);
-                continue;
-            }
-        }
         let n = (last - first + 1) as u32;
-        let x = first as u32;
-        let fpi = rs.at(first);
-        let instr = match (proc_, &plane) {
-            (Procedure::Single, Some(p)) => {
-                Instruction::eval1(x, 1, intensity(&p.pixel(first), channels))
-            }
+        let instr = match (proc_, plane) {
             (Procedure::Sequence | Procedure::ShareSequence, Some(p)) => exact_run(p, first, last),
-            _ => centre_instruction(proc_, x, n, ac, inc, &fpi, &rs),
+            _ => {
+                let ac = s.coverage(first);
+                if proc_ == Procedure::Single && ac == 0.0 {
+                    continue; // the edge only touches this pixel's border
+                }
+                if let Claim::Eval0 { tolerance } = claim {
+                    let full =
+                        matches!(proc_, Procedure::Single | Procedure::MiddlePart) && ac == 1.0;
+                    if full {
+                        push_claim(fill, &rs, first, last, tolerance, notes);
+                        continue;
+                    }
+                }
+                match (proc_, plane) {
+                    (Procedure::Single, Some(p)) => {
+                        Instruction::eval1(first as u32, 1, intensity(&p.pixel(first), channels))
+                    }
+                    _ => centre_instruction(proc_, first as u32, n, ac, inc, &rs),
+                }
+            }
         };
         if notes {
             if n == 1 {
@@ -356,17 +379,17 @@ pub fn box_row_into(
 
 /// The report's instruction for a stretch `x .. x + n` of procedure `proc_`: coverage
 /// `ac` at its first pixel growing by `inc` per pixel, times the intensity at each pixel
-/// centre (`fpi` at the first, changing by `rs.di`).
+/// centre (`rs` at the first, changing by `rs.di`).
 fn centre_instruction(
     proc_: Procedure,
     x: u32,
     n: u32,
     ac: f64,
     inc: f64,
-    fpi: &Vector,
     rs: &RowShade,
 ) -> Instruction {
     let channels = rs.channels;
+    let fpi = &rs.at(i64::from(x));
     match proc_ {
         Procedure::Single | Procedure::Claim => {
             Instruction::eval1(x, 1, map(fpi, channels, |v, _| v * ac))

@@ -15,7 +15,7 @@
 //!   "The exact box filter"), from the values at its first, middle and last pixel.
 
 use crate::coverage::Slice;
-use crate::dofill::Shade;
+use crate::dofill::RowShade;
 use crate::trapezoid::{vector, Trapezium, Vector};
 use cwisim_isa::MAX_CHANNELS;
 
@@ -37,58 +37,43 @@ pub struct RowPlane {
     /// The band's top and bottom.
     y0: f64,
     y1: f64,
-    /// The left and right edge's x at the top (`y0`) and at the bottom (`y1`).
-    left: (f64, f64),
-    right: (f64, f64),
+    /// The left and right edge over the band.
+    left: BandEdge,
+    right: BandEdge,
 }
 
 impl RowPlane {
-    /// The plane of `t` over the band of `s`. Flat shading: the polygon's intensity,
-    /// gradients 0. Gouraud: at the middle height `y_m` the value and x-gradient of the
-    /// scanline function (0 where the edges meet, as in the report's mode); the
-    /// y-gradient is what each edge's own intensity gradient leaves after its run in x,
+    /// The Gouraud plane of `t` over the band of `s`, from the row's scanline function
+    /// `line` at the band's middle height `y_m` (its value at the left edge and its
+    /// x-gradient, 0 where the edges meet, as in the report's mode); the y-gradient is
+    /// what each edge's own intensity gradient leaves after its run in x,
     /// `dI_E/dy − b_x · dx_E/dy`, averaged over the two edges (they agree for planar
-    /// intensities).
-    pub fn new(t: &Trapezium, shade: &Shade, s: &Slice, channels: usize) -> RowPlane {
-        let y_m = 0.5 * (s.y0 + s.y1);
-        let zero = [0.0; MAX_CHANNELS];
-        let (x_l, x_r) = (t.left.x_at(y_m), t.right.x_at(y_m));
-        let (i_m, b_x, b_y) = match shade {
-            Shade::Flat(v) => (*v, zero, zero),
-            Shade::Gouraud => {
-                let (il, ir) = (t.left.i_at(y_m, channels), t.right.i_at(y_m, channels));
-                let width = x_r - x_l;
-                let b_x = if width > 1e-12 * (1.0 + x_l.abs()) {
-                    vector(channels, |c| (ir[c] - il[c]) / width)
-                } else {
-                    zero
-                };
-                let along = |e: &crate::trapezoid::Edge, c: usize| {
-                    let dy = e.y_bot - e.y_top;
-                    (e.i_bot[c] - e.i_top[c]) / dy - b_x[c] * (e.x_bot - e.x_top) / dy
-                };
-                let b_y = vector(channels, |c| 0.5 * (along(&t.left, c) + along(&t.right, c)));
-                // A gradient beyond f64 (a change of up to 1e308 across a band or a run
-                // narrower than the change's ratio to f64's range: a sliver 1e-12 px wide
-                // shading 0 → 1e300 across) is taken as 0: the row is then that narrow in
-                // that direction, so the constant `il` is off by at most the polygon's
-                // intensity range times the row's area, and no inf or NaN reaches an Eval.
-                let finite =
-                    |g: Vector| vector(channels, |c| if g[c].is_finite() { g[c] } else { 0.0 });
-                (il, finite(b_x), finite(b_y))
-            }
+    /// intensities). A flat row needs no plane: its values are the report's.
+    pub(crate) fn new(t: &Trapezium, s: &Slice, line: &RowShade) -> RowPlane {
+        let channels = line.channels;
+        let b_x = line.di;
+        let along = |e: &crate::trapezoid::Edge, c: usize| {
+            let dy = e.y_bot - e.y_top;
+            (e.i_bot[c] - e.i_top[c]) / dy - b_x[c] * (e.x_bot - e.x_top) / dy
         };
+        let b_y = vector(channels, |c| 0.5 * (along(&t.left, c) + along(&t.right, c)));
+        // A gradient beyond f64 (a change of up to 1e308 across a band or a run
+        // narrower than the change's ratio to f64's range: a sliver 1e-12 px wide
+        // shading 0 → 1e300 across) is taken as 0: the row is then that narrow in
+        // that direction, so the constant `il` is off by at most the polygon's
+        // intensity range times the row's area, and no inf or NaN reaches an Eval.
+        let finite = |g: Vector| vector(channels, |c| if g[c].is_finite() { g[c] } else { 0.0 });
         RowPlane {
-            i_m,
-            b_x,
-            b_y,
-            x_l,
-            y_m,
+            i_m: line.i_left,
+            b_x: finite(b_x),
+            b_y: finite(b_y),
+            x_l: line.x_left,
+            y_m: 0.5 * (s.y0 + s.y1),
             channels,
             y0: s.y0,
             y1: s.y1,
-            left: (t.left.x_at(s.y0), t.left.x_at(s.y1)),
-            right: (t.right.x_at(s.y0), t.right.x_at(s.y1)),
+            left: BandEdge::new(s.left.at_top, s.left.at_bottom, s.y1 - s.y0),
+            right: BandEdge::new(s.right.at_top, s.right.at_bottom, s.y1 - s.y0),
         }
     }
 
@@ -130,11 +115,11 @@ impl RowPlane {
     /// Area and first moments `∫∫ (x − x0) dA`, `∫∫ (y − y0) dA` of the row's
     /// quadrilateral clipped to the column `[x0, x0 + 1]`, with the coordinates taken
     /// relative to `(x0, y0)` (so that far-away pixels lose no precision): what lies left
-    /// of the right edge less what lies left of the left edge ([`left_of`]).
+    /// of the right edge less what lies left of the left edge ([`BandEdge::left_of`]).
     fn moments(&self, x0: f64) -> (f64, f64, f64) {
         let h = self.y1 - self.y0;
-        let r = left_of(self.right.0 - x0, self.right.1 - x0, h);
-        let l = left_of(self.left.0 - x0, self.left.1 - x0, h);
+        let r = self.right.left_of(x0, h);
+        let l = self.left.left_of(x0, h);
         let area = r[0] - l[0];
         // edges that cross by a rounding (an apex) leave no negative area
         if area <= 0.0 {
@@ -144,60 +129,66 @@ impl RowPlane {
     }
 }
 
-/// Area and first moments `[∫∫ dA, ∫∫ x dA, ∫∫ t dA]` of the part of the unit column
-/// `0 ≤ x ≤ 1` over the band `0 ≤ t ≤ h` that lies left of an edge running straight
-/// from `x = u0` at `t = 0` to `x = u1` at `t = h`.
-///
-/// At height `t` that part is `[0, c(t)]` with `c` the edge's x clamped to `[0, 1]`, so
-/// the three are `∫ c`, `∫ c²/2` and `∫ t·c` over the band: closed forms over at most
-/// three pieces, where `c` is 0, the edge's linear x, or 1.
-fn left_of(u0: f64, u1: f64, h: f64) -> [f64; 3] {
-    let d = u1 - u0;
-    if d == 0.0 || !d.is_finite() {
-        // vertical (or not a number: nothing to integrate)
-        let c = u0.clamp(0.0, 1.0);
-        return if c.is_nan() {
-            [0.0; 3]
-        } else {
-            [h * c, h * c * c / 2.0, c * h * h / 2.0]
-        };
-    }
-    // where the edge crosses x = 0 and x = 1, as heights clamped to the band
-    let (s0, s1) = (h * (-u0 / d), h * ((1.0 - u0) / d));
-    let rising = d > 0.0;
-    let (s_a, s_b) = if rising { (s0, s1) } else { (s1, s0) };
-    // (max then min, not `clamp`: a NaN passes through instead of panicking)
-    let (t_a, t_b) = (s_a.max(0.0).min(h), s_b.max(0.0).min(h));
-    // c at the ends of the linear piece: 0 or 1 where the edge crosses the column's
-    // side within the band, else its (clamped) x at the band's top or bottom
-    let c_a = if s_a > 0.0 {
-        if rising {
-            0.0
-        } else {
-            1.0
+/// One edge of a row over the row's band (of height `h`, `t` measured down from its
+/// top): its x at the top and the bottom, and how far down the band it moves per unit
+/// of x (`h / (bottom − top)`; infinite for a vertical edge), taken once per row.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct BandEdge {
+    top: f64,
+    bottom: f64,
+    dt_dx: f64,
+}
+
+impl BandEdge {
+    fn new(top: f64, bottom: f64, h: f64) -> BandEdge {
+        BandEdge {
+            top,
+            bottom,
+            dt_dx: h / (bottom - top),
         }
-    } else {
-        u0.clamp(0.0, 1.0)
-    };
-    let c_b = if s_b < h {
-        if rising {
-            1.0
-        } else {
-            0.0
-        }
-    } else {
-        u1.clamp(0.0, 1.0)
-    };
-    let mut m = linear_piece(t_a, t_b, c_a, c_b);
-    // the piece where the whole column lies left of the edge (c = 1)
-    let (f_a, f_b) = if rising { (t_b, h) } else { (0.0, t_a) };
-    let len = f_b - f_a;
-    if len > 0.0 {
-        m[0] += len;
-        m[1] += len / 2.0;
-        m[2] += len * (f_a + f_b) / 2.0;
     }
-    m
+
+    /// Area and first moments `[∫∫ dA, ∫∫ (x − x0) dA, ∫∫ t dA]` of the part of the
+    /// column `x0 ≤ x ≤ x0 + 1` over the band that lies left of the edge.
+    ///
+    /// At height `t` that part is `[x0, x0 + c(t)]` with `c` the edge's `x − x0`
+    /// clamped to `[0, 1]`, so the three are `∫ c`, `∫ c²/2` and `∫ t·c` over the band:
+    /// closed forms over at most three pieces, where `c` is 0, linear, or 1.
+    fn left_of(&self, x0: f64, h: f64) -> [f64; 3] {
+        let (u0, u1) = (self.top - x0, self.bottom - x0);
+        let k = self.dt_dx;
+        if !k.is_finite() {
+            // vertical, or so steep that it moves less than f64 can tell over the band
+            let c = u0.clamp(0.0, 1.0);
+            return if c.is_nan() {
+                [0.0; 3]
+            } else {
+                [h * c, h * c * c / 2.0, c * h * h / 2.0]
+            };
+        }
+        // where the edge crosses the column's sides x0 and x0 + 1, as heights
+        let (s0, s1) = (-u0 * k, (1.0 - u0) * k);
+        let rising = k > 0.0;
+        let (s_a, s_b) = if rising { (s0, s1) } else { (s1, s0) };
+        // clamped to the band (max then min, not `clamp`: a NaN passes, no panic)
+        let (t_a, t_b) = (s_a.max(0.0).min(h), s_b.max(0.0).min(h));
+        // c at the ends of the linear piece: 0 or 1 where the edge crosses a side of
+        // the column within the band, else its (clamped) value at the band's top or
+        // bottom
+        let (inner, outer) = if rising { (0.0, 1.0) } else { (1.0, 0.0) };
+        let c_a = if s_a > 0.0 { inner } else { u0.clamp(0.0, 1.0) };
+        let c_b = if s_b < h { outer } else { u1.clamp(0.0, 1.0) };
+        let mut m = linear_piece(t_a, t_b, c_a, c_b);
+        // the piece where the whole column lies left of the edge (c = 1)
+        let (f_a, f_b) = if rising { (t_b, h) } else { (0.0, t_a) };
+        let len = f_b - f_a;
+        if len > 0.0 {
+            m[0] += len;
+            m[1] += len / 2.0;
+            m[2] += len * (f_a + f_b) / 2.0;
+        }
+        m
+    }
 }
 
 /// `[∫ c, ∫ c²/2, ∫ t·c]` over `[t_a, t_b]` for `c` linear from `c_a` to `c_b` (0 for
@@ -240,6 +231,7 @@ pub fn forward_differences(n: u32, first: f64, middle: f64, last: f64) -> (f64, 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::dofill::Shade;
     use crate::trapezoid::Edge;
 
     fn edge(top: (f64, f64), bot: (f64, f64), plane: impl Fn(f64, f64) -> f64) -> Edge {
@@ -290,7 +282,8 @@ mod tests {
         };
         for row in 0..3 {
             let s = Slice::of(&t, row).unwrap();
-            let p = RowPlane::new(&t, &Shade::Gouraud, &s, 1);
+            let line = RowShade::new(&t, &Shade::Gouraud, 0.5 * (s.y0 + s.y1), 1);
+            let p = RowPlane::new(&t, &s, &line);
             assert!((p.b_x[0] - 0.07).abs() < 1e-14 && (p.b_y[0] + 0.2).abs() < 1e-14);
             for i in 0..12 {
                 let want = brute(&t, row, i, plane);
@@ -328,10 +321,10 @@ mod tests {
     fn clip_moments(p: &RowPlane, x0: f64) -> (f64, f64, f64) {
         let h = p.y1 - p.y0;
         let quad = [
-            [p.left.0 - x0, 0.0],
-            [p.right.0 - x0, 0.0],
-            [p.right.1 - x0, h],
-            [p.left.1 - x0, h],
+            [p.left.top - x0, 0.0],
+            [p.right.top - x0, 0.0],
+            [p.right.bottom - x0, h],
+            [p.left.bottom - x0, h],
         ];
         let mut a = [[0.0; 2]; 8];
         let mut b = [[0.0; 2]; 8];
@@ -387,12 +380,12 @@ mod tests {
     /// moments (polynomials of degree ≤ 2 there) exactly, up to rounding.
     fn quadrature_moments(p: &RowPlane, x0: f64) -> (f64, f64, f64) {
         let h = p.y1 - p.y0;
-        let edge = |e: (f64, f64)| move |t: f64| (e.0 - x0) + (e.1 - e.0) * (t / h);
+        let edge = |e: BandEdge| move |t: f64| (e.top - x0) + (e.bottom - e.top) * (t / h);
         let (l, r) = (edge(p.left), edge(p.right));
         let mut cuts = vec![0.0, h];
         for (a, b) in [
-            (p.left.0 - x0, p.left.1 - x0),
-            (p.right.0 - x0, p.right.1 - x0),
+            (p.left.top - x0, p.left.bottom - x0),
+            (p.right.top - x0, p.right.bottom - x0),
         ] {
             for side in [0.0, 1.0] {
                 if b != a {
@@ -425,6 +418,8 @@ mod tests {
     /// `l1` (bottom) and the right edge from `r0` to `r1`; intensity 0 (only its
     /// moments are taken).
     fn row(y0: f64, h: f64, l: (f64, f64), r: (f64, f64)) -> RowPlane {
+        let y1 = y0 + h;
+        let h = y1 - y0; // the band's height as f64 has it
         RowPlane {
             i_m: [0.0; MAX_CHANNELS],
             b_x: [0.0; MAX_CHANNELS],
@@ -433,9 +428,9 @@ mod tests {
             y_m: y0 + h / 2.0,
             channels: 1,
             y0,
-            y1: y0 + h,
-            left: l,
-            right: r,
+            y1,
+            left: BandEdge::new(l.0, l.1, h),
+            right: BandEdge::new(r.0, r.1, h),
         }
     }
 
@@ -465,6 +460,8 @@ mod tests {
             row(0.0, 0.75, (3.0, 1.0), (3.0, 5.0)),
             row(0.0, 0.75, (1.0, 3.0), (5.0, 3.0)),
             row(0.0, 1.0, (0.0, 1.0), (1.0, 2.0)),
+            row(0.0, 1.0, (1e-300, 3e-300), (0.5, 0.5 + 1e-16)),
+            row(0.0, 1.0, (-1e-300, 1e-300), (1.0 - 1e-16, 1.0 + 1e-16)),
         ];
         for _ in 0..3000 {
             let h = [1.0, next(), 1e-6 * next()][(next() * 3.0) as usize];
@@ -479,8 +476,8 @@ mod tests {
     /// The columns a row's moments are checked in: every one it touches and one beyond
     /// each side.
     fn columns(p: &RowPlane) -> impl Iterator<Item = f64> {
-        let lo = p.left.0.min(p.left.1).floor() - 1.0;
-        let hi = p.right.0.max(p.right.1).ceil() + 1.0;
+        let lo = p.left.top.min(p.left.bottom).floor() - 1.0;
+        let hi = p.right.top.max(p.right.bottom).ceil() + 1.0;
         let n = ((hi - lo) as usize).min(400);
         (0..=n).map(move |k| lo + k as f64)
     }
