@@ -30,8 +30,9 @@ impl Intensity {
             !values.is_empty() && values.len() <= MAX_CHANNELS,
             "an intensity has 1..={MAX_CHANNELS} channels"
         );
-        let mut v = [0.0; MAX_CHANNELS];
-        v[..values.len()].copy_from_slice(values);
+        // every lane written (the unused ones 0) rather than a copy of `values.len()`
+        // lanes: a fixed-size store, no call to `memcpy`
+        let v = std::array::from_fn(|c| values.get(c).copied().unwrap_or(0.0));
         Intensity {
             len: values.len() as u8,
             values: v,

@@ -152,12 +152,7 @@ impl RowShade {
     /// Intensity at the centre of pixel column `i`.
     fn at(&self, i: i64) -> Vector {
         let dx = i as f64 + 0.5 - self.x_left;
-        let mut v = [0.0; cwisim_isa::MAX_CHANNELS];
-        let ch = self.channels;
-        for ((v, i), d) in v[..ch].iter_mut().zip(&self.i_left).zip(&self.di) {
-            *v = i + dx * d;
-        }
-        v
+        vector(self.channels, |c| self.i_left[c] + dx * self.di[c])
     }
 
     fn flat(&self) -> bool {
@@ -223,10 +218,7 @@ fn claim_run(
     while a <= last {
         let b = (a + k - 1).min(last);
         let (va, vb) = (rs.at(a), rs.at(b));
-        let mut centre = [0.0; cwisim_isa::MAX_CHANNELS];
-        for ((m, a), b) in centre[..ch].iter_mut().zip(&va).zip(&vb) {
-            *m = 0.5 * (a + b);
-        }
+        let centre = vector(ch, |c| 0.5 * (va[c] + vb[c]));
         out.push((
             Procedure::Claim,
             Instruction::eval0(a as u32, (b - a + 1) as u32, intensity(&centre, ch)),

@@ -156,6 +156,14 @@ impl BandEdge {
     /// closed forms over at most three pieces, where `c` is 0, linear, or 1.
     fn left_of(&self, x0: f64, h: f64) -> [f64; 3] {
         let (u0, u1) = (self.top - x0, self.bottom - x0);
+        // the common cases first: the edge clear of the column on either side (what
+        // the pieces below give for them, without their rounding at the band's ends)
+        if u0 <= 0.0 && u1 <= 0.0 {
+            return [0.0; 3];
+        }
+        if u0 >= 1.0 && u1 >= 1.0 {
+            return [h, h / 2.0, h * h / 2.0];
+        }
         let k = self.dt_dx;
         if !k.is_finite() {
             // vertical, or so steep that it moves less than f64 can tell over the band
