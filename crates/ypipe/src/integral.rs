@@ -116,6 +116,7 @@ impl RowPlane {
     /// quadrilateral clipped to the column `[x0, x0 + 1]`, with the coordinates taken
     /// relative to `(x0, y0)` (so that far-away pixels lose no precision): what lies left
     /// of the right edge less what lies left of the left edge ([`BandEdge::left_of`]).
+    #[inline]
     fn moments(&self, x0: f64) -> (f64, f64, f64) {
         let h = self.y1 - self.y0;
         let r = self.right.left_of(x0, h);
@@ -154,6 +155,7 @@ impl BandEdge {
     /// At height `t` that part is `[x0, x0 + c(t)]` with `c` the edge's `x − x0`
     /// clamped to `[0, 1]`, so the three are `∫ c`, `∫ c²/2` and `∫ t·c` over the band:
     /// closed forms over at most three pieces, where `c` is 0, linear, or 1.
+    #[inline]
     fn left_of(&self, x0: f64, h: f64) -> [f64; 3] {
         let (u0, u1) = (self.top - x0, self.bottom - x0);
         // the common cases first: the edge clear of the column on either side (what
@@ -201,6 +203,7 @@ impl BandEdge {
 
 /// `[∫ c, ∫ c²/2, ∫ t·c]` over `[t_a, t_b]` for `c` linear from `c_a` to `c_b` (0 for
 /// an empty piece).
+#[inline]
 fn linear_piece(t_a: f64, t_b: f64, c_a: f64, c_b: f64) -> [f64; 3] {
     let len = t_b - t_a;
     if len <= 0.0 {
