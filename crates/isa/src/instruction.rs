@@ -134,7 +134,9 @@ impl PartialEq for Values {
 impl Eq for Values {}
 
 impl Values {
-    #[inline]
+    // always inlined: built out of line, the record is returned through memory and
+    // copied into its instruction with loads wider than the stores that wrote it
+    #[inline(always)]
     fn new(values: [Intensity; 3]) -> Values {
         if values.iter().all(|v| v.len() <= 1) {
             let mut present = 0;
