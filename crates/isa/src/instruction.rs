@@ -24,13 +24,15 @@ impl Intensity {
     ///
     /// # Panics
     /// If `values` is empty or longer than [`MAX_CHANNELS`]; parsers check this first.
+    #[inline]
     pub fn new(values: &[f64]) -> Intensity {
         assert!(
             !values.is_empty() && values.len() <= MAX_CHANNELS,
             "an intensity has 1..={MAX_CHANNELS} channels"
         );
-        let mut v = [0.0; MAX_CHANNELS];
-        v[..values.len()].copy_from_slice(values);
+        // every lane written (the unused ones 0) rather than a copy of `values.len()`
+        // lanes: a fixed-size store, no call to `memcpy`
+        let v = std::array::from_fn(|c| values.get(c).copied().unwrap_or(0.0));
         Intensity {
             len: values.len() as u8,
             values: v,
@@ -48,11 +50,13 @@ impl Intensity {
     }
 
     /// The values, one per channel.
+    #[inline]
     pub fn as_slice(&self) -> &[f64] {
         &self.values[..usize::from(self.len)]
     }
 
     /// The number of channels.
+    #[inline]
     pub fn len(&self) -> usize {
         usize::from(self.len)
     }
@@ -130,6 +134,9 @@ impl PartialEq for Values {
 impl Eq for Values {}
 
 impl Values {
+    // always inlined: built out of line, the record is returned through memory and
+    // copied into its instruction with loads wider than the stores that wrote it
+    #[inline(always)]
     fn new(values: [Intensity; 3]) -> Values {
         if values.iter().all(|v| v.len() <= 1) {
             let mut present = 0;
@@ -148,6 +155,7 @@ impl Values {
 }
 
 impl Instruction {
+    #[inline]
     fn with(op: Opcode, x: u32, dx: u32, i: Intensity, di: Intensity, ddi: Intensity) -> Self {
         Self::from_parts(op, x, dx, [i, di, ddi])
     }
@@ -155,6 +163,7 @@ impl Instruction {
     /// An instruction from its fields as they are, the value slots `[I, dI, ddI]` among
     /// them. Nothing is checked (decoders and fuzzers build what they read, then
     /// [`Self::check`] it).
+    #[inline]
     pub fn from_parts(op: Opcode, x: u32, dx: u32, values: [Intensity; 3]) -> Self {
         Instruction {
             op,
@@ -238,18 +247,22 @@ impl Instruction {
         )
     }
     /// `Eval0(x, dx, I)`.
+    #[inline]
     pub fn eval0(x: u32, dx: u32, i: Intensity) -> Self {
         Self::with(Opcode::Eval0, x, dx, i, Intensity::NONE, Intensity::NONE)
     }
     /// `Eval1(x, dx, I)`.
+    #[inline]
     pub fn eval1(x: u32, dx: u32, i: Intensity) -> Self {
         Self::with(Opcode::Eval1, x, dx, i, Intensity::NONE, Intensity::NONE)
     }
     /// `Eval2(x, dx, I, dI)`.
+    #[inline]
     pub fn eval2(x: u32, dx: u32, i: Intensity, di: Intensity) -> Self {
         Self::with(Opcode::Eval2, x, dx, i, di, Intensity::NONE)
     }
     /// `Eval3(x, dx, I, dI, ddI)`.
+    #[inline]
     pub fn eval3(x: u32, dx: u32, i: Intensity, di: Intensity, ddi: Intensity) -> Self {
         Self::with(Opcode::Eval3, x, dx, i, di, ddi)
     }

@@ -64,6 +64,7 @@ pub const MAX_COORDINATE: f64 = 1e15;
 pub type Vector = [f64; cwisim_isa::MAX_CHANNELS];
 
 /// The vector whose first `channels` entries are `f(c)` (the rest 0).
+#[inline]
 pub fn vector(channels: usize, f: impl Fn(usize) -> f64) -> Vector {
     std::array::from_fn(|c| if c < channels { f(c) } else { 0.0 })
 }

@@ -19,13 +19,17 @@
 use crate::floor::{ceil_i64, floor_i64};
 use crate::trapezoid::Trapezium;
 
-/// An edge over one slice: its x extent.
+/// An edge over one slice: its x at the band's top and bottom, and its x extent.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SliceEdge {
     /// Smallest x of the edge within the band.
     pub lo: f64,
     /// Largest x of the edge within the band.
     pub hi: f64,
+    /// The edge's x at the band's top (`y0`).
+    pub at_top: f64,
+    /// The edge's x at the band's bottom (`y1`).
+    pub at_bottom: f64,
 }
 
 impl SliceEdge {
@@ -89,6 +93,8 @@ impl Slice {
             SliceEdge {
                 lo: a.min(b),
                 hi: a.max(b),
+                at_top: a,
+                at_bottom: b,
             }
         };
         Some(Slice {
@@ -206,10 +212,14 @@ mod tests {
             left: SliceEdge {
                 lo: l.0.min(l.1),
                 hi: l.0.max(l.1),
+                at_top: l.0,
+                at_bottom: l.1,
             },
             right: SliceEdge {
                 lo: r.0.min(r.1),
                 hi: r.0.max(r.1),
+                at_top: r.0,
+                at_bottom: r.1,
             },
         }
     }

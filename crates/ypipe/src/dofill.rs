@@ -105,16 +105,23 @@ impl RowFill {
     }
 }
 
-/// The intensity model of one row: value at a pixel centre and change per pixel.
-struct RowShade {
-    x_left: f64,
-    i_left: Vector,
-    di: Vector,
-    channels: usize,
+/// The intensity model of one row: the scanline function at height `y`, its value at
+/// the left edge and change per pixel (what the report's values take at pixel centres,
+/// and what the exact box filter's [`RowPlane`] is built on).
+pub(crate) struct RowShade {
+    /// The left edge's x at `y` (0 for flat shading).
+    pub(crate) x_left: f64,
+    /// The intensity there.
+    pub(crate) i_left: Vector,
+    /// The change per pixel (0 where the edges meet).
+    pub(crate) di: Vector,
+    /// Channels in use.
+    pub(crate) channels: usize,
 }
 
 impl RowShade {
-    fn new(t: &Trapezium, shade: &Shade, y: f64, channels: usize) -> RowShade {
+    /// The scanline function of `t` at height `y`.
+    pub(crate) fn new(t: &Trapezium, shade: &Shade, y: f64, channels: usize) -> RowShade {
         match shade {
             Shade::Flat(v) => RowShade {
                 x_left: 0.0,
@@ -188,36 +195,27 @@ pub fn claim_chunk(di: &[f64], tolerance: f64, n: u32) -> u32 {
 /// Pushes the `Eval0`s that claim pixels `first ..= last` of a row: one when the row is
 /// flat, else a staircase of [`claim_chunk`] pixels each, holding the Gouraud value at the
 /// chunk's centre (the mean of its first and last pixel-centre values). Returns how many.
-fn claim_run(
-    rs: &RowShade,
-    first: i64,
-    last: i64,
-    tolerance: f64,
-    out: &mut Vec<(Procedure, Instruction)>,
-) -> usize {
+fn claim_run(rs: &RowShade, first: i64, last: i64, tolerance: f64, out: &mut impl RowOut) -> usize {
     let ch = rs.channels;
     let n = (last - first + 1) as u32;
     if rs.flat() {
-        out.push((
-            Procedure::Claim,
-            Instruction::eval0(first as u32, n, intensity(&rs.at(first), ch)),
-        ));
+        let instr = Instruction::eval0(first as u32, n, intensity(&rs.at(first), ch));
+        out.put(Procedure::Claim, &instr);
         return 1;
     }
     let k = i64::from(claim_chunk(&rs.di[..ch], tolerance, n));
-    let before = out.len();
+    let mut count = 0;
     let mut a = first;
     while a <= last {
         let b = (a + k - 1).min(last);
         let (va, vb) = (rs.at(a), rs.at(b));
         let centre = vector(ch, |c| 0.5 * (va[c] + vb[c]));
-        out.push((
-            Procedure::Claim,
-            Instruction::eval0(a as u32, (b - a + 1) as u32, intensity(&centre, ch)),
-        ));
+        let instr = Instruction::eval0(a as u32, (b - a + 1) as u32, intensity(&centre, ch));
+        out.put(Procedure::Claim, &instr);
+        count += 1;
         a = b + 1;
     }
-    out.len() - before
+    count
 }
 
 fn intensity(v: &Vector, channels: usize) -> Intensity {
@@ -249,7 +247,7 @@ pub fn box_row(
 }
 
 /// [`box_row`] into a reused `fill` (cleared first), writing its note only when `notes`;
-/// false when the row emits nothing. What [`crate::emit`] calls: no allocation per row.
+/// false when the row emits nothing. No allocation per row.
 #[allow(clippy::too_many_arguments)]
 pub fn box_row_into(
     t: &Trapezium,
@@ -262,15 +260,61 @@ pub fn box_row_into(
     notes: bool,
     fill: &mut RowFill,
 ) -> bool {
-    let Some(s) = Slice::of(t, row) else {
-        return false;
-    };
+    fill.reset(None);
+    let note = notes.then_some(&mut fill.note);
+    fill.case = box_row_to(
+        t,
+        row,
+        width,
+        shade,
+        channels,
+        claim,
+        value,
+        note,
+        &mut fill.instructions,
+    );
+    !fill.instructions.is_empty()
+}
+
+/// Where DO_FILL puts a row's instructions, each with the procedure that made it: a
+/// [`RowFill`]'s list, or (what [`crate::emit_rows`] does when no notes are asked for)
+/// straight into a sink, so that no instruction is built twice.
+pub trait RowOut {
+    /// Takes one instruction.
+    fn put(&mut self, proc_: Procedure, instr: &Instruction);
+}
+
+impl RowOut for Vec<(Procedure, Instruction)> {
+    fn put(&mut self, proc_: Procedure, instr: &Instruction) {
+        self.push((proc_, instr.clone()));
+    }
+}
+
+/// [`box_row`]'s instructions into `out`, its note appended to `note` when there is one;
+/// the row's case, or `None` when the trapezium does not reach the row.
+#[allow(clippy::too_many_arguments)]
+pub fn box_row_to(
+    t: &Trapezium,
+    row: u32,
+    width: u32,
+    shade: &Shade,
+    channels: usize,
+    claim: Claim,
+    value: BoxValue,
+    mut note: Option<&mut String>,
+    out: &mut impl RowOut,
+) -> Option<Case> {
+    let s = Slice::of(t, row)?;
     let h = s.height();
     let rs = RowShade::new(t, shade, 0.5 * (s.y0 + s.y1), channels);
     // the exact values, where they differ from the report's (a varying intensity)
-    let plane = match value {
-        BoxValue::Exact => Some(RowPlane::new(t, shade, &s, channels)).filter(|p| !p.constant()),
-        BoxValue::Centre => None,
+    let plane_of_row;
+    let plane = match (value, shade) {
+        (BoxValue::Exact, Shade::Gouraud) => {
+            plane_of_row = RowPlane::new(t, &s, &rs);
+            Some(&plane_of_row).filter(|p| !p.constant())
+        }
+        _ => None, // a flat row's values are the report's
     };
     let (l0, l1, r0, r1) = s.edge_pixels();
     let mut specials = [l0, l1, r0, r1];
@@ -307,10 +351,9 @@ pub fn box_row_into(
         }
     }
     let case = s.case();
-    fill.reset(Some(case));
-    if notes {
+    if let Some(note) = note.as_mut() {
         let _ = write!(
-            fill.note,
+            note,
             "row {row} trapezium {} (polygon {}): case {}:",
             t.id, t.polygon, case.0
         );
@@ -321,52 +364,55 @@ pub fn box_row_into(
         if first > last {
             continue;
         }
-        let ac = s.coverage(first);
-        if proc_ == Procedure::Single && ac == 0.0 {
-            continue; // the edge only touches this pixel's border
-        }
-        if let Claim::Eval0 { tolerance } = claim {
-            let full = matches!(proc_, Procedure::Single | Procedure::MiddlePart) && ac == 1.0;
-            if full {
-                push_claim(fill, &rs, first, last, tolerance, notes);
-                continue;
-            }
-        }
         let n = (last - first + 1) as u32;
-        let x = first as u32;
-        let fpi = rs.at(first);
-        let instr = match (proc_, &plane) {
-            (Procedure::Single, Some(p)) => {
-                Instruction::eval1(x, 1, intensity(&p.pixel(first), channels))
-            }
+        let instr = match (proc_, plane) {
             (Procedure::Sequence | Procedure::ShareSequence, Some(p)) => exact_run(p, first, last),
-            _ => centre_instruction(proc_, x, n, ac, inc, &fpi, &rs),
+            _ => {
+                let ac = s.coverage(first);
+                if proc_ == Procedure::Single && ac == 0.0 {
+                    continue; // the edge only touches this pixel's border
+                }
+                if let Claim::Eval0 { tolerance } = claim {
+                    let full =
+                        matches!(proc_, Procedure::Single | Procedure::MiddlePart) && ac == 1.0;
+                    if full {
+                        push_claim(&rs, first, last, tolerance, out, note.as_deref_mut());
+                        continue;
+                    }
+                }
+                match (proc_, plane) {
+                    (Procedure::Single, Some(p)) => {
+                        Instruction::eval1(first as u32, 1, intensity(&p.pixel(first), channels))
+                    }
+                    _ => centre_instruction(proc_, first as u32, n, ac, inc, &rs),
+                }
+            }
         };
-        if notes {
+        if let Some(note) = note.as_mut() {
             if n == 1 {
-                let _ = write!(fill.note, " {} {first}", proc_.name());
+                let _ = write!(note, " {} {first}", proc_.name());
             } else {
-                let _ = write!(fill.note, " {} {first}..={last}", proc_.name());
+                let _ = write!(note, " {} {first}..={last}", proc_.name());
             }
         }
-        fill.instructions.push((proc_, instr));
+        out.put(proc_, &instr);
     }
-    !fill.instructions.is_empty()
+    Some(case)
 }
 
 /// The report's instruction for a stretch `x .. x + n` of procedure `proc_`: coverage
 /// `ac` at its first pixel growing by `inc` per pixel, times the intensity at each pixel
-/// centre (`fpi` at the first, changing by `rs.di`).
+/// centre (`rs` at the first, changing by `rs.di`).
 fn centre_instruction(
     proc_: Procedure,
     x: u32,
     n: u32,
     ac: f64,
     inc: f64,
-    fpi: &Vector,
     rs: &RowShade,
 ) -> Instruction {
     let channels = rs.channels;
+    let fpi = &rs.at(i64::from(x));
     match proc_ {
         Procedure::Single | Procedure::Claim => {
             Instruction::eval1(x, 1, map(fpi, channels, |v, _| v * ac))
@@ -424,24 +470,24 @@ fn exact_run(p: &RowPlane, first: i64, last: i64) -> Instruction {
     )
 }
 
-/// Claims pixels `first ..= last` into `fill`, with its note (` claim 3..=9 (2 Eval0)`)
-/// when `notes`.
+/// Claims pixels `first ..= last` into `out`, with its note (` claim 3..=9 (2 Eval0)`)
+/// appended to `note` when there is one.
 fn push_claim(
-    fill: &mut RowFill,
     rs: &RowShade,
     first: i64,
     last: i64,
     tolerance: f64,
-    notes: bool,
+    out: &mut impl RowOut,
+    note: Option<&mut String>,
 ) {
-    let count = claim_run(rs, first, last, tolerance, &mut fill.instructions);
-    if notes {
+    let count = claim_run(rs, first, last, tolerance, out);
+    if let Some(note) = note {
         if first == last {
-            let _ = write!(fill.note, " claim {first}");
+            let _ = write!(note, " claim {first}");
         } else {
-            let _ = write!(fill.note, " claim {first}..={last}");
+            let _ = write!(note, " claim {first}..={last}");
         }
-        let _ = write!(fill.note, " ({count} Eval0)");
+        let _ = write!(note, " ({count} Eval0)");
     }
 }
 
@@ -502,7 +548,8 @@ pub fn sampled_row_into(
                 t.id, t.polygon
             );
         }
-        push_claim(fill, &rs, first, end - 1, tolerance, notes);
+        let note = notes.then_some(&mut fill.note);
+        push_claim(&rs, first, end - 1, tolerance, &mut fill.instructions, note);
         return true;
     }
     let (x, n) = (first as u32, (end - first) as u32);

@@ -33,7 +33,9 @@ pub mod integral;
 pub mod scan;
 pub mod trapezoid;
 
-use crate::dofill::{box_row_into, sampled_row_into, BoxValue, Procedure, RowFill, Shade};
+use crate::dofill::{
+    box_row_into, box_row_to, sampled_row_into, BoxValue, Procedure, RowFill, RowOut, Shade,
+};
 use cwisim_isa::{Instruction, TraceHeader, TraceWrite, MAX_CHANNELS};
 use cwisim_scene::ScreenScene;
 use std::io;
@@ -187,6 +189,18 @@ impl<'s> ScanPlan<'s> {
 }
 
 impl EmitStats {
+    /// Counts one instruction of DO_FILL made by `proc_`.
+    fn count(&mut self, proc_: Procedure) {
+        match proc_ {
+            Procedure::Single => self.single_pixels += 1,
+            Procedure::MiddlePart => self.middle_parts += 1,
+            Procedure::Sequence => self.sequences += 1,
+            Procedure::ShareSequence => self.share_sequences += 1,
+            Procedure::Claim => self.claims += 1,
+        }
+        self.instructions += 1;
+    }
+
     /// Adds a band's counts (everything but `polygons` and `trapezia`, which
     /// [`ScanPlan::scene_stats`] gives once).
     pub fn add_band(&mut self, band: &EmitStats) {
@@ -200,6 +214,26 @@ impl EmitStats {
         self.share_sequences += band.share_sequences;
         self.claims += band.claims;
         self.instructions += band.instructions;
+    }
+}
+
+/// A row's instructions straight into a sink, counted; the first error is kept and
+/// nothing is written after it.
+struct Direct<'a> {
+    sink: &'a mut dyn TraceWrite,
+    stats: &'a mut EmitStats,
+    /// Instructions put in this row.
+    put: u64,
+    result: io::Result<()>,
+}
+
+impl RowOut for Direct<'_> {
+    fn put(&mut self, proc_: Procedure, instr: &Instruction) {
+        if self.result.is_ok() {
+            self.stats.count(proc_);
+            self.put += 1;
+            self.result = self.sink.write(instr);
+        }
     }
 }
 
@@ -241,17 +275,34 @@ pub fn emit_rows(
             scan::Visit::Fill(row, t) => {
                 let shade = &shades[t.polygon as usize];
                 let (w, claim) = (scene.width, options.claim);
-                let boxed = |value| {
-                    move |fill: &mut RowFill| {
-                        box_row_into(t, row, w, shade, channels, claim, value, notes, fill)
-                    }
+                let value = match options.aa {
+                    Antialias::Box => Some(BoxValue::Exact),
+                    Antialias::BoxCentre => Some(BoxValue::Centre),
+                    Antialias::None => None,
                 };
-                let filled = match options.aa {
-                    Antialias::Box => boxed(BoxValue::Exact)(&mut fill),
-                    Antialias::BoxCentre => boxed(BoxValue::Centre)(&mut fill),
-                    Antialias::None => {
-                        sampled_row_into(t, row, w, shade, channels, claim, notes, &mut fill)
+                if let (Some(value), false) = (value, notes) {
+                    // no note to write first: straight into the sink
+                    let mut direct = Direct {
+                        sink: &mut *sink,
+                        stats: &mut stats,
+                        put: 0,
+                        result: Ok(()),
+                    };
+                    let case =
+                        box_row_to(t, row, w, shade, channels, claim, value, None, &mut direct);
+                    let put = direct.put;
+                    result = direct.result;
+                    if let (Some(case), true) = (case, put > 0) {
+                        stats.rows_filled += 1;
+                        stats.cases[usize::from(case.0) - 1] += 1;
                     }
+                    return;
+                }
+                let filled = match value {
+                    Some(value) => {
+                        box_row_into(t, row, w, shade, channels, claim, value, notes, &mut fill)
+                    }
+                    None => sampled_row_into(t, row, w, shade, channels, claim, notes, &mut fill),
                 };
                 if !filled {
                     return;
@@ -267,14 +318,7 @@ pub fn emit_rows(
                 };
                 result = commented.and_then(|()| {
                     for (proc_, instr) in &fill.instructions {
-                        match proc_ {
-                            Procedure::Single => stats.single_pixels += 1,
-                            Procedure::MiddlePart => stats.middle_parts += 1,
-                            Procedure::Sequence => stats.sequences += 1,
-                            Procedure::ShareSequence => stats.share_sequences += 1,
-                            Procedure::Claim => stats.claims += 1,
-                        }
-                        stats.instructions += 1;
+                        stats.count(*proc_);
                         sink.write(instr)?;
                     }
                     Ok(())

@@ -123,23 +123,23 @@ pub fn scan_rows(
 /// (then Identifier, side). Built once per scene and shared by the bands of
 /// [`scan_rows_of`].
 pub fn edge_list(trapezia: &[Trapezium], channels: usize) -> Vec<EdgeNode> {
-    let mut edge_list: Vec<EdgeNode> = trapezia
+    // the sort keys alone are sorted (the nodes are big to move); the position in the
+    // input breaks ties, so the order is the stable sort's
+    let mut keys: Vec<(i64, u32, Side, usize)> = trapezia
         .iter()
         .enumerate()
         .flat_map(|(k, t)| {
+            let top = floor_i64(t.y_top);
             [
-                EdgeNode::new(t, k, Side::Left, channels),
-                EdgeNode::new(t, k, Side::Right, channels),
+                (top, t.id, Side::Left, 2 * k),
+                (top, t.id, Side::Right, 2 * k + 1),
             ]
         })
         .collect();
-    edge_list.sort_by(|a, b| {
-        a.top_row()
-            .cmp(&b.top_row())
-            .then(a.identifier.cmp(&b.identifier))
-            .then(a.side.cmp(&b.side))
-    });
-    edge_list
+    keys.sort_unstable();
+    keys.iter()
+        .map(|&(_, _, side, n)| EdgeNode::new(&trapezia[n / 2], n / 2, side, channels))
+        .collect()
 }
 
 /// [`scan_rows`] with the scene's [`edge_list`] built already.
