@@ -18,7 +18,7 @@
 //! The figures are in docs/PERFORMANCE.md.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use cwisim_isa::{io::read_all, Encoding, Instruction, TraceWrite};
+use cwisim_isa::{io::read_all, Encoding, Instruction, TraceHeader, TraceWrite};
 use cwisim_render::vanrij::VanRij;
 use cwisim_render::{
     render as run_pipeline, ArrayConfig, LoadedScene, PolygonScene, Settings, Taps,
@@ -26,10 +26,22 @@ use cwisim_render::{
 use cwisim_scene::ScreenScene;
 use cwisim_world::embedded::embedded;
 use cwisim_world::{parse_any, project::project, resolve_on, AnyScene, Visibility, WorldScene};
-use cwisim_xproc::{EngineWriter, ImageSink, Machine, NullSink, Timing};
+use cwisim_xproc::{EngineWriter, ImageSink, LineSink, Machine, NullSink, RunStats, Timing};
 use cwisim_ypipe::{emit, header, Claim, Options, Shading};
 use std::hint::black_box;
 use std::time::Duration;
+
+/// `stream` through the fast `f64` array, each instruction checked as a renderer's is,
+/// its scanlines into `sink`; the array's statistics.
+fn replay(h: &TraceHeader, stream: &[Instruction], sink: &mut dyn LineSink<f64>) -> RunStats {
+    let mut a =
+        EngineWriter::<f64>::new(h, &Machine::default(), Timing::Fast, sink).expect("machine");
+    for i in stream {
+        a.write(i).expect("valid");
+    }
+    a.finish().expect("finish");
+    a.into_stats().expect("finished")
+}
 
 fn pot(size: u32) -> WorldScene {
     match parse_any(embedded("pot").expect("pot").text, None)
@@ -143,30 +155,13 @@ fn stages_1024(c: &mut Criterion) {
         let h = header(&screen);
         g.throughput(Throughput::Elements(stream.len() as u64));
         g.bench_function(BenchmarkId::new("array_instructions", name), |b| {
-            b.iter(|| {
-                let mut sink = NullSink;
-                let mut a =
-                    EngineWriter::<f64>::new(&h, &Machine::default(), Timing::Fast, &mut sink)
-                        .expect("machine");
-                for i in &stream {
-                    a.write(i).expect("valid");
-                }
-                a.finish().expect("finish");
-                black_box(a.into_stats())
-            })
+            b.iter(|| black_box(replay(&h, &stream, &mut NullSink)))
         });
         // the same into the `f64` image, as `cwisim render`'s array stage does
         g.bench_function(BenchmarkId::new("array_image", name), |b| {
             b.iter(|| {
                 let mut sink = ImageSink::new(h.width as usize, h.channel_count(), 1 << 34);
-                let mut a =
-                    EngineWriter::<f64>::new(&h, &Machine::default(), Timing::Fast, &mut sink)
-                        .expect("machine");
-                for i in &stream {
-                    a.write(i).expect("valid");
-                }
-                a.finish().expect("finish");
-                black_box(a.into_stats());
+                black_box(replay(&h, &stream, &mut sink));
                 black_box(sink.finish().expect("within the limit"))
             })
         });

@@ -360,25 +360,27 @@ fn feed_parallel(
     // would be mapped and faulted in page by page (most bands are over the allocator's
     // mmap threshold), which costs more than the work overlapped
     let spare: Mutex<Vec<PackedStream>> = Mutex::new(Vec::new());
+    // band `k` emitted into a reused buffer, by whichever thread takes it
+    let emit_band = |k: usize| -> io::Result<(PackedStream, Counters)> {
+        let reused = spare.lock().ok().and_then(|mut s| s.pop());
+        let mut band = reused.unwrap_or_default();
+        band.clear();
+        let counters = plan.emit_rows(band_rows(k as u32), &mut band)?;
+        Ok((band, counters))
+    };
     // this thread feeds the array: it counts as one of the `threads`
     let workers = threads.saturating_sub(1).max(1);
     std::thread::scope(|scope| {
         let (tx, rx) = mpsc::channel::<(usize, io::Result<(PackedStream, Counters)>)>();
         for _ in 0..workers {
             let tx = tx.clone();
-            let (next_band, band_rows, spare) = (&next_band, &band_rows, &spare);
+            let (next_band, emit_band) = (&next_band, &emit_band);
             scope.spawn(move || loop {
                 let k = next_band.fetch_add(1, Ordering::Relaxed);
                 if k >= n as usize {
                     break;
                 }
-                let reused = spare.lock().ok().and_then(|mut s| s.pop());
-                let mut band = reused.unwrap_or_default();
-                band.clear();
-                let r = plan
-                    .emit_rows(band_rows(k as u32), &mut band)
-                    .map(|counters| (band, counters));
-                if tx.send((k, r)).is_err() {
+                if tx.send((k, emit_band(k))).is_err() {
                     break; // the feeder stopped on an error
                 }
             });
@@ -409,13 +411,7 @@ fn feed_parallel(
             }
             let k = next_band.fetch_add(1, Ordering::Relaxed);
             if k < n as usize {
-                let reused = spare.lock().ok().and_then(|mut s| s.pop());
-                let mut band = reused.unwrap_or_default();
-                band.clear();
-                let r = plan
-                    .emit_rows(band_rows(k as u32), &mut band)
-                    .map(|counters| (band, counters));
-                waiting.insert(k, r);
+                waiting.insert(k, emit_band(k));
                 continue;
             }
             // every band is taken: wait for the workers'

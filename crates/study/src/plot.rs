@@ -280,6 +280,46 @@ pub fn decade_grid(
     Ok(())
 }
 
+/// A chart with log scales on both axes.
+pub type LogLogChart<'a, 'b> =
+    ChartContext<'a, BitMapBackend<'b>, Cartesian2d<LogCoord<f64>, LogCoord<f64>>>;
+
+/// The part of `root` from column `cols.0` to `cols.1` and row `rows.0` to `rows.1`.
+pub fn panel_area<'b>(
+    root: &DrawingArea<BitMapBackend<'b>, Shift>,
+    cols: (i32, i32),
+    rows: (i32, i32),
+) -> DrawingArea<BitMapBackend<'b>, Shift> {
+    root.clone().shrink(
+        (cols.0 as u32, rows.0 as u32),
+        ((cols.1 - cols.0) as u32, (rows.1 - rows.0) as u32),
+    )
+}
+
+/// A log–log panel over `x` × `y` (each as [`decades`] gives them) on `area`, the part
+/// of `root` at `cols` × `rows` ([`panel_area`]): both decade grids and the axes' L drawn
+/// on `root`, their labels added to `labels`; the chart, to draw series on.
+pub fn log_log_panel<'a, 'b>(
+    root: &DrawingArea<BitMapBackend<'b>, Shift>,
+    area: &'a DrawingArea<BitMapBackend<'b>, Shift>,
+    labels: &mut Vec<Label>,
+    (x, y): ((f64, f64), (f64, f64)),
+    (cols, rows): ((i32, i32), (i32, i32)),
+) -> Result<LogLogChart<'a, 'b>, String> {
+    let chart = ChartBuilder::on(area)
+        .build_cartesian_2d((x.0..x.1).log_scale(), (y.0..y.1).log_scale())
+        .map_err(err)?;
+    let at = |px: f64, py: f64| chart.backend_coord(&(px, py));
+    decade_grid(root, labels, LogAxis::Y, y, |v| at(x.0, v).1, cols)?;
+    decade_grid(root, labels, LogAxis::X, x, |v| at(v, y.0).0, rows)?;
+    root.draw(&PathElement::new(
+        vec![(cols.0, rows.0), (cols.0, rows.1), (cols.1, rows.1)],
+        BLACK,
+    ))
+    .map_err(err)?;
+    Ok(chart)
+}
+
 /// Turns a plotting error into a message.
 pub fn err<E: std::fmt::Display>(e: E) -> String {
     format!("cannot draw the plot: {e}")

@@ -5,7 +5,10 @@
 //! vertical axes and the cycles axis are logarithmic; errors below [`ERROR_FLOOR`] (an
 //! image equal to the full-quality one) sit on the floor.
 
-use crate::plot::{decade_grid, decades, draw_on, err, rgb, Align, Label, LogAxis, Rgb, OVERRUN};
+use crate::plot::{
+    decade_grid, decades, draw_on, err, log_log_panel, panel_area, rgb, Align, Label, LogAxis, Rgb,
+    OVERRUN,
+};
 use crate::refine::{PhaseRow, RefineRun};
 use plotters::prelude::*;
 
@@ -99,29 +102,13 @@ pub fn render_refine_plot(runs: &[(Option<String>, RefineRun)]) -> Result<Rgb, S
             14.0,
         ));
         // the upper panel
-        let area = root.clone().shrink(
-            (left as u32, top_upper as u32),
-            ((right - left) as u32, (top_lower - top_upper) as u32),
-        );
-        let mut chart = ChartBuilder::on(&area)
-            .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
-            .map_err(err)?;
-        let at = |x: f64, y: f64| chart.backend_coord(&(x, y));
-        decade_grid(
+        let area = panel_area(root, (left, right), (top_upper, top_lower));
+        let mut chart = log_log_panel(
             root,
+            &area,
             labels,
-            LogAxis::Y,
-            (y0, y1),
-            |y| at(x0, y).1,
-            (left, right),
-        )?;
-        decade_grid(
-            root,
-            labels,
-            LogAxis::X,
-            (x0, x1),
-            |x| at(x, y0).0,
-            (top_upper, top_lower),
+            ((x0, x1), (y0, y1)),
+            ((left, right), (top_upper, top_lower)),
         )?;
         labels.push(
             Label::new(
@@ -134,11 +121,6 @@ pub fn render_refine_plot(runs: &[(Option<String>, RefineRun)]) -> Result<Rgb, S
         labels.push(
             Label::new("RMS error", (left - 8, top_upper - 12), 14.0).align(Align::End, Align::End),
         );
-        root.draw(&PathElement::new(
-            vec![(left, top_upper), (left, top_lower), (right, top_lower)],
-            BLACK,
-        ))
-        .map_err(err)?;
         for (_, color, rows) in &series {
             let pts: Vec<(f64, f64)> = rows
                 .iter()
@@ -175,10 +157,7 @@ pub fn render_refine_plot(runs: &[(Option<String>, RefineRun)]) -> Result<Rgb, S
         }
         // the lower panel: busy cycles per scanline, per frame of the first run
         let lines = first.lines.max(2) as f64;
-        let area = root.clone().shrink(
-            (left as u32, bot_upper as u32),
-            ((right - left) as u32, (bot_lower - bot_upper) as u32),
-        );
+        let area = panel_area(root, (left, right), (bot_upper, bot_lower));
         let mut chart = ChartBuilder::on(&area)
             .build_cartesian_2d(0f64..lines, (b0..b1).log_scale())
             .map_err(err)?;

@@ -7,7 +7,7 @@
 //! report's), a hollow one point sampling; a circle is exact visibility, a square eval0 (or a screen scene). Errors
 //! below [`ERROR_FLOOR`] (an exact image) are drawn on the floor.
 
-use crate::plot::{decade_grid, decades, draw_on, err, rgb, Align, Label, LogAxis, Rgb};
+use crate::plot::{decades, draw_on, err, log_log_panel, panel_area, rgb, Align, Label, Rgb};
 use crate::tradeoff::Row;
 use plotters::prelude::*;
 
@@ -63,29 +63,13 @@ pub fn render_tradeoff_plot(rows: &[Row], name: &str) -> Result<Rgb, String> {
             (16, 42),
             14.0,
         ));
-        let area = root.clone().shrink(
-            (left as u32, upper as u32),
-            ((right - left) as u32, (lower - upper) as u32),
-        );
-        let mut chart = ChartBuilder::on(&area)
-            .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
-            .map_err(err)?;
-        let at = |x: f64, y: f64| chart.backend_coord(&(x, y));
-        decade_grid(
+        let area = panel_area(root, (left, right), (upper, lower));
+        let mut chart = log_log_panel(
             root,
+            &area,
             labels,
-            LogAxis::Y,
-            (y0, y1),
-            |y| at(x0, y).1,
-            (left, right),
-        )?;
-        decade_grid(
-            root,
-            labels,
-            LogAxis::X,
-            (x0, x1),
-            |x| at(x, y0).0,
-            (upper, lower),
+            ((x0, x1), (y0, y1)),
+            ((left, right), (upper, lower)),
         )?;
         labels.push(
             Label::new(
@@ -98,11 +82,6 @@ pub fn render_tradeoff_plot(rows: &[Row], name: &str) -> Result<Rgb, String> {
         labels.push(
             Label::new("RMS error", (left - 8, upper - 12), 15.0).align(Align::End, Align::End),
         );
-        root.draw(&PathElement::new(
-            vec![(left, upper), (left, lower), (right, lower)],
-            BLACK,
-        ))
-        .map_err(err)?;
         // the staircase: the lowest error reached for at most so many cycles
         let mut by_cycles: Vec<&Row> = rows.iter().collect();
         by_cycles.sort_by(|a, b| {
