@@ -3,17 +3,22 @@
 //! executed in one call), with the wall time of each side measured.
 //!
 //! With `threads > 1`, `threads − 1` workers each take the next band of rows of the frame
-//! and emit it into a [`PackedStream`]; the calling thread feeds the finished bands to the
-//! array in band order and hands their buffers back for reuse, and while the band it wants
-//! is not ready it emits the next untaken band itself (the array is idle most of a frame,
-//! so with two threads both cores emit). The renderer and the array
-//! overlap, and the array sees exactly the serial stream: output, trace and statistics
-//! are byte-identical at any thread count.
+//! and emit it; the calling thread takes the finished bands in, in band order, and while
+//! the band it wants is not ready it emits the next untaken band itself (so with two
+//! threads both cores emit). Each thread also executes the bands it emits, on processors
+//! of its own (`cwisim_xproc::band`): the calling thread only times, records and outputs
+//! their scanlines, in order. A tap that wants every instruction, or an array that takes
+//! no bands (the cycle-stepped engine), gets the bands' instructions instead
+//! ([`PackedStream`]), fed to the array on the calling thread. Either way the array's
+//! output, statistics and cycles are those of the serial stream: byte-identical at any
+//! thread count.
 
 use crate::error::RenderError;
 use crate::renderer::{Counters, FramePlan, Renderer};
 use cwisim_isa::{CheckedStream, Instruction, Opcode, PackedStream, TraceHeader, TraceWrite};
-use cwisim_xproc::{EngineWriter, Image, LineOut, LineSink, Machine, Numeric, RunStats, Timing};
+use cwisim_xproc::{
+    Band, BandArray, EngineWriter, Image, LineOut, LineSink, Machine, Numeric, RunStats, Timing,
+};
 use std::cell::RefCell;
 use std::io;
 use std::rc::Rc;
@@ -48,9 +53,12 @@ pub struct Rendered {
     pub counters: Counters,
     /// The array's statistics.
     pub stats: RunStats,
-    /// Wall time in the renderer (emitting instructions).
+    /// Wall time in the renderer (emitting instructions): the wall time the array did
+    /// not take.
     pub renderer_time: Duration,
-    /// Wall time in the array simulator.
+    /// Wall time in the array simulator. When bands run through the array on the threads
+    /// that emit them, the wall time is shared out between the two in proportion to
+    /// the time each took summed over the threads.
     pub array_time: Duration,
     /// The renderer's figures per pixel row, one entry per frame
     /// ([`FramePlan::row_figures`]; `Null` for a frame without them).
@@ -196,6 +204,9 @@ struct ScanlineFeed<'a, 's> {
     /// Scanlines ended (`Refresh`) in the buffer.
     buffered_lines: u64,
     array_time: Duration,
+    /// Bands executed on the threads that emitted them: the time spent emitting and
+    /// executing them, summed over the threads.
+    thread_times: Option<(Duration, Duration)>,
     lines: u64,
     /// The array's (or a tap's) own failure, told apart from the renderer's.
     fault: Option<io::Error>,
@@ -225,6 +236,7 @@ impl<'a, 's> ScanlineFeed<'a, 's> {
             buffer: Vec::new(),
             buffered_lines: 0,
             array_time: Duration::ZERO,
+            thread_times: None,
             lines: 0,
             fault: None,
         })
@@ -240,7 +252,15 @@ impl<'a, 's> ScanlineFeed<'a, 's> {
         total: Duration,
     ) -> Result<Rendered, RenderError> {
         self.finish().map_err(RenderError::Array)?;
-        let array_time = self.array_time;
+        let array_time = match self.thread_times {
+            None => self.array_time,
+            // the wall time shared out in proportion to each side's time on all threads
+            Some((emitting, executing)) => {
+                let array = (self.array_time + executing).as_secs_f64();
+                let both = array + emitting.as_secs_f64();
+                total.mul_f64(if both > 0.0 { array / both } else { 0.0 })
+            }
+        };
         let stats = self.array.into_stats().expect("finished");
         Ok(Rendered {
             counters,
@@ -277,6 +297,44 @@ impl<'a, 's> ScanlineFeed<'a, 's> {
         self.buffer = stream.into_vec();
         self.buffer.clear();
         r
+    }
+
+    /// Processors for `threads` threads to execute bands of whole scanlines on
+    /// ([`EngineWriter::band_array`]); `None` if the array takes no bands, or a tap
+    /// wants every instruction.
+    fn band_arrays(&self, threads: usize) -> Option<Vec<BandArray<f64>>> {
+        if self.taps.also.is_some() {
+            return None;
+        }
+        (0..threads).map(|_| self.array.band_array()).collect()
+    }
+
+    /// Takes in a band executed on another thread, after whatever is buffered, and then
+    /// its instructions after its last `Refresh`; `false` if the array cannot take it
+    /// (nothing taken: emit it again, into this feed).
+    fn take_in(&mut self, executed: &Executed) -> io::Result<bool> {
+        self.flush()?;
+        let start = Instant::now();
+        let taken = self.array.absorb(&executed.band);
+        self.array_time += start.elapsed();
+        if !taken? {
+            return Ok(false);
+        }
+        let threads = self
+            .thread_times
+            .get_or_insert((Duration::ZERO, Duration::ZERO));
+        threads.0 += executed.emitting;
+        threads.1 += executed.executing;
+        for _ in 0..executed.band.scanlines() {
+            self.lines += 1;
+            if let Some(p) = self.taps.progress.as_deref_mut() {
+                p(self.lines);
+            }
+        }
+        for instr in &executed.tail {
+            self.write(instr)?;
+        }
+        Ok(true)
     }
 
     /// Notes an error of the array's or a tap's own, so that it is not blamed on the
@@ -336,9 +394,100 @@ impl TraceWrite for ScanlineFeed<'_, '_> {
     }
 }
 
+/// A band of rows as a thread emitted it: either its instructions, for the feeding thread
+/// to feed to the array; or, when the array takes bands ([`EngineWriter::band_array`])
+/// and no tap needs the instructions, its whole scanlines already executed on the
+/// emitting thread's own processors, and the instructions after its last `Refresh`.
+enum Emitted {
+    Instructions(PackedStream),
+    Executed(Executed),
+}
+
+/// A band executed on the thread that emitted it ([`BandFeed`]).
+struct Executed {
+    band: Band<f64>,
+    /// The instructions after the band's last `Refresh`, for the array itself.
+    tail: Vec<Instruction>,
+    /// Time spent emitting, and executing on the band's processors.
+    emitting: Duration,
+    executing: Duration,
+}
+
+/// Where a band's rows are emitted when the emitting thread executes them too: a batch of
+/// whole scanlines at a time is checked ([`CheckedStream::from_vec`]) and run through
+/// the thread's own processors into the band, as [`ScanlineFeed`] runs them through the
+/// array.
+struct BandFeed {
+    header: TraceHeader,
+    array: BandArray<f64>,
+    buffer: Vec<Instruction>,
+    /// Instructions in the buffer up to and including its last `Refresh`.
+    whole: usize,
+    band: Band<f64>,
+    executing: Duration,
+}
+
+impl BandFeed {
+    /// Empties the feed for a band, keeping its buffers.
+    fn start(&mut self, band: Band<f64>) {
+        self.buffer.clear();
+        self.whole = 0;
+        self.band = band;
+        self.band.clear();
+        self.executing = Duration::ZERO;
+    }
+
+    /// Runs the buffer's whole scanlines into the band, keeping what follows them.
+    fn run_whole(&mut self) -> io::Result<()> {
+        let start = Instant::now();
+        let rest = self.buffer.split_off(self.whole);
+        let whole = std::mem::replace(&mut self.buffer, rest);
+        let stream = CheckedStream::from_vec(&self.header, whole).map_err(|u| u.refusal())?;
+        self.array
+            .run(&stream, &mut self.band)
+            .map_err(io::Error::other)?;
+        self.whole = 0;
+        self.executing += start.elapsed();
+        Ok(())
+    }
+
+    /// The band executed, and the instructions after its last `Refresh`.
+    fn take(&mut self, emitting: Duration) -> io::Result<Executed> {
+        self.run_whole()?;
+        Ok(Executed {
+            band: std::mem::take(&mut self.band),
+            tail: std::mem::take(&mut self.buffer),
+            emitting: emitting.saturating_sub(self.executing),
+            executing: self.executing,
+        })
+    }
+}
+
+impl TraceWrite for BandFeed {
+    fn write(&mut self, instr: &Instruction) -> io::Result<()> {
+        self.buffer.push(instr.clone());
+        if instr.op == Opcode::Refresh {
+            self.whole = self.buffer.len();
+            if self.whole >= ScanlineFeed::BATCH {
+                self.run_whole()?;
+            }
+        }
+        Ok(())
+    }
+
+    fn finish(&mut self) -> io::Result<()> {
+        Ok(())
+    }
+}
+
 /// One frame in bands: `threads − 1` workers emit bands of rows (taking the next band as
 /// they finish one) while this thread feeds the finished bands to the array in order,
 /// emitting the next untaken band itself whenever the band it wants is not there yet.
+///
+/// When the array takes bands and no tap wants the instructions, each thread also
+/// executes the bands it emits, on processors of its own, and this thread takes their
+/// scanlines in, in order ([`EngineWriter::absorb`]); a band the array cannot take (or
+/// one that failed) is emitted again here, into the array, as one thread would.
 fn feed_parallel(
     plan: &dyn FramePlan,
     rows: u32,
@@ -356,22 +505,58 @@ fn feed_parallel(
         a..b
     };
     let next_band = AtomicUsize::new(0);
+    // processors for every thread that emits, if the bands are executed where emitted
+    let band_feeds: Option<Mutex<Vec<BandFeed>>> = feed.band_arrays(threads).map(|arrays| {
+        Mutex::new(
+            arrays
+                .into_iter()
+                .map(|array| BandFeed {
+                    header: feed.header,
+                    array,
+                    buffer: Vec::new(),
+                    whole: 0,
+                    band: Band::new(),
+                    executing: Duration::ZERO,
+                })
+                .collect(),
+        )
+    });
     // buffers the feeder has emptied, for the workers to reuse: a fresh buffer per band
     // would be mapped and faulted in page by page (most bands are over the allocator's
     // mmap threshold), which costs more than the work overlapped
     let spare: Mutex<Vec<PackedStream>> = Mutex::new(Vec::new());
-    // band `k` emitted into a reused buffer, by whichever thread takes it
-    let emit_band = |k: usize| -> io::Result<(PackedStream, Counters)> {
+    let spare_bands: Mutex<Vec<Band<f64>>> = Mutex::new(Vec::new());
+    // band `k` emitted (and executed, if so) into reused buffers, by whichever thread
+    // takes it
+    let emit_band = |k: usize| -> io::Result<(Emitted, Counters)> {
+        let rows = band_rows(k as u32);
+        if let Some(feeds) = &band_feeds {
+            let start = Instant::now();
+            let mut bf = feeds
+                .lock()
+                .ok()
+                .and_then(|mut f| f.pop())
+                .expect("one band feed per thread");
+            let reused = spare_bands.lock().ok().and_then(|mut s| s.pop());
+            bf.start(reused.unwrap_or_default());
+            let done = plan
+                .emit_rows(rows, &mut bf)
+                .and_then(|counters| Ok((Emitted::Executed(bf.take(start.elapsed())?), counters)));
+            if let Ok(mut f) = feeds.lock() {
+                f.push(bf);
+            }
+            return done;
+        }
         let reused = spare.lock().ok().and_then(|mut s| s.pop());
         let mut band = reused.unwrap_or_default();
         band.clear();
-        let counters = plan.emit_rows(band_rows(k as u32), &mut band)?;
-        Ok((band, counters))
+        let counters = plan.emit_rows(rows, &mut band)?;
+        Ok((Emitted::Instructions(band), counters))
     };
     // this thread feeds the array: it counts as one of the `threads`
     let workers = threads.saturating_sub(1).max(1);
     std::thread::scope(|scope| {
-        let (tx, rx) = mpsc::channel::<(usize, io::Result<(PackedStream, Counters)>)>();
+        let (tx, rx) = mpsc::channel::<(usize, io::Result<(Emitted, Counters)>)>();
         for _ in 0..workers {
             let tx = tx.clone();
             let (next_band, emit_band) = (&next_band, &emit_band);
@@ -398,14 +583,40 @@ fn feed_parallel(
                 waiting.insert(k, band);
             }
             if let Some(band) = waiting.remove(&want) {
-                let (instructions, band_counters) = band.map_err(&fault)?;
+                let emitted = match band {
+                    Ok((Emitted::Instructions(instructions), band_counters)) => {
+                        for instr in instructions.iter() {
+                            feed.write(&instr).map_err(RenderError::Array)?;
+                        }
+                        if let Ok(mut s) = spare.lock() {
+                            s.push(instructions);
+                        }
+                        Ok(band_counters)
+                    }
+                    Ok((Emitted::Executed(executed), band_counters)) => {
+                        let taken = feed.take_in(&executed).map_err(RenderError::Array)?;
+                        if let Ok(mut s) = spare_bands.lock() {
+                            s.push(executed.band);
+                        }
+                        if taken {
+                            Ok(band_counters)
+                        } else {
+                            Err(())
+                        }
+                    }
+                    Err(e) if band_feeds.is_none() => return Err(fault(e)),
+                    Err(_) => Err(()),
+                };
+                let band_counters = match emitted {
+                    Ok(c) => c,
+                    // not taken, or failed on its thread: again here, as on one thread
+                    Err(()) => plan.emit_rows(band_rows(want as u32), feed).map_err(|e| {
+                        feed.fault
+                            .take()
+                            .map_or_else(|| fault(e), RenderError::Array)
+                    })?,
+                };
                 counters.merge(&band_counters);
-                for instr in instructions.iter() {
-                    feed.write(&instr).map_err(RenderError::Array)?;
-                }
-                if let Ok(mut s) = spare.lock() {
-                    s.push(instructions);
-                }
                 want += 1;
                 continue;
             }

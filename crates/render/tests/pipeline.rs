@@ -293,3 +293,96 @@ fn the_arrays_refusal_of_a_renderers_instruction_is_its_own_message() {
         );
     }
 }
+
+/// Rows whose `Eval2` ramps go negative, with `Acc_mode` toggled at the end of every
+/// fifth row: negative accumulation is left on across whole stretches of scanlines, so
+/// that bands executed on their own threads start with the wrong assumption and must be
+/// emitted again into the array.
+struct Toggling;
+
+impl Toggling {
+    const WIDTH: u32 = 32;
+    const LINES: u32 = 120;
+}
+
+impl FramePlan for Toggling {
+    fn emit_rows(&self, rows: Range<u32>, sink: &mut dyn TraceWrite) -> io::Result<Counters> {
+        for y in rows {
+            sink.write(&Instruction::eval2(
+                0,
+                Self::WIDTH,
+                Intensity::grey(0.5),
+                Intensity::grey(-f64::from(y % 7 + 1) / 32.0),
+            ))?;
+            sink.write(&Instruction::refresh())?;
+            if y % 5 == 4 {
+                sink.write(&Instruction::acc_mode())?;
+            }
+        }
+        Ok(Counters::default())
+    }
+}
+
+impl Renderer for Toggling {
+    fn name(&self) -> &'static str {
+        "toggling"
+    }
+
+    fn header(&self) -> TraceHeader {
+        TraceHeader::new(Self::WIDTH, Self::LINES, 1).unwrap()
+    }
+
+    fn frame<'a>(
+        &'a self,
+        _: u32,
+        _: Option<&'a Image>,
+    ) -> Result<Box<dyn FramePlan + 'a>, RenderError> {
+        Ok(Box::new(Toggling))
+    }
+
+    fn settings_phrase(&self) -> String {
+        "toggling".into()
+    }
+}
+
+#[test]
+fn bands_that_start_with_negative_accumulation_on_are_byte_identical() {
+    let (image, done) = run(&Toggling, 1).unwrap();
+    // some scanlines kept their negative values, some dropped them
+    assert!(image.data.iter().any(|v| *v < 0.0));
+    assert!(done.stats.totals.dropped_negative > 0);
+    for threads in [2, 3, 5] {
+        let (again, d) = run(&Toggling, threads).unwrap();
+        let bits = |i: &Image| i.data.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&again), bits(&image), "{threads} threads");
+        assert_eq!(d.stats, done.stats, "{threads} threads");
+    }
+}
+
+#[test]
+fn progress_hears_every_scanline_once_output_when_bands_run_on_their_threads() {
+    for threads in [2, 3] {
+        let output = std::cell::Cell::new(0);
+        let mut told = Vec::new();
+        let mut progress = |n: u64| {
+            assert!(
+                output.get() >= n,
+                "told of scanline {n} before the array output it"
+            );
+            told.push(n);
+        };
+        render(
+            &Stripes,
+            &ArrayConfig::default(),
+            threads,
+            &mut Counting(&output),
+            Taps {
+                also: None,
+                progress: Some(&mut progress),
+            },
+        )
+        .unwrap();
+        assert_eq!(told, (1..=u64::from(Stripes::LINES)).collect::<Vec<_>>());
+        assert_eq!(output.get(), u64::from(Stripes::LINES));
+    }
+}

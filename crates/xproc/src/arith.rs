@@ -20,7 +20,7 @@ use std::fmt::Debug;
 use std::marker::PhantomData;
 
 /// The arithmetic of the register file (see the module documentation).
-pub trait Arith: Send + Sync + 'static {
+pub trait Arith: Clone + Send + Sync + 'static {
     /// What one register holds.
     type Reg: Copy + Debug + Send + Sync + 'static;
     /// What a scanline hands to the sink.
@@ -96,7 +96,7 @@ pub struct Counts {
 /// [`Arith::chain`] step by step, with the arithmetic's adders: the definition every
 /// implementation of `chain` must equal.
 #[inline]
-pub fn chain_steps<A: Arith + ?Sized, const ORDER: usize, const C: usize>(
+pub fn chain_steps<A: Arith, const ORDER: usize, const C: usize>(
     ar: &A,
     acc: &mut [A::Reg],
     wave: Wave<A::Reg>,

@@ -1,6 +1,7 @@
 //! The engine interface, the choice of timing model, and replaying a trace.
 
 use crate::arith::{Arith, F32Arith, FixedArith, Native};
+use crate::band::{Band, BandArray};
 use crate::fast::FastEngine;
 use crate::machine::{Machine, MachineError, Timeline};
 use crate::numeric::Numeric;
@@ -22,6 +23,22 @@ pub trait Engine<T: Sample> {
         for instr in instrs {
             self.execute(instr, sink);
         }
+    }
+    /// Processors of this array's size and arithmetic for executing bands of whole
+    /// scanlines on another thread, to be taken in by [`Self::absorb`] (`crate::band`);
+    /// `None` if this engine cannot take bands in (the cycle-stepped engine, which
+    /// steps every instruction itself).
+    fn band_array(&self) -> Option<BandArray<T>> {
+        None
+    }
+    /// Takes in a band's scanlines as if its instructions were executed now: timed,
+    /// recorded and handed to `sink` in order. `false`, nothing taken, if the band cannot
+    /// be taken here (the engine is not between scanlines, or negative accumulation is
+    /// not as the band assumed, or the engine takes no bands): execute its instructions
+    /// instead.
+    fn absorb(&mut self, band: &Band<T>, sink: &mut dyn LineSink<T>) -> bool {
+        let _ = (band, sink);
+        false
     }
     /// Drains the array and returns the statistics.
     fn finish(self: Box<Self>, sink: &mut dyn LineSink<T>) -> RunStats;

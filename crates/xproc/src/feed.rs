@@ -2,6 +2,7 @@
 //! [`TraceWrite`], so a Y-processor (or any renderer) can send its stream straight to
 //! the simulator instead of through a file.
 
+use crate::band::{Band, BandArray};
 use crate::engine::{engine, numeric_engine, Engine, Timing};
 use crate::machine::{Machine, MachineError};
 use crate::numeric::Numeric;
@@ -60,6 +61,21 @@ impl<'a, T: Sample> EngineWriter<'a, T> {
         let (engine, sink) = self.parts()?;
         engine.execute_all(stream.instructions(), sink);
         Ok(())
+    }
+
+    /// Processors for executing bands of whole scanlines on another thread
+    /// ([`Engine::band_array`]); `None` for an engine that takes no bands, or after
+    /// [`TraceWrite::finish`].
+    pub fn band_array(&self) -> Option<BandArray<T>> {
+        self.engine.as_ref()?.band_array()
+    }
+
+    /// Takes in a band's scanlines, handing them to the sink ([`Engine::absorb`]):
+    /// `false`, nothing taken, if the engine cannot take this band here — execute its
+    /// instructions instead.
+    pub fn absorb(&mut self, band: &Band<T>) -> io::Result<bool> {
+        let (engine, sink) = self.parts()?;
+        Ok(engine.absorb(band, sink))
     }
 
     /// The engine (until [`TraceWrite::finish`]) and the sink it hands scanlines to.

@@ -37,6 +37,8 @@
 #![warn(missing_docs)]
 
 pub mod arith;
+pub mod band;
+mod clock;
 pub mod engine;
 pub mod fast;
 pub mod feed;
@@ -44,11 +46,13 @@ pub mod machine;
 pub mod numeric;
 pub mod output;
 pub mod probe;
+mod processors;
 pub mod sample;
 pub mod stats;
 pub mod stepped;
 
 pub use arith::{Arith, F32Arith, FixedArith, Native};
+pub use band::{Band, BandArray, BandError};
 pub use engine::{
     engine, numeric_engine, replay, replay_numeric, replay_probed, replay_streaming, run,
     run_numeric, Engine, ReplayError, Timing,

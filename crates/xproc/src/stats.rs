@@ -1,5 +1,6 @@
 //! Per-scanline and per-run statistics, recorded the same way by both engines.
 
+use crate::clock::IssueTimes;
 use cwisim_isa::Opcode;
 use serde::ser::SerializeMap;
 use serde::{Serialize, Serializer};
@@ -142,8 +143,8 @@ impl std::fmt::Debug for LineRecords {
     }
 }
 
-/// What one instruction did in the processors.
-#[derive(Clone, Copy, Debug, Default)]
+/// What instructions did in the processors (one instruction's, or a scanline's).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub(crate) struct Work {
     /// Processors addressed.
     pub(crate) updates: u64,
@@ -156,34 +157,23 @@ pub(crate) struct Work {
 }
 
 /// The issue side of one scanline, tallied by an engine that issues in order (the fast
-/// engine) and handed to the recorder once, at the scanline's `Refresh` or at the end
-/// ([`Recorder::issued`]): per instruction only the opcode is counted. The rest of what
-/// [`Recorder::issue`] records per instruction follows from it: the busy cycles are
-/// each opcode's count times its cost, and the stall cycles — `entry − previous entry −
-/// cost` summed over the line — telescope to the entry of the line's last instruction
-/// less the entry of the instruction before its first, less the busy cycles.
+/// engine): per instruction only the opcode is counted, and the first one noted. The
+/// scanline is timed whole from the tally ([`crate::clock::Clock::issue`]) and handed to
+/// the recorder once, at its `Refresh` or at the end ([`Recorder::issued`]).
 #[derive(Clone, Debug, Default)]
 pub(crate) struct IssueTally {
     /// Instructions, by opcode.
     pub(crate) opcodes: OpcodeCounts,
-    /// The line has an instruction: the two fields below are set.
-    pub(crate) open: bool,
-    /// Cycle the line's first instruction started to issue.
-    pub(crate) first_issue: u64,
-    /// Cycle the instruction before the line's first entered the chain (0 for the
-    /// trace's first).
-    pub(crate) entry_before: u64,
+    /// The scanline's first instruction (`None`: it has none yet).
+    pub(crate) first: Option<Opcode>,
 }
 
 impl IssueTally {
-    /// Counts an instruction of opcode `op` that started to issue at `begin`; `before`
-    /// is the entry cycle of the instruction before it.
+    /// Counts an instruction of opcode `op`.
     #[inline(always)]
-    pub(crate) fn count(&mut self, op: Opcode, begin: u64, before: u64) {
-        if !self.open {
-            self.open = true;
-            self.first_issue = begin;
-            self.entry_before = before;
+    pub(crate) fn count(&mut self, op: Opcode) {
+        if self.first.is_none() {
+            self.first = Some(op);
         }
         self.opcodes.0[op.index()] += 1;
     }
@@ -327,13 +317,13 @@ impl Recorder {
         l.stall_cycles += stall;
     }
 
-    /// The instructions of scanline `line`, tallied by the engine ([`IssueTally`]); `last`
-    /// is the cycle the last of them entered the first processor. The same record as
-    /// one [`Self::issue`] per instruction; nothing for an empty tally.
-    pub(crate) fn issued(&mut self, line: u64, tally: &IssueTally, last: u64) {
-        if !tally.open {
-            return;
-        }
+    /// The instructions of scanline `line`, tallied by the engine ([`IssueTally`]) and
+    /// timed whole ([`crate::clock::Clock::issue`]). The same record as one
+    /// [`Self::issue`] per instruction: the busy cycles are each opcode's count times its
+    /// cost, and the stall cycles — `entry − previous entry − cost` summed over the
+    /// scanline — telescope to its last entry less the entry before its first, less the
+    /// busy cycles.
+    pub(crate) fn issued(&mut self, line: u64, tally: &IssueTally, times: &IssueTimes) {
         let busy: u64 = tally
             .opcodes
             .0
@@ -343,13 +333,13 @@ impl Recorder {
             .sum();
         let l = self.line_mut(line);
         if l.instructions == 0 {
-            l.first_issue = tally.first_issue;
+            l.first_issue = times.first_issue;
         }
         l.instructions += tally.opcodes.total();
         l.opcodes.add(&tally.opcodes);
         l.busy_cycles += busy;
-        l.stall_cycles += last - tally.entry_before - busy;
-        self.last_entry = last;
+        l.stall_cycles += times.last_entry - times.entry_before - busy;
+        self.last_entry = times.last_entry;
     }
 
     /// Work an instruction of scanline `line` did in the processors.
@@ -391,86 +381,5 @@ impl Recorder {
         self.stats.totals = t;
         self.stats.lines = self.kept;
         self.stats
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::machine::Machine;
-    use cwisim_isa::TraceHeader;
-    use proptest::prelude::*;
-
-    /// Both ways of recording one stream of instructions, given as (opcode index, cycles
-    /// the bus waits for a gate before it): one [`Recorder::issue`] per instruction, and
-    /// an [`IssueTally`] per scanline handed over at its `Refresh` and at the end.
-    fn both_ways(machine: &Machine, stream: &[(usize, u64)]) -> (RunStats, RunStats) {
-        let header = TraceHeader::new(16, 3, 1).unwrap();
-        let timeline = machine.timeline(&header).unwrap();
-        let (mut each, mut tallied) = (Recorder::new(&timeline), Recorder::new(&timeline));
-        let mut tally = IssueTally::default();
-        let (mut line, mut last_entry) = (0u64, None::<u64>);
-        for &(k, wait) in stream {
-            let op = Opcode::ALL[k];
-            let before = last_entry.unwrap_or(0);
-            let begin = before + wait;
-            let cost = timeline.cost_table()[op.index()];
-            let entry = (begin + cost).max(last_entry.map_or(0, |e| e + timeline.hop));
-            each.issue(line, op, begin, entry, cost);
-            tally.count(op, begin, before);
-            last_entry = Some(entry);
-            if op == Opcode::Refresh {
-                tallied.issued(line, &std::mem::take(&mut tally), entry);
-                let ready = entry + timeline.traversal();
-                each.ready(line, ready, timeline.deadline(line));
-                tallied.ready(line, ready, timeline.deadline(line));
-                line += 1;
-            }
-        }
-        tallied.issued(line, &tally, last_entry.unwrap_or(0));
-        let end = last_entry.map_or(0, |e| e + timeline.traversal());
-        (each.finish(line, end), tallied.finish(line, end))
-    }
-
-    proptest! {
-        #![proptest_config(ProptestConfig::with_cases(300))]
-
-        /// The per-scanline tally folds into the same records and totals as the
-        /// per-instruction accounting: empty scanlines, stalls, every opcode (`Dis`,
-        /// `Acc_mode` among them) and instructions after the last `Refresh` included.
-        #[test]
-        fn a_tally_per_scanline_records_what_each_instruction_did(
-            stream in proptest::collection::vec(
-                (prop_oneof![3 => Just(12usize), 5 => 0usize..14], prop_oneof![3 => Just(0u64), 1 => 0u64..50]),
-                0..120,
-            ),
-            hop in 1u32..4,
-            value_cycles in 0u32..3,
-            refresh_cycles in 1u32..5,
-        ) {
-            let machine = Machine {
-                hop_cycles: hop,
-                value_cycles,
-                opcode_cycles: [("Refresh".to_string(), refresh_cycles)].into(),
-                line_period_cycles: Some(40),
-                ..Machine::default()
-            };
-            let (each, tallied) = both_ways(&machine, &stream);
-            prop_assert_eq!(each, tallied);
-        }
-    }
-
-    #[test]
-    fn the_tally_sees_empty_scanlines_and_a_tail_after_the_last_refresh() {
-        let machine = Machine::default();
-        // Refresh, Refresh (two empty scanlines), Dis + Acc_mode + Refresh, then Eval1
-        // and Nop never refreshed
-        let stream = [(12, 0), (12, 7), (10, 0), (11, 3), (12, 0), (7, 0), (13, 2)];
-        let (each, tallied) = both_ways(&machine, &stream);
-        assert_eq!(each, tallied);
-        assert_eq!(tallied.lines.len(), 3);
-        assert_eq!(tallied.totals.unrefreshed_instructions, 2);
-        assert!(tallied.lines.iter().all(|l| l.instructions > 0));
-        assert!(tallied.lines[1].stall_cycles >= 7);
     }
 }

@@ -1,0 +1,207 @@
+//! Bands of scanlines executed ahead on their own processors (`BandArray`) and taken in
+//! by the fast engine in order (`Engine::absorb`) give the serial run, bit for bit:
+//! the same scanlines, the same statistics, the same cycle of every event — on random
+//! traces cut into random bands, on random machines, in every numeric format. A band the
+//! engine refuses (negative accumulation left on before it, or the engine caught inside
+//! a scanline) has its instructions executed instead, as a pipeline would.
+
+mod common;
+
+use cwisim_isa::{CheckedStream, Instruction, Intensity, Opcode, TraceHeader};
+use cwisim_xproc::{
+    numeric_engine, Band, BandArray, BandError, ImageSink, Machine, Numeric, RunStats, Timing,
+};
+use proptest::prelude::*;
+
+/// What a run gives: the image's bits and the statistics.
+type Outcome = (Vec<u64>, RunStats);
+
+fn image_sink(header: &TraceHeader) -> ImageSink {
+    ImageSink::new(header.width as usize, header.channel_count(), 1 << 24)
+}
+
+fn bits(sink: ImageSink) -> Vec<u64> {
+    sink.finish()
+        .unwrap()
+        .data
+        .iter()
+        .map(|v| v.to_bits())
+        .collect()
+}
+
+fn serial(
+    header: &TraceHeader,
+    machine: &Machine,
+    numeric: &Numeric,
+    trace: &[Instruction],
+) -> Outcome {
+    let mut sink = image_sink(header);
+    let mut e = numeric_engine(header, machine, Timing::Fast, numeric).unwrap();
+    e.execute_all(trace, &mut sink);
+    let stats = e.finish(&mut sink);
+    (bits(sink), stats)
+}
+
+/// The trace cut at `cuts` into bands; each band's whole scanlines executed on one of two
+/// band arrays (reused, alternately) and taken in, its instructions after its last
+/// `Refresh` executed by the engine. Returns the outcome and how many bands were refused.
+fn in_bands(
+    header: &TraceHeader,
+    machine: &Machine,
+    numeric: &Numeric,
+    trace: &[Instruction],
+    cuts: &[usize],
+) -> (Outcome, usize) {
+    let mut sink = image_sink(header);
+    let mut e = numeric_engine(header, machine, Timing::Fast, numeric).unwrap();
+    let mut arrays = [e.band_array().unwrap(), e.band_array().unwrap()];
+    let mut band = Band::new();
+    let mut bounds: Vec<usize> = cuts.iter().map(|&c| c.min(trace.len())).collect();
+    bounds.push(0);
+    bounds.push(trace.len());
+    bounds.sort_unstable();
+    let mut refused = 0;
+    for (k, w) in bounds.windows(2).enumerate() {
+        let part = &trace[w[0]..w[1]];
+        let whole = part
+            .iter()
+            .rposition(|i| i.op == Opcode::Refresh)
+            .map_or(0, |i| i + 1);
+        band.clear();
+        let stream = CheckedStream::from_vec(header, part[..whole].to_vec()).unwrap();
+        arrays[k % 2].run(&stream, &mut band).unwrap();
+        assert_eq!(band.instructions(), whole as u64);
+        if !e.absorb(&band, &mut sink) {
+            refused += 1;
+            e.execute_all(&part[..whole], &mut sink);
+        }
+        e.execute_all(&part[whole..], &mut sink);
+    }
+    let stats = e.finish(&mut sink);
+    ((bits(sink), stats), refused)
+}
+
+fn case() -> impl Strategy<Value = (Numeric, TraceHeader, Machine, Vec<Instruction>, Vec<usize>)> {
+    (
+        prop_oneof![3 => Just(Numeric::F64), 1 => common::numeric()],
+        1u32..40,
+        1u32..5,
+        prop_oneof![Just(1u8), Just(3u8)],
+        1u32..4,
+        0u32..3,
+        1u64..300,
+    )
+        .prop_flat_map(
+            |(numeric, width, lines, channels, hop, value_cycles, period)| {
+                let header = TraceHeader::new(width, lines, channels).unwrap();
+                let m = Machine {
+                    hop_cycles: hop,
+                    value_cycles,
+                    line_period_cycles: Some(period),
+                    vblank_lines: 2,
+                    ..Machine::default()
+                };
+                (
+                    Just(numeric),
+                    Just(header),
+                    Just(m),
+                    proptest::collection::vec(
+                        prop_oneof![
+                            // scanline ends are common, so that bands hold several
+                            1 => Just(Instruction::refresh()),
+                            4 => common::instruction(width, usize::from(channels), common::value()),
+                        ],
+                        0..120,
+                    ),
+                    proptest::collection::vec(0usize..120, 0..6),
+                )
+            },
+        )
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(400))]
+
+    #[test]
+    fn bands_taken_in_order_are_the_serial_run(
+        (numeric, header, machine, trace, cuts) in case()
+    ) {
+        let (banded, _) = in_bands(&header, &machine, &numeric, &trace, &cuts);
+        prop_assert_eq!(banded, serial(&header, &machine, &numeric, &trace));
+    }
+}
+
+/// A band after negative accumulation was left on is refused, and one after a scanline
+/// left open too; the rest are taken in; the outcome is the serial run's.
+#[test]
+fn the_engine_refuses_a_band_it_cannot_take() {
+    let h = TraceHeader::new(8, 4, 1).unwrap();
+    let g = Intensity::grey;
+    let trace = vec![
+        Instruction::eval1(0, 8, g(0.5)),
+        Instruction::refresh(),
+        // band 2: leaves negative accumulation on
+        Instruction::acc_mode(),
+        Instruction::eval2(0, 8, g(0.5), g(-0.25)),
+        Instruction::refresh(),
+        // band 3 (refused: it assumed it off), turns it off again
+        Instruction::eval2(0, 8, g(0.5), g(-0.25)),
+        Instruction::acc_mode(),
+        Instruction::refresh(),
+        // band 4 (taken), then an open scanline
+        Instruction::eval2(0, 8, g(0.5), g(-0.25)),
+        Instruction::refresh(),
+        Instruction::eval0(2, 2, g(1.0)),
+        // band 5 (refused: the engine is inside a scanline)
+        Instruction::eval1(0, 4, g(0.25)),
+        Instruction::refresh(),
+    ];
+    let machine = Machine::default();
+    let (banded, refused) = in_bands(&h, &machine, &Numeric::F64, &trace, &[2, 5, 8, 11]);
+    assert_eq!(refused, 2);
+    let reference = serial(&h, &machine, &Numeric::F64, &trace);
+    assert_eq!(banded, reference);
+    assert_eq!(reference.1.totals.lines, 5);
+    // negative values went through in scanline 2 only
+    assert!(reference.1.lines[1].dropped_negative == 0);
+    assert!(reference.1.lines[3].dropped_negative > 0);
+}
+
+#[test]
+fn a_band_array_refuses_an_open_scanline_and_another_header() {
+    let h = TraceHeader::new(8, 4, 1).unwrap();
+    let e = numeric_engine(&h, &Machine::default(), Timing::Fast, &Numeric::F64).unwrap();
+    let mut array: BandArray<f64> = e.band_array().unwrap();
+    let mut band = Band::new();
+    let open = CheckedStream::from_vec(
+        &h,
+        vec![
+            Instruction::refresh(),
+            Instruction::eval1(0, 2, Intensity::grey(0.5)),
+        ],
+    )
+    .unwrap();
+    assert_eq!(
+        array.run(&open, &mut band),
+        Err(BandError::OpenScanline { last: "Eval1" })
+    );
+    let other = CheckedStream::from_vec(
+        &TraceHeader::new(16, 4, 1).unwrap(),
+        vec![Instruction::refresh()],
+    )
+    .unwrap();
+    let refused = array.run(&other, &mut band).unwrap_err();
+    assert_eq!(
+        refused.to_string(),
+        "a stream checked against a 16-wide, 1-channel header, fed to a band of a 8-wide, 1-channel array"
+    );
+    assert_eq!((band.scanlines(), band.instructions()), (0, 0));
+}
+
+#[test]
+fn the_stepped_engine_takes_no_bands() {
+    let h = TraceHeader::new(8, 4, 1).unwrap();
+    let mut e = numeric_engine(&h, &Machine::default(), Timing::Stepped, &Numeric::F64).unwrap();
+    assert!(e.band_array().is_none());
+    assert!(!e.absorb(&Band::new(), &mut image_sink(&h)));
+}
