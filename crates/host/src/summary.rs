@@ -179,8 +179,17 @@ pub fn write_render_summary(
         + t.output;
     let mut parts = vec![format!("load {}", ms(t.load))];
     parts.extend(stages.iter().map(|(name, d)| format!("{name} {}", ms(*d))));
-    parts.push(format!("Y-processor {}", ms(rendered.renderer_time)));
-    parts.push(format!("array {}", ms(rendered.array_time)));
+    if rendered.array_on_threads {
+        // each thread ran the array on the bands it emitted, interleaved with emitting
+        parts.push(format!(
+            "Y-processor and array in bands on threads {}",
+            ms(rendered.renderer_time)
+        ));
+        parts.push(format!("array in order {}", ms(rendered.array_time)));
+    } else {
+        parts.push(format!("Y-processor {}", ms(rendered.renderer_time)));
+        parts.push(format!("array {}", ms(rendered.array_time)));
+    }
     parts.push(format!("output {}", ms(t.output)));
     parts.push(format!("total {}", ms(total)));
     row(out, "time", parts.join(" · "))?;

@@ -54,12 +54,15 @@ pub struct Rendered {
     /// The array's statistics.
     pub stats: RunStats,
     /// Wall time in the renderer (emitting instructions): the wall time the array did
-    /// not take.
+    /// not take on the calling thread. With [`Self::array_on_threads`], it includes the
+    /// array's execution of the bands, interleaved with their emission.
     pub renderer_time: Duration,
-    /// Wall time in the array simulator. When bands run through the array on the threads
-    /// that emit them, the wall time is shared out between the two in proportion to
-    /// the time each took summed over the threads.
+    /// Wall time in the array simulator on the calling thread.
     pub array_time: Duration,
+    /// The bands' scanlines were executed on the threads that emitted them, interleaved
+    /// with their emission: the array's time on the calling thread is only that of
+    /// taking them in (timing, recording and output in order).
+    pub array_on_threads: bool,
     /// The renderer's figures per pixel row, one entry per frame
     /// ([`FramePlan::row_figures`]; `Null` for a frame without them).
     pub row_figures: Vec<serde_json::Value>,
@@ -204,9 +207,8 @@ struct ScanlineFeed<'a, 's> {
     /// Scanlines ended (`Refresh`) in the buffer.
     buffered_lines: u64,
     array_time: Duration,
-    /// Bands executed on the threads that emitted them: the time spent emitting and
-    /// executing them, summed over the threads.
-    thread_times: Option<(Duration, Duration)>,
+    /// Some band was executed on the thread that emitted it.
+    bands_on_threads: bool,
     lines: u64,
     /// The array's (or a tap's) own failure, told apart from the renderer's.
     fault: Option<io::Error>,
@@ -236,7 +238,7 @@ impl<'a, 's> ScanlineFeed<'a, 's> {
             buffer: Vec::new(),
             buffered_lines: 0,
             array_time: Duration::ZERO,
-            thread_times: None,
+            bands_on_threads: false,
             lines: 0,
             fault: None,
         })
@@ -252,21 +254,14 @@ impl<'a, 's> ScanlineFeed<'a, 's> {
         total: Duration,
     ) -> Result<Rendered, RenderError> {
         self.finish().map_err(RenderError::Array)?;
-        let array_time = match self.thread_times {
-            None => self.array_time,
-            // the wall time shared out in proportion to each side's time on all threads
-            Some((emitting, executing)) => {
-                let array = (self.array_time + executing).as_secs_f64();
-                let both = array + emitting.as_secs_f64();
-                total.mul_f64(if both > 0.0 { array / both } else { 0.0 })
-            }
-        };
+        let array_time = self.array_time;
         let stats = self.array.into_stats().expect("finished");
         Ok(Rendered {
             counters,
             stats,
             renderer_time: total.saturating_sub(array_time),
             array_time,
+            array_on_threads: self.bands_on_threads,
             row_figures,
         })
     }
@@ -309,30 +304,22 @@ impl<'a, 's> ScanlineFeed<'a, 's> {
         (0..threads).map(|_| self.array.band_array()).collect()
     }
 
-    /// Takes in a band executed on another thread, after whatever is buffered, and then
-    /// its instructions after its last `Refresh`; `false` if the array cannot take it
-    /// (nothing taken: emit it again, into this feed).
-    fn take_in(&mut self, executed: &Executed) -> io::Result<bool> {
+    /// Takes in a band executed on another thread, after whatever is buffered; `false`
+    /// if the array cannot take it (nothing taken: emit it again, into this feed).
+    fn take_in(&mut self, band: &Band<f64>) -> io::Result<bool> {
         self.flush()?;
         let start = Instant::now();
-        let taken = self.array.absorb(&executed.band);
+        let taken = self.array.absorb(band);
         self.array_time += start.elapsed();
         if !taken? {
             return Ok(false);
         }
-        let threads = self
-            .thread_times
-            .get_or_insert((Duration::ZERO, Duration::ZERO));
-        threads.0 += executed.emitting;
-        threads.1 += executed.executing;
-        for _ in 0..executed.band.scanlines() {
+        self.bands_on_threads = true;
+        for _ in 0..band.scanlines() {
             self.lines += 1;
             if let Some(p) = self.taps.progress.as_deref_mut() {
                 p(self.lines);
             }
-        }
-        for instr in &executed.tail {
-            self.write(instr)?;
         }
         Ok(true)
     }
@@ -396,88 +383,11 @@ impl TraceWrite for ScanlineFeed<'_, '_> {
 
 /// A band of rows as a thread emitted it: either its instructions, for the feeding thread
 /// to feed to the array; or, when the array takes bands ([`EngineWriter::band_array`])
-/// and no tap needs the instructions, its whole scanlines already executed on the
-/// emitting thread's own processors, and the instructions after its last `Refresh`.
+/// and no tap needs the instructions, its scanlines executed on the emitting thread's own
+/// processors as it emitted them.
 enum Emitted {
     Instructions(PackedStream),
-    Executed(Executed),
-}
-
-/// A band executed on the thread that emitted it ([`BandFeed`]).
-struct Executed {
-    band: Band<f64>,
-    /// The instructions after the band's last `Refresh`, for the array itself.
-    tail: Vec<Instruction>,
-    /// Time spent emitting, and executing on the band's processors.
-    emitting: Duration,
-    executing: Duration,
-}
-
-/// Where a band's rows are emitted when the emitting thread executes them too: a batch of
-/// whole scanlines at a time is checked ([`CheckedStream::from_vec`]) and run through
-/// the thread's own processors into the band, as [`ScanlineFeed`] runs them through the
-/// array.
-struct BandFeed {
-    header: TraceHeader,
-    array: BandArray<f64>,
-    buffer: Vec<Instruction>,
-    /// Instructions in the buffer up to and including its last `Refresh`.
-    whole: usize,
-    band: Band<f64>,
-    executing: Duration,
-}
-
-impl BandFeed {
-    /// Empties the feed for a band, keeping its buffers.
-    fn start(&mut self, band: Band<f64>) {
-        self.buffer.clear();
-        self.whole = 0;
-        self.band = band;
-        self.band.clear();
-        self.executing = Duration::ZERO;
-    }
-
-    /// Runs the buffer's whole scanlines into the band, keeping what follows them.
-    fn run_whole(&mut self) -> io::Result<()> {
-        let start = Instant::now();
-        let rest = self.buffer.split_off(self.whole);
-        let whole = std::mem::replace(&mut self.buffer, rest);
-        let stream = CheckedStream::from_vec(&self.header, whole).map_err(|u| u.refusal())?;
-        self.array
-            .run(&stream, &mut self.band)
-            .map_err(io::Error::other)?;
-        self.whole = 0;
-        self.executing += start.elapsed();
-        Ok(())
-    }
-
-    /// The band executed, and the instructions after its last `Refresh`.
-    fn take(&mut self, emitting: Duration) -> io::Result<Executed> {
-        self.run_whole()?;
-        Ok(Executed {
-            band: std::mem::take(&mut self.band),
-            tail: std::mem::take(&mut self.buffer),
-            emitting: emitting.saturating_sub(self.executing),
-            executing: self.executing,
-        })
-    }
-}
-
-impl TraceWrite for BandFeed {
-    fn write(&mut self, instr: &Instruction) -> io::Result<()> {
-        self.buffer.push(instr.clone());
-        if instr.op == Opcode::Refresh {
-            self.whole = self.buffer.len();
-            if self.whole >= ScanlineFeed::BATCH {
-                self.run_whole()?;
-            }
-        }
-        Ok(())
-    }
-
-    fn finish(&mut self) -> io::Result<()> {
-        Ok(())
-    }
+    Executed(Band<f64>),
 }
 
 /// One frame in bands: `threads − 1` workers emit bands of rows (taking the next band as
@@ -506,21 +416,7 @@ fn feed_parallel(
     };
     let next_band = AtomicUsize::new(0);
     // processors for every thread that emits, if the bands are executed where emitted
-    let band_feeds: Option<Mutex<Vec<BandFeed>>> = feed.band_arrays(threads).map(|arrays| {
-        Mutex::new(
-            arrays
-                .into_iter()
-                .map(|array| BandFeed {
-                    header: feed.header,
-                    array,
-                    buffer: Vec::new(),
-                    whole: 0,
-                    band: Band::new(),
-                    executing: Duration::ZERO,
-                })
-                .collect(),
-        )
-    });
+    let band_arrays: Option<Mutex<Vec<BandArray<f64>>>> = feed.band_arrays(threads).map(Mutex::new);
     // buffers the feeder has emptied, for the workers to reuse: a fresh buffer per band
     // would be mapped and faulted in page by page (most bands are over the allocator's
     // mmap threshold), which costs more than the work overlapped
@@ -530,20 +426,20 @@ fn feed_parallel(
     // takes it
     let emit_band = |k: usize| -> io::Result<(Emitted, Counters)> {
         let rows = band_rows(k as u32);
-        if let Some(feeds) = &band_feeds {
-            let start = Instant::now();
-            let mut bf = feeds
+        if let Some(arrays) = &band_arrays {
+            let mut array = arrays
                 .lock()
                 .ok()
-                .and_then(|mut f| f.pop())
-                .expect("one band feed per thread");
+                .and_then(|mut a| a.pop())
+                .expect("processors for every thread");
             let reused = spare_bands.lock().ok().and_then(|mut s| s.pop());
-            bf.start(reused.unwrap_or_default());
-            let done = plan
-                .emit_rows(rows, &mut bf)
-                .and_then(|counters| Ok((Emitted::Executed(bf.take(start.elapsed())?), counters)));
-            if let Ok(mut f) = feeds.lock() {
-                f.push(bf);
+            array.start(reused.unwrap_or_default());
+            let done = plan.emit_rows(rows, &mut array).and_then(|counters| {
+                let band = array.take().map_err(io::Error::other)?;
+                Ok((Emitted::Executed(band), counters))
+            });
+            if let Ok(mut a) = arrays.lock() {
+                a.push(array);
             }
             return done;
         }
@@ -593,10 +489,10 @@ fn feed_parallel(
                         }
                         Ok(band_counters)
                     }
-                    Ok((Emitted::Executed(executed), band_counters)) => {
-                        let taken = feed.take_in(&executed).map_err(RenderError::Array)?;
+                    Ok((Emitted::Executed(band), band_counters)) => {
+                        let taken = feed.take_in(&band).map_err(RenderError::Array)?;
                         if let Ok(mut s) = spare_bands.lock() {
-                            s.push(executed.band);
+                            s.push(band);
                         }
                         if taken {
                             Ok(band_counters)
@@ -604,7 +500,7 @@ fn feed_parallel(
                             Err(())
                         }
                     }
-                    Err(e) if band_feeds.is_none() => return Err(fault(e)),
+                    Err(e) if band_arrays.is_none() => return Err(fault(e)),
                     Err(_) => Err(()),
                 };
                 let band_counters = match emitted {

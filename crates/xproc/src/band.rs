@@ -18,11 +18,12 @@ use crate::arith::Arith;
 use crate::processors::{LineEnd, Processors};
 use crate::sample::Sample;
 use crate::stats::{IssueTally, Work};
-use cwisim_isa::{CheckedStream, Opcode, TraceHeader};
+use cwisim_isa::{refusal, Instruction, TraceHeader, TraceWrite};
+use std::io;
 
 /// Scanlines executed by a [`BandArray`], waiting to be taken in by the engine
 /// ([`crate::Engine::absorb`]). Reusable: [`Band::clear`] keeps its buffers.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct Band<T> {
     lines: Vec<BandLine>,
     /// Every scanline's values, one after the other.
@@ -48,6 +49,12 @@ pub(crate) struct BandLineRef<'a, T> {
     pub(crate) work: Work,
     pub(crate) span: (usize, usize),
     pub(crate) values: &'a [T],
+}
+
+impl<T> Default for Band<T> {
+    fn default() -> Self {
+        Band::new()
+    }
 }
 
 impl<T> Band<T> {
@@ -106,73 +113,67 @@ impl<T> Band<T> {
     }
 }
 
-/// Why a [`BandArray`] refused a stream (nothing of it executed).
-#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-pub enum BandError {
-    /// The stream was checked against another header than the array's.
-    #[error("a stream checked against a {stream_width}-wide, {stream_channels}-channel header, fed to a band of a {width}-wide, {channels}-channel array")]
-    Header {
-        /// The stream's width.
-        stream_width: u32,
-        /// The stream's channels.
-        stream_channels: u8,
-        /// The array's width.
-        width: u32,
-        /// The array's channels.
-        channels: u8,
-    },
-    /// The stream does not end with a `Refresh`: a band holds whole scanlines.
-    #[error("a band holds whole scanlines: its stream must end with a `Refresh` (this one ends with `{last}`)")]
-    OpenScanline {
-        /// The stream's last opcode.
-        last: &'static str,
-    },
-}
-
-/// Processors of their own for executing bands of whole scanlines, on any thread
-/// ([`crate::Engine::band_array`]). Each band starts from the state between scanlines,
-/// negative accumulation off.
+/// Processors of their own for executing a band of whole scanlines on any thread
+/// ([`crate::Engine::band_array`]): [`Self::start`] a band, write its instructions
+/// ([`TraceWrite`]: each checked, then executed as it comes), [`Self::take`] it. Each
+/// band starts from the state between scanlines, negative accumulation off.
 pub struct BandArray<T> {
     header: TraceHeader,
     processors: Box<dyn RunScanlines<T> + Send>,
+    band: Band<T>,
 }
+
+/// A band that does not hold whole scanlines ([`BandArray::take`]): the instructions
+/// after its last `Refresh` are in none of its scanlines, so it cannot be taken in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("a band holds whole scanlines: its stream must end with a `Refresh`")]
+pub struct OpenScanline;
 
 impl<T: Sample> BandArray<T> {
     pub(crate) fn new<A: Arith<Out = T>>(header: &TraceHeader, processors: Processors<A>) -> Self {
         BandArray {
             header: *header,
             processors: Box::new(processors),
+            band: Band::new(),
         }
     }
 
-    /// Executes the whole scanlines of `stream` into `band`, after any already there (an
-    /// empty band starts with negative accumulation off). Refused, nothing executed, if
-    /// the stream was checked against another header or does not end with a `Refresh`.
-    pub fn run(&mut self, stream: &CheckedStream, band: &mut Band<T>) -> Result<(), BandError> {
-        let h = stream.header();
-        if h != &self.header {
-            return Err(BandError::Header {
-                stream_width: h.width,
-                stream_channels: h.channels,
-                width: self.header.width,
-                channels: self.header.channels,
-            });
+    /// Starts a band in `band`'s buffers (emptied; [`Band::new`] for new ones), the
+    /// processors between scanlines, negative accumulation off.
+    pub fn start(&mut self, band: Band<T>) {
+        self.band = band;
+        self.band.clear();
+        if !self.processors.between() {
+            self.processors.reset();
         }
-        match stream.instructions().last() {
-            None => return Ok(()),
-            Some(i) if i.op != Opcode::Refresh => {
-                return Err(BandError::OpenScanline { last: i.op.name() })
-            }
-            Some(_) => {}
+        self.processors.set_negative(false);
+    }
+
+    /// The band executed since [`Self::start`]; [`OpenScanline`] if its last instruction
+    /// was not a `Refresh` (the band is dropped).
+    pub fn take(&mut self) -> Result<Band<T>, OpenScanline> {
+        let mut band = std::mem::take(&mut self.band);
+        if !self.processors.between() {
+            return Err(OpenScanline);
         }
-        if band.lines.is_empty() && band.instructions == 0 {
-            self.processors.set_negative(false);
-        } else {
-            self.processors.set_negative(band.negative_at_end);
-        }
-        self.processors.run_into(stream, band);
-        band.instructions += stream.len() as u64;
         band.negative_at_end = self.processors.negative();
+        Ok(band)
+    }
+}
+
+impl<T: Sample> TraceWrite for BandArray<T> {
+    /// Executes the instruction into the band; one that does not fit the header is an
+    /// error (`InvalidInput`, worded as the array's [`crate::EngineWriter`] words it),
+    /// not executed.
+    #[inline]
+    fn write(&mut self, instr: &Instruction) -> io::Result<()> {
+        instr.check(&self.header).map_err(|e| refusal(instr, &e))?;
+        self.processors.step_into(instr, &mut self.band);
+        self.band.instructions += 1;
+        Ok(())
+    }
+
+    fn finish(&mut self) -> io::Result<()> {
         Ok(())
     }
 }
@@ -181,7 +182,9 @@ impl<T: Sample> BandArray<T> {
 trait RunScanlines<T> {
     fn set_negative(&mut self, on: bool);
     fn negative(&self) -> bool;
-    fn run_into(&mut self, stream: &CheckedStream, band: &mut Band<T>);
+    fn step_into(&mut self, instr: &Instruction, band: &mut Band<T>);
+    fn between(&self) -> bool;
+    fn reset(&mut self);
 }
 
 impl<A: Arith> RunScanlines<A::Out> for Processors<A> {
@@ -193,17 +196,28 @@ impl<A: Arith> RunScanlines<A::Out> for Processors<A> {
         self.negative_enabled()
     }
 
-    fn run_into(&mut self, stream: &CheckedStream, band: &mut Band<A::Out>) {
-        debug_assert!(self.between_scanlines());
-        let (lines, values) = (&mut band.lines, &mut band.values);
-        self.run(stream.instructions(), &mut |end: LineEnd<'_, A::Out>| {
-            values.extend_from_slice(end.values);
-            lines.push(BandLine {
-                tally: end.tally,
-                work: end.work,
-                span: end.span,
-                values_end: values.len(),
-            });
+    fn step_into(&mut self, instr: &Instruction, band: &mut Band<A::Out>) {
+        self.run(std::slice::from_ref(instr), &mut keep_in(band));
+    }
+
+    fn between(&self) -> bool {
+        self.between_scanlines()
+    }
+
+    fn reset(&mut self) {
+        *self = self.fresh();
+    }
+}
+
+/// Keeps each scanline the processors hand out in `band`.
+fn keep_in<T: Sample>(band: &mut Band<T>) -> impl FnMut(LineEnd<'_, T>) + '_ {
+    |end: LineEnd<'_, T>| {
+        band.values.extend_from_slice(end.values);
+        band.lines.push(BandLine {
+            tally: end.tally,
+            work: end.work,
+            span: end.span,
+            values_end: band.values.len(),
         });
     }
 }

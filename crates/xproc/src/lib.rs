@@ -52,7 +52,7 @@ pub mod stats;
 pub mod stepped;
 
 pub use arith::{Arith, F32Arith, FixedArith, Native};
-pub use band::{Band, BandArray, BandError};
+pub use band::{Band, BandArray, OpenScanline};
 pub use engine::{
     engine, numeric_engine, replay, replay_numeric, replay_probed, replay_streaming, run,
     run_numeric, Engine, ReplayError, Timing,

@@ -7,9 +7,9 @@
 
 mod common;
 
-use cwisim_isa::{CheckedStream, Instruction, Intensity, Opcode, TraceHeader};
+use cwisim_isa::{Instruction, Intensity, Opcode, TraceHeader, TraceWrite};
 use cwisim_xproc::{
-    numeric_engine, Band, BandArray, BandError, ImageSink, Machine, Numeric, RunStats, Timing,
+    numeric_engine, Band, BandArray, ImageSink, Machine, Numeric, OpenScanline, RunStats, Timing,
 };
 use proptest::prelude::*;
 
@@ -55,7 +55,7 @@ fn in_bands(
     let mut sink = image_sink(header);
     let mut e = numeric_engine(header, machine, Timing::Fast, numeric).unwrap();
     let mut arrays = [e.band_array().unwrap(), e.band_array().unwrap()];
-    let mut band = Band::new();
+    let mut spare = Band::new();
     let mut bounds: Vec<usize> = cuts.iter().map(|&c| c.min(trace.len())).collect();
     bounds.push(0);
     bounds.push(trace.len());
@@ -67,15 +67,19 @@ fn in_bands(
             .iter()
             .rposition(|i| i.op == Opcode::Refresh)
             .map_or(0, |i| i + 1);
-        band.clear();
-        let stream = CheckedStream::from_vec(header, part[..whole].to_vec()).unwrap();
-        arrays[k % 2].run(&stream, &mut band).unwrap();
+        let array = &mut arrays[k % 2];
+        array.start(spare);
+        for i in &part[..whole] {
+            array.write(i).unwrap();
+        }
+        let band = array.take().unwrap();
         assert_eq!(band.instructions(), whole as u64);
         if !e.absorb(&band, &mut sink) {
             refused += 1;
             e.execute_all(&part[..whole], &mut sink);
         }
         e.execute_all(&part[whole..], &mut sink);
+        spare = band;
     }
     let stats = e.finish(&mut sink);
     ((bits(sink), stats), refused)
@@ -168,34 +172,30 @@ fn the_engine_refuses_a_band_it_cannot_take() {
 }
 
 #[test]
-fn a_band_array_refuses_an_open_scanline_and_another_header() {
+fn a_band_array_refuses_an_unfit_instruction_and_an_open_scanline() {
     let h = TraceHeader::new(8, 4, 1).unwrap();
     let e = numeric_engine(&h, &Machine::default(), Timing::Fast, &Numeric::F64).unwrap();
     let mut array: BandArray<f64> = e.band_array().unwrap();
-    let mut band = Band::new();
-    let open = CheckedStream::from_vec(
-        &h,
-        vec![
-            Instruction::refresh(),
-            Instruction::eval1(0, 2, Intensity::grey(0.5)),
-        ],
-    )
-    .unwrap();
+    array.start(Band::new());
+    let past_the_end = Instruction::eval1(6, 4, Intensity::grey(0.5));
     assert_eq!(
-        array.run(&open, &mut band),
-        Err(BandError::OpenScanline { last: "Eval1" })
+        array.write(&past_the_end).unwrap_err().to_string(),
+        "Eval1 6 4 0.5: range [x, x+dx) = [6, 10) reaches past the array's end (8)"
     );
-    let other = CheckedStream::from_vec(
-        &TraceHeader::new(16, 4, 1).unwrap(),
-        vec![Instruction::refresh()],
-    )
-    .unwrap();
-    let refused = array.run(&other, &mut band).unwrap_err();
-    assert_eq!(
-        refused.to_string(),
-        "a stream checked against a 16-wide, 1-channel header, fed to a band of a 8-wide, 1-channel array"
-    );
-    assert_eq!((band.scanlines(), band.instructions()), (0, 0));
+    array.write(&Instruction::refresh()).unwrap();
+    array
+        .write(&Instruction::eval1(0, 2, Intensity::grey(0.5)))
+        .unwrap();
+    assert_eq!(array.take().unwrap_err(), OpenScanline);
+    // the next band starts between scanlines again
+    array.start(Band::new());
+    array
+        .write(&Instruction::eval1(0, 2, Intensity::grey(0.5)))
+        .unwrap();
+    array.write(&Instruction::refresh()).unwrap();
+    let band = array.take().unwrap();
+    assert_eq!((band.scanlines(), band.instructions()), (1, 2));
+    assert!(!band.negative_at_end());
 }
 
 #[test]
