@@ -197,7 +197,7 @@ impl<A: Arith> RunScanlines<A::Out> for Processors<A> {
     }
 
     fn step_into(&mut self, instr: &Instruction, band: &mut Band<A::Out>) {
-        self.run(std::slice::from_ref(instr), &mut keep_in(band));
+        self.execute(instr, &mut keep_in(band));
     }
 
     fn between(&self) -> bool {

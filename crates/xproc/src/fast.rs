@@ -126,7 +126,11 @@ impl<A: Arith> Engine<A::Out> for FastEngine<A> {
     }
 
     fn execute(&mut self, instr: &Instruction, sink: &mut dyn LineSink<A::Out>) {
-        self.execute_all(std::slice::from_ref(instr), sink);
+        let scanlines = &mut self.scanlines;
+        self.processors
+            .execute(instr, &mut |end: LineEnd<'_, A::Out>| {
+                scanlines.output(&end.tally, end.work, end.span, end.values, sink)
+            });
     }
 
     fn execute_all(&mut self, instrs: &[Instruction], sink: &mut dyn LineSink<A::Out>) {

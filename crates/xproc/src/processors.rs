@@ -156,6 +156,21 @@ impl<A: Arith> Processors<A> {
         }
     }
 
+    /// Executes one instruction, handing its scanline to `on_line` if it is a `Refresh`.
+    #[inline]
+    pub(crate) fn execute<F: FnMut(LineEnd<'_, A::Out>)>(
+        &mut self,
+        instr: &Instruction,
+        on_line: &mut F,
+    ) {
+        match self.channels {
+            1 => self.step::<1, F>(instr, on_line),
+            2 => self.step::<2, F>(instr, on_line),
+            3 => self.step::<3, F>(instr, on_line),
+            _ => self.step::<4, F>(instr, on_line),
+        }
+    }
+
     fn run_with<const C: usize, F: FnMut(LineEnd<'_, A::Out>)>(
         &mut self,
         instrs: &[Instruction],
