@@ -195,12 +195,8 @@ fn a_renderers_bad_instruction_is_an_internal_fault() {
 
 /// One frame of many scanlines, each of many instructions: the array is fed in several
 /// batches.
+#[derive(Default)]
 struct Stripes;
-
-impl Stripes {
-    const WIDTH: u32 = 64;
-    const LINES: u32 = 300;
-}
 
 impl FramePlan for Stripes {
     fn emit_rows(&self, rows: Range<u32>, sink: &mut dyn TraceWrite) -> io::Result<Counters> {
@@ -219,13 +215,29 @@ impl FramePlan for Stripes {
     }
 }
 
-impl Renderer for Stripes {
+/// A renderer of one frame, planned by `P` (a unit type) alone, `WIDTH × LINES`.
+trait OneFrame: FramePlan + Default + 'static {
+    const NAME: &'static str;
+    const WIDTH: u32;
+    const LINES: u32;
+}
+
+impl OneFrame for Stripes {
+    const NAME: &'static str = "stripes";
+    const WIDTH: u32 = 64;
+    const LINES: u32 = 300;
+}
+
+/// [`OneFrame`] as a renderer.
+struct Single<P>(P);
+
+impl<P: OneFrame> Renderer for Single<P> {
     fn name(&self) -> &'static str {
-        "stripes"
+        P::NAME
     }
 
     fn header(&self) -> TraceHeader {
-        TraceHeader::new(Self::WIDTH, Self::LINES, 1).unwrap()
+        TraceHeader::new(P::WIDTH, P::LINES, 1).unwrap()
     }
 
     fn frame<'a>(
@@ -233,11 +245,11 @@ impl Renderer for Stripes {
         _: u32,
         _: Option<&'a Image>,
     ) -> Result<Box<dyn FramePlan + 'a>, RenderError> {
-        Ok(Box::new(Stripes))
+        Ok(Box::new(P::default()))
     }
 
     fn settings_phrase(&self) -> String {
-        "stripes".into()
+        P::NAME.into()
     }
 }
 
@@ -250,36 +262,59 @@ impl cwisim_xproc::LineSink<f64> for Counting<'_> {
     }
 }
 
+/// The taps of a render of `Stripes` on `threads` threads, with or without a tap that
+/// hears every instruction (without one, the bands run through the array on their own
+/// threads): what that tap heard, the progress told, the scanlines output, the result.
+fn tapped(
+    threads: usize,
+    hear: bool,
+) -> (Vec<Instruction>, Vec<u64>, u64, cwisim_render::Rendered) {
+    let output = std::cell::Cell::new(0);
+    let mut heard: Vec<Instruction> = Vec::new();
+    let mut told = Vec::new();
+    let mut progress = |n: u64| {
+        assert!(
+            output.get() >= n,
+            "told of scanline {n} before the array output it"
+        );
+        told.push(n);
+    };
+    let done = render(
+        &Single(Stripes),
+        &ArrayConfig::default(),
+        threads,
+        &mut Counting(&output),
+        Taps {
+            also: hear.then_some(&mut heard as &mut dyn TraceWrite),
+            progress: Some(&mut progress),
+        },
+    )
+    .unwrap();
+    (heard, told, output.get(), done)
+}
+
 #[test]
 fn the_taps_hear_every_instruction_and_every_scanline_once_it_is_output() {
     let mut emitted: Vec<Instruction> = Vec::new();
-    emit(&Stripes, &mut emitted).unwrap();
-    for threads in [1, 2] {
-        let output = std::cell::Cell::new(0);
-        let mut heard: Vec<Instruction> = Vec::new();
-        let mut told = Vec::new();
-        let mut progress = |n: u64| {
-            assert!(
-                output.get() >= n,
-                "told of scanline {n} before the array output it"
-            );
-            told.push(n);
-        };
-        let done = render(
-            &Stripes,
-            &ArrayConfig::default(),
-            threads,
-            &mut Counting(&output),
-            Taps {
-                also: Some(&mut heard),
-                progress: Some(&mut progress),
-            },
-        )
-        .unwrap();
-        assert_eq!(heard, emitted, "{threads} threads");
-        assert_eq!(told, (1..=u64::from(Stripes::LINES)).collect::<Vec<_>>());
-        assert_eq!(output.get(), u64::from(Stripes::LINES));
-        assert_eq!(done.stats.totals.instructions, emitted.len() as u64);
+    emit(&Single(Stripes), &mut emitted).unwrap();
+    let every_line: Vec<u64> = (1..=u64::from(Stripes::LINES)).collect();
+    for (threads, hear) in [(1, true), (2, true), (2, false), (3, false)] {
+        let (heard, told, output, done) = tapped(threads, hear);
+        let what = format!("{threads} threads, hearing {hear}");
+        assert_eq!(
+            heard,
+            if hear { emitted.clone() } else { Vec::new() },
+            "{what}"
+        );
+        assert_eq!(told, every_line, "{what}");
+        assert_eq!(output, u64::from(Stripes::LINES), "{what}");
+        assert_eq!(
+            done.stats.totals.instructions,
+            emitted.len() as u64,
+            "{what}"
+        );
+        // without a tap that hears them, the bands ran through the array on their threads
+        assert_eq!(done.array_on_threads, threads > 1 && !hear, "{what}");
     }
 }
 
@@ -298,9 +333,11 @@ fn the_arrays_refusal_of_a_renderers_instruction_is_its_own_message() {
 /// fifth row: negative accumulation is left on across whole stretches of scanlines, so
 /// that bands executed on their own threads start with the wrong assumption and must be
 /// emitted again into the array.
+#[derive(Default)]
 struct Toggling;
 
-impl Toggling {
+impl OneFrame for Toggling {
+    const NAME: &'static str = "toggling";
     const WIDTH: u32 = 32;
     const LINES: u32 = 120;
 }
@@ -323,66 +360,16 @@ impl FramePlan for Toggling {
     }
 }
 
-impl Renderer for Toggling {
-    fn name(&self) -> &'static str {
-        "toggling"
-    }
-
-    fn header(&self) -> TraceHeader {
-        TraceHeader::new(Self::WIDTH, Self::LINES, 1).unwrap()
-    }
-
-    fn frame<'a>(
-        &'a self,
-        _: u32,
-        _: Option<&'a Image>,
-    ) -> Result<Box<dyn FramePlan + 'a>, RenderError> {
-        Ok(Box::new(Toggling))
-    }
-
-    fn settings_phrase(&self) -> String {
-        "toggling".into()
-    }
-}
-
 #[test]
 fn bands_that_start_with_negative_accumulation_on_are_byte_identical() {
-    let (image, done) = run(&Toggling, 1).unwrap();
+    let (image, done) = run(&Single(Toggling), 1).unwrap();
     // some scanlines kept their negative values, some dropped them
     assert!(image.data.iter().any(|v| *v < 0.0));
     assert!(done.stats.totals.dropped_negative > 0);
     for threads in [2, 3, 5] {
-        let (again, d) = run(&Toggling, threads).unwrap();
+        let (again, d) = run(&Single(Toggling), threads).unwrap();
         let bits = |i: &Image| i.data.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
         assert_eq!(bits(&again), bits(&image), "{threads} threads");
         assert_eq!(d.stats, done.stats, "{threads} threads");
-    }
-}
-
-#[test]
-fn progress_hears_every_scanline_once_output_when_bands_run_on_their_threads() {
-    for threads in [2, 3] {
-        let output = std::cell::Cell::new(0);
-        let mut told = Vec::new();
-        let mut progress = |n: u64| {
-            assert!(
-                output.get() >= n,
-                "told of scanline {n} before the array output it"
-            );
-            told.push(n);
-        };
-        render(
-            &Stripes,
-            &ArrayConfig::default(),
-            threads,
-            &mut Counting(&output),
-            Taps {
-                also: None,
-                progress: Some(&mut progress),
-            },
-        )
-        .unwrap();
-        assert_eq!(told, (1..=u64::from(Stripes::LINES)).collect::<Vec<_>>());
-        assert_eq!(output.get(), u64::from(Stripes::LINES));
     }
 }
