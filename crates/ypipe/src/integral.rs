@@ -48,7 +48,9 @@ impl RowPlane {
     /// x-gradient, 0 where the edges meet, as in the report's mode); the y-gradient is
     /// what each edge's own intensity gradient leaves after its run in x,
     /// `dI_E/dy − b_x · dx_E/dy`, averaged over the two edges (they agree for planar
-    /// intensities). A flat row needs no plane: its values are the report's.
+    /// intensities). A flat row needs no plane: its values are the report's. Inlined, as
+    /// [`Slice::of`].
+    #[inline]
     pub(crate) fn new(t: &Trapezium, s: &Slice, line: &RowShade) -> RowPlane {
         let channels = line.channels;
         let b_x = line.di;
