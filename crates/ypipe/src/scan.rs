@@ -7,7 +7,10 @@
 //! edge table, which is kept sorted on **Identifier, then Xmax** (section 3.4.1, figure
 //! 27), so that consecutive pairs are the two edges of one trapezium. Each pair is filled
 //! with DO_FILL (or point-sampled), nodes whose bottom falls in the row leave, and the
-//! others are updated to the next row.
+//! others are updated to the next row. (Here a node knows which side it bounds, so the
+//! table is kept on Identifier then side, which pairs and orders the trapezia as the
+//! report's key does and never changes while a node is active: only the nodes that
+//! enter are sorted, and merged in; `AetEntry`.)
 //!
 //! Departure (docs/ERRATA.md): a node's Xmax is evaluated from the edge's end points at
 //! the new row instead of subtracting `1/slope` once per row (and its Imax, the
@@ -213,34 +216,45 @@ pub fn scan_slices_of(
     mut visit: impl FnMut(SliceVisit<'_>),
 ) {
     let mut next = 0;
-    let mut aet: Vec<EdgeNode> = Vec::new();
+    // the active nodes, kept where they were put (a slot freed by a node that leaves is
+    // reused), and the AET proper: their keys, sorted
+    let mut nodes: Vec<EdgeNode> = Vec::new();
+    let mut free: Vec<usize> = Vec::new();
+    let mut aet: Vec<AetEntry> = Vec::new();
+    let (mut fresh, mut merged): (Vec<AetEntry>, Vec<AetEntry>) = (Vec::new(), Vec::new());
     for row in rows {
         let r = i64::from(row);
         // 4.1: insert the nodes whose trapezium starts in this row (and, when a band
         // starts below a trapezium's top, those that started above and still go on)
+        fresh.clear();
         while next < edge_list.len() && edge_list[next].top_row() <= r {
             let mut node = edge_list[next];
             if node.bottom_row() >= r {
                 node.update_to(r);
-                aet.push(node);
+                let slot = match free.pop() {
+                    Some(slot) => {
+                        nodes[slot] = node;
+                        slot
+                    }
+                    None => {
+                        nodes.push(node);
+                        nodes.len() - 1
+                    }
+                };
+                fresh.push(AetEntry::of(&node, slot));
             }
             next += 1;
         }
-        // sorted on Identifier, then Xmax (the side breaks ties at a shared apex)
-        aet.sort_by(|a, b| {
-            a.identifier
-                .cmp(&b.identifier)
-                .then(a.x_max.total_cmp(&b.x_max))
-                .then(a.side.cmp(&b.side))
-        });
-        // 4.2: each pair of nodes is one trapezium
+        if !fresh.is_empty() {
+            fresh.sort_unstable();
+            merge_into(&aet, &fresh, &mut merged);
+            std::mem::swap(&mut aet, &mut merged);
+        }
+        // 4.2: each pair of nodes is one trapezium, its left edge first
         for pair in aet.chunks_exact(2) {
-            debug_assert_eq!(pair[0].identifier, pair[1].identifier);
-            let (left, right) = if pair[0].side == Side::Left {
-                (&pair[0], &pair[1])
-            } else {
-                (&pair[1], &pair[0])
-            };
+            debug_assert_eq!(pair[0].trapezium, pair[1].trapezium);
+            let (left, right) = (&nodes[pair[0].slot], &nodes[pair[1].slot]);
+            debug_assert_eq!((left.side, right.side), (Side::Left, Side::Right));
             // `Slice::of`'s band: the nodes' y_max is max(y_top, row), y_low
             // min(y_bot, row + 1)
             let (y0, y1) = (left.y_max, left.y_low);
@@ -258,11 +272,61 @@ pub fn scan_slices_of(
         }
         visit(SliceVisit::EndOfRow(row));
         // 4.3: remove the nodes whose trapezium ends in this row; 4.5: update the rest
-        aet.retain(|n| n.bottom_row() > r);
-        for n in &mut aet {
-            n.update_to(r + 1);
+        aet.retain(|e| {
+            let stays = nodes[e.slot].bottom_row() > r;
+            if !stays {
+                free.push(e.slot);
+            }
+            stays
+        });
+        for e in &aet {
+            nodes[e.slot].update_to(r + 1);
         }
     }
+}
+
+/// An active node's place in the AET: its key — Identifier, then (for identifiers that
+/// repeat) the trapezium's index, then the side —, and the slot it is kept in. Sorted
+/// on the key, the two nodes of a trapezium are neighbours, the left one first, and the
+/// trapezia come in Identifier order, the order of the report's key (Identifier, then
+/// Xmax): a node knows its side, so Xmax, which tells the report the two edges of a
+/// pair apart, need not be compared, and the key never changes while the node is
+/// active — only the nodes that enter are sorted, and merged in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+struct AetEntry {
+    identifier: u32,
+    trapezium: usize,
+    side: Side,
+    slot: usize,
+}
+
+impl AetEntry {
+    fn of(node: &EdgeNode, slot: usize) -> AetEntry {
+        AetEntry {
+            identifier: node.identifier,
+            trapezium: node.trapezium,
+            side: node.side,
+            slot,
+        }
+    }
+}
+
+/// The sorted `a` and `b` merged into `out` (cleared first).
+fn merge_into(a: &[AetEntry], b: &[AetEntry], out: &mut Vec<AetEntry>) {
+    out.clear();
+    out.reserve(a.len() + b.len());
+    let (mut i, mut j) = (0, 0);
+    while i < a.len() && j < b.len() {
+        if b[j] < a[i] {
+            out.push(b[j]);
+            j += 1;
+        } else {
+            out.push(a[i]);
+            i += 1;
+        }
+    }
+    out.extend_from_slice(&a[i..]);
+    out.extend_from_slice(&b[j..]);
 }
 
 #[cfg(test)]
