@@ -82,6 +82,10 @@ pub struct Slice {
 
 impl Slice {
     /// The part of `t` in pixel row `row`, or `None` when they do not overlap.
+    ///
+    /// Inlined: returned from a call, the record comes back through memory, written as
+    /// 8-byte fields and read back with wider loads, which stall (store forwarding).
+    #[inline]
     pub fn of(t: &Trapezium, row: u32) -> Option<Slice> {
         let y0 = t.y_top.max(f64::from(row));
         let y1 = t.y_bot.min(f64::from(row) + 1.0);

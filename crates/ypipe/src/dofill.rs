@@ -120,7 +120,8 @@ pub(crate) struct RowShade {
 }
 
 impl RowShade {
-    /// The scanline function of `t` at height `y`.
+    /// The scanline function of `t` at height `y` (inlined, as [`Slice::of`]).
+    #[inline]
     pub(crate) fn new(t: &Trapezium, shade: &Shade, y: f64, channels: usize) -> RowShade {
         match shade {
             Shade::Flat(v) => RowShade {
@@ -218,10 +219,20 @@ fn claim_run(rs: &RowShade, first: i64, last: i64, tolerance: f64, out: &mut imp
     count
 }
 
+/// The first `channels` values of `v` as an [`Intensity`]. Each common channel count
+/// is its own call with a constant length: with a variable one the slice's pointer and
+/// length are stored as two words and read back as one 16-byte load, which stalls
+/// (store forwarding) once per value.
+#[inline]
 fn intensity(v: &Vector, channels: usize) -> Intensity {
-    Intensity::new(&v[..channels])
+    match channels {
+        1 => Intensity::new(&v[..1]),
+        3 => Intensity::new(&v[..3]),
+        _ => Intensity::new(&v[..channels]),
+    }
 }
 
+#[inline]
 fn map(v: &Vector, channels: usize, f: impl Fn(f64, usize) -> f64) -> Intensity {
     intensity(&vector(channels, |c| f(v[c], c)), channels)
 }
@@ -301,17 +312,37 @@ pub fn box_row_to(
     channels: usize,
     claim: Claim,
     value: BoxValue,
-    mut note: Option<&mut String>,
+    note: Option<&mut String>,
     out: &mut impl RowOut,
 ) -> Option<Case> {
     let s = Slice::of(t, row)?;
+    Some(box_slice_to(
+        t, &s, width, shade, channels, claim, value, note, out,
+    ))
+}
+
+/// [`box_row_to`] for the row's [`Slice`] of `t` already taken (what
+/// [`crate::scan::scan_slices_of`] hands over); the row's case.
+#[allow(clippy::too_many_arguments)]
+pub fn box_slice_to(
+    t: &Trapezium,
+    s: &Slice,
+    width: u32,
+    shade: &Shade,
+    channels: usize,
+    claim: Claim,
+    value: BoxValue,
+    mut note: Option<&mut String>,
+    out: &mut impl RowOut,
+) -> Case {
+    let row = s.row;
     let h = s.height();
     let rs = RowShade::new(t, shade, 0.5 * (s.y0 + s.y1), channels);
     // the exact values, where they differ from the report's (a varying intensity)
     let plane_of_row;
     let plane = match (value, shade) {
         (BoxValue::Exact, Shade::Gouraud) => {
-            plane_of_row = RowPlane::new(t, &s, &rs);
+            plane_of_row = RowPlane::new(t, s, &rs);
             Some(&plane_of_row).filter(|p| !p.constant())
         }
         _ => None, // a flat row's values are the report's
@@ -329,7 +360,6 @@ pub fn box_row_to(
     let specials = &specials[..n_specials];
     let in_left = |p: i64| p > l0 && p < l1;
     let in_right = |p: i64| p > r0 && p < r1;
-    let (s_left, s_right) = (s.left.increment(h), s.right.increment(h));
     // (procedure, first, last, coverage increment): at most 4 pixels and 3 runs
     let mut stretches = [(Procedure::Single, 0i64, 0i64, 0.0f64); 7];
     let mut n_stretches = 0;
@@ -339,10 +369,14 @@ pub fn box_row_to(
         if let Some(&next) = specials.get(k + 1) {
             if next - p >= 2 {
                 let q = p + 1;
+                // the increments only where a run needs them (a division each)
                 let run = match (in_left(q), in_right(q)) {
-                    (true, true) => (Procedure::ShareSequence, s_left - s_right),
-                    (true, false) => (Procedure::Sequence, s_left),
-                    (false, true) => (Procedure::Sequence, -s_right),
+                    (true, true) => (
+                        Procedure::ShareSequence,
+                        s.left.increment(h) - s.right.increment(h),
+                    ),
+                    (true, false) => (Procedure::Sequence, s.left.increment(h)),
+                    (false, true) => (Procedure::Sequence, -s.right.increment(h)),
                     (false, false) => (Procedure::MiddlePart, 0.0),
                 };
                 stretches[n_stretches] = (run.0, q, next - 1, run.1);
@@ -397,7 +431,7 @@ pub fn box_row_to(
         }
         out.put(proc_, &instr);
     }
-    Some(case)
+    case
 }
 
 /// The report's instruction for a stretch `x .. x + n` of procedure `proc_`: coverage

@@ -48,7 +48,9 @@ impl RowPlane {
     /// x-gradient, 0 where the edges meet, as in the report's mode); the y-gradient is
     /// what each edge's own intensity gradient leaves after its run in x,
     /// `dI_E/dy − b_x · dx_E/dy`, averaged over the two edges (they agree for planar
-    /// intensities). A flat row needs no plane: its values are the report's.
+    /// intensities). A flat row needs no plane: its values are the report's. Inlined, as
+    /// [`Slice::of`].
+    #[inline]
     pub(crate) fn new(t: &Trapezium, s: &Slice, line: &RowShade) -> RowPlane {
         let channels = line.channels;
         let b_x = line.di;
@@ -166,6 +168,14 @@ impl BandEdge {
         if u0 >= 1.0 && u1 >= 1.0 {
             return [h, h / 2.0, h * h / 2.0];
         }
+        self.crossing(u0, u1, h)
+    }
+
+    /// [`Self::left_of`] for an edge that is not clear of the column, from its `x − x0`
+    /// at the band's top and bottom (`u0`, `u1`). Out of line, so that the clear cases
+    /// above are decided where the integral is taken, without a call.
+    #[inline(never)]
+    fn crossing(&self, u0: f64, u1: f64, h: f64) -> [f64; 3] {
         let k = self.dt_dx;
         if !k.is_finite() {
             // vertical, or so steep that it moves less than f64 can tell over the band

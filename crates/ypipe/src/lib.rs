@@ -34,7 +34,7 @@ pub mod scan;
 pub mod trapezoid;
 
 use crate::dofill::{
-    box_row_into, box_row_to, sampled_row_into, BoxValue, Procedure, RowFill, RowOut, Shade,
+    box_row_into, box_slice_to, sampled_row_into, BoxValue, Procedure, RowFill, RowOut, Shade,
 };
 use cwisim_isa::{Instruction, TraceHeader, TraceWrite, MAX_CHANNELS};
 use cwisim_scene::ScreenScene;
@@ -267,12 +267,13 @@ pub fn emit_rows(
     let mut result = Ok(());
     let notes = sink.wants_comments();
     let mut fill = RowFill::default();
-    scan::scan_rows_of(trapezia, &plan.edges, rows, channels, |visit| {
+    scan::scan_slices_of(trapezia, &plan.edges, rows, |visit| {
         if result.is_err() {
             return;
         }
         match visit {
-            scan::Visit::Fill(row, t) => {
+            scan::SliceVisit::Fill(slice, t) => {
+                let row = slice.row;
                 let shade = &shades[t.polygon as usize];
                 let (w, claim) = (scene.width, options.claim);
                 let value = match options.aa {
@@ -288,11 +289,20 @@ pub fn emit_rows(
                         put: 0,
                         result: Ok(()),
                     };
-                    let case =
-                        box_row_to(t, row, w, shade, channels, claim, value, None, &mut direct);
+                    let case = box_slice_to(
+                        t,
+                        slice,
+                        w,
+                        shade,
+                        channels,
+                        claim,
+                        value,
+                        None,
+                        &mut direct,
+                    );
                     let put = direct.put;
                     result = direct.result;
-                    if let (Some(case), true) = (case, put > 0) {
+                    if put > 0 {
                         stats.rows_filled += 1;
                         stats.cases[usize::from(case.0) - 1] += 1;
                     }
@@ -324,7 +334,7 @@ pub fn emit_rows(
                     Ok(())
                 });
             }
-            scan::Visit::EndOfRow(_) => {
+            scan::SliceVisit::EndOfRow(_) => {
                 stats.instructions += 1;
                 result = sink.write(&Instruction::refresh());
             }

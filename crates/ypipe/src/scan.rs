@@ -7,14 +7,21 @@
 //! edge table, which is kept sorted on **Identifier, then Xmax** (section 3.4.1, figure
 //! 27), so that consecutive pairs are the two edges of one trapezium. Each pair is filled
 //! with DO_FILL (or point-sampled), nodes whose bottom falls in the row leave, and the
-//! others are updated to the next row.
+//! others are updated to the next row. (Here a node knows which side it bounds, so the
+//! table is kept on Identifier then side, which pairs and orders the trapezia as the
+//! report's key does and never changes while a node is active: only the nodes that
+//! enter are sorted, and merged in; `AetEntry`.)
 //!
-//! Departure (docs/ERRATA.md): a node's Xmax and Imax are evaluated from the edge's end
-//! points at the new row instead of subtracting `1/slope` and `di/dy` once per row. The
-//! results are the same values up to rounding, without the drift that repeated
-//! subtraction accumulates over thousands of rows, and two polygons sharing an edge get
-//! bit-identical positions on it.
+//! Departure (docs/ERRATA.md): a node's Xmax is evaluated from the edge's end points at
+//! the new row instead of subtracting `1/slope` once per row (and its Imax, the
+//! intensity there, on demand: [`EdgeNode::i_max`]). The results are the same values up
+//! to rounding, without the drift that repeated subtraction accumulates over thousands of
+//! rows, and two polygons sharing an edge get bit-identical positions on it. A node also
+//! keeps the edge's x at the bottom of its part of the row, which is the next row's Xmax:
+//! each row's x is evaluated once, and the row's [`Slice`] comes from the two nodes of
+//! its trapezium ([`scan_slices_of`]) with no further evaluation.
 
+use crate::coverage::{Slice, SliceEdge};
 use crate::floor::{ceil_i64, floor_i64};
 use crate::trapezoid::{Edge, Trapezium, Vector};
 
@@ -42,17 +49,19 @@ pub struct EdgeNode {
     pub y_max: f64,
     /// `dx/dy`.
     pub inv_slope: f64,
-    /// Intensity at `(x_max, y_max)`.
-    pub i_max: Vector,
     /// Which side it bounds.
     pub side: Side,
+    /// The bottom of the edge's part of the current row, and the edge's x there (NaN
+    /// before the node's first row).
+    y_low: f64,
+    x_low: f64,
     /// The edge itself, and its trapezium's index in the input.
     edge: Edge,
     trapezium: usize,
 }
 
 impl EdgeNode {
-    fn new(t: &Trapezium, index: usize, side: Side, channels: usize) -> EdgeNode {
+    fn new(t: &Trapezium, index: usize, side: Side) -> EdgeNode {
         let edge = if side == Side::Left { t.left } else { t.right };
         EdgeNode {
             identifier: t.id,
@@ -61,11 +70,17 @@ impl EdgeNode {
             y_top: t.y_top,
             y_max: t.y_top,
             inv_slope: edge.inv_slope(),
-            i_max: edge.i_at(t.y_top, channels),
             side,
+            y_low: f64::NAN,
+            x_low: f64::NAN,
             edge,
             trapezium: index,
         }
+    }
+
+    /// Imax: the intensity at `(x_max, y_max)`, in `channels` channels.
+    pub fn i_max(&self, channels: usize) -> Vector {
+        self.edge.i_at(self.y_max, channels)
     }
 
     /// The first pixel row the node's trapezium touches.
@@ -78,11 +93,32 @@ impl EdgeNode {
         (ceil_i64(self.y_min) - 1).max(self.top_row())
     }
 
-    /// Moves the node to the top of pixel row `row`.
-    fn update_to(&mut self, row: i64, channels: usize) {
-        self.y_max = self.y_top.max(row as f64);
-        self.x_max = self.edge.x_at(self.y_max);
-        self.i_max = self.edge.i_at(self.y_max, channels);
+    /// Moves the node to the top of pixel row `row`: the x there is the one kept at the
+    /// bottom of the row before when that was the same height (always, moving down by
+    /// one row within the trapezium), else evaluated.
+    #[inline]
+    fn update_to(&mut self, row: i64) {
+        let y = self.y_top.max(row as f64);
+        self.x_max = if y.to_bits() == self.y_low.to_bits() {
+            self.x_low
+        } else {
+            self.edge.x_at(y)
+        };
+        self.y_max = y;
+        self.y_low = self.y_min.min(row as f64 + 1.0);
+        self.x_low = self.edge.x_at(self.y_low);
+    }
+
+    /// The edge over the node's part of the current row.
+    #[inline]
+    fn slice_edge(&self) -> SliceEdge {
+        let (a, b) = (self.x_max, self.x_low);
+        SliceEdge {
+            lo: a.min(b),
+            hi: a.max(b),
+            at_top: a,
+            at_bottom: b,
+        }
     }
 }
 
@@ -121,8 +157,10 @@ pub fn scan_rows(
 
 /// The edge list of `trapezia`: both edges of every trapezium, sorted on the top row
 /// (then Identifier, side). Built once per scene and shared by the bands of
-/// [`scan_rows_of`].
+/// [`scan_rows_of`]. (`channels` is the trapezia's: a node's intensity is taken in them
+/// on demand, [`EdgeNode::i_max`].)
 pub fn edge_list(trapezia: &[Trapezium], channels: usize) -> Vec<EdgeNode> {
+    debug_assert!(channels <= cwisim_isa::MAX_CHANNELS);
     // the sort keys alone are sorted (the nodes are big to move); the position in the
     // input breaks ties, so the order is the stable sort's
     let mut keys: Vec<(i64, u32, Side, usize)> = trapezia
@@ -138,11 +176,12 @@ pub fn edge_list(trapezia: &[Trapezium], channels: usize) -> Vec<EdgeNode> {
         .collect();
     keys.sort_unstable();
     keys.iter()
-        .map(|&(_, _, side, n)| EdgeNode::new(&trapezia[n / 2], n / 2, side, channels))
+        .map(|&(_, _, side, n)| EdgeNode::new(&trapezia[n / 2], n / 2, side))
         .collect()
 }
 
-/// [`scan_rows`] with the scene's [`edge_list`] built already.
+/// [`scan_rows`] with the scene's [`edge_list`] built already (`channels`, the
+/// trapezia's, as there: the scan itself takes no intensities).
 pub fn scan_rows_of(
     trapezia: &[Trapezium],
     edge_list: &[EdgeNode],
@@ -150,44 +189,150 @@ pub fn scan_rows_of(
     channels: usize,
     mut visit: impl FnMut(Visit<'_>),
 ) {
+    debug_assert!(channels <= cwisim_isa::MAX_CHANNELS);
+    scan_slices_of(trapezia, edge_list, rows, |v| match v {
+        SliceVisit::Fill(s, t) => visit(Visit::Fill(s.row, t)),
+        SliceVisit::EndOfRow(row) => visit(Visit::EndOfRow(row)),
+    });
+}
+
+/// What [`scan_slices_of`] visits.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SliceVisit<'a> {
+    /// A trapezium active in a pixel row, in active-edge-table order, with its part of
+    /// the row: what [`Slice::of`] gives, from the scan's own evaluations of the edges.
+    Fill(&'a Slice, &'a Trapezium),
+    /// The end of a pixel row (where the `Refresh` goes).
+    EndOfRow(u32),
+}
+
+/// [`scan_rows_of`] with each trapezium's [`Slice`] of the row (bit for bit
+/// [`Slice::of`]'s); a trapezium whose band misses the row (`Slice::of` gives `None`)
+/// is not visited.
+pub fn scan_slices_of(
+    trapezia: &[Trapezium],
+    edge_list: &[EdgeNode],
+    rows: std::ops::Range<u32>,
+    mut visit: impl FnMut(SliceVisit<'_>),
+) {
     let mut next = 0;
-    let mut aet: Vec<EdgeNode> = Vec::new();
+    // the active nodes, kept where they were put (a slot freed by a node that leaves is
+    // reused), and the AET proper: their keys, sorted
+    let mut nodes: Vec<EdgeNode> = Vec::new();
+    let mut free: Vec<usize> = Vec::new();
+    let mut aet: Vec<AetEntry> = Vec::new();
+    let (mut fresh, mut merged): (Vec<AetEntry>, Vec<AetEntry>) = (Vec::new(), Vec::new());
     for row in rows {
         let r = i64::from(row);
         // 4.1: insert the nodes whose trapezium starts in this row (and, when a band
         // starts below a trapezium's top, those that started above and still go on)
+        fresh.clear();
         while next < edge_list.len() && edge_list[next].top_row() <= r {
             let mut node = edge_list[next];
             if node.bottom_row() >= r {
-                node.update_to(r, channels);
-                aet.push(node);
+                node.update_to(r);
+                let slot = match free.pop() {
+                    Some(slot) => {
+                        nodes[slot] = node;
+                        slot
+                    }
+                    None => {
+                        nodes.push(node);
+                        nodes.len() - 1
+                    }
+                };
+                fresh.push(AetEntry::of(&node, slot));
             }
             next += 1;
         }
-        // sorted on Identifier, then Xmax (the side breaks ties at a shared apex)
-        aet.sort_by(|a, b| {
-            a.identifier
-                .cmp(&b.identifier)
-                .then(a.x_max.total_cmp(&b.x_max))
-                .then(a.side.cmp(&b.side))
-        });
-        // 4.2: each pair of nodes is one trapezium
-        for pair in aet.chunks_exact(2) {
-            debug_assert_eq!(pair[0].identifier, pair[1].identifier);
-            visit(Visit::Fill(row, &trapezia[pair[0].trapezium]));
+        if !fresh.is_empty() {
+            fresh.sort_unstable();
+            merge_into(&aet, &fresh, &mut merged);
+            std::mem::swap(&mut aet, &mut merged);
         }
-        visit(Visit::EndOfRow(row));
+        // 4.2: each pair of nodes is one trapezium, its left edge first
+        for pair in aet.chunks_exact(2) {
+            debug_assert_eq!(pair[0].trapezium, pair[1].trapezium);
+            let (left, right) = (&nodes[pair[0].slot], &nodes[pair[1].slot]);
+            debug_assert_eq!((left.side, right.side), (Side::Left, Side::Right));
+            // `Slice::of`'s band: the nodes' y_max is max(y_top, row), y_low
+            // min(y_bot, row + 1)
+            let (y0, y1) = (left.y_max, left.y_low);
+            if y1 <= y0 {
+                continue;
+            }
+            let slice = Slice {
+                row,
+                y0,
+                y1,
+                left: left.slice_edge(),
+                right: right.slice_edge(),
+            };
+            visit(SliceVisit::Fill(&slice, &trapezia[pair[0].trapezium]));
+        }
+        visit(SliceVisit::EndOfRow(row));
         // 4.3: remove the nodes whose trapezium ends in this row; 4.5: update the rest
-        aet.retain(|n| n.bottom_row() > r);
-        for n in &mut aet {
-            n.update_to(r + 1, channels);
+        aet.retain(|e| {
+            let stays = nodes[e.slot].bottom_row() > r;
+            if !stays {
+                free.push(e.slot);
+            }
+            stays
+        });
+        for e in &aet {
+            nodes[e.slot].update_to(r + 1);
         }
     }
+}
+
+/// An active node's place in the AET: its key — Identifier, then (for identifiers that
+/// repeat) the trapezium's index, then the side —, and the slot it is kept in. Sorted
+/// on the key, the two nodes of a trapezium are neighbours, the left one first, and the
+/// trapezia come in Identifier order, the order of the report's key (Identifier, then
+/// Xmax): a node knows its side, so Xmax, which tells the report the two edges of a
+/// pair apart, need not be compared, and the key never changes while the node is
+/// active — only the nodes that enter are sorted, and merged in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+struct AetEntry {
+    identifier: u32,
+    trapezium: usize,
+    side: Side,
+    slot: usize,
+}
+
+impl AetEntry {
+    fn of(node: &EdgeNode, slot: usize) -> AetEntry {
+        AetEntry {
+            identifier: node.identifier,
+            trapezium: node.trapezium,
+            side: node.side,
+            slot,
+        }
+    }
+}
+
+/// The sorted `a` and `b` merged into `out` (cleared first).
+fn merge_into(a: &[AetEntry], b: &[AetEntry], out: &mut Vec<AetEntry>) {
+    out.clear();
+    out.reserve(a.len() + b.len());
+    let (mut i, mut j) = (0, 0);
+    while i < a.len() && j < b.len() {
+        if b[j] < a[i] {
+            out.push(b[j]);
+            j += 1;
+        } else {
+            out.push(a[i]);
+            i += 1;
+        }
+    }
+    out.extend_from_slice(&a[i..]);
+    out.extend_from_slice(&b[j..]);
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::coverage::Slice;
     use crate::trapezoid::trapezia;
     use cwisim_scene::Polygon;
 
@@ -215,8 +360,8 @@ mod tests {
             .enumerate()
             .flat_map(|(k, t)| {
                 [
-                    EdgeNode::new(t, k, Side::Left, 1),
-                    EdgeNode::new(t, k, Side::Right, 1),
+                    EdgeNode::new(t, k, Side::Left),
+                    EdgeNode::new(t, k, Side::Right),
                 ]
             })
             .collect();
@@ -244,6 +389,89 @@ mod tests {
                 [1, 2],
                 "row {row}: each trapezium once, in Identifier order"
             );
+        }
+    }
+
+    /// The scan's slices are [`Slice::of`]'s bit for bit, for every trapezium it visits
+    /// in every row, and it visits exactly those [`scan_rows_of`] does whose band meets
+    /// the row: random polygons, slivers, rows starting mid-trapezium, huge coordinates.
+    #[test]
+    fn the_scans_slices_are_slice_of_bit_for_bit() {
+        let mut seed = 0x0DDB_1A5E_5BAD_5EEDu64;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let poly = |v: Vec<[f64; 2]>| Polygon {
+            intensity: vec![vec![0.5]; v.len()],
+            vertices: v,
+            depth: None,
+        };
+        let mut polygons = vec![
+            poly(vec![[0.5, 0.25], [40.0, 0.25 + 1e-12], [20.0, 30.7]]),
+            poly(vec![[3.0, 2.0], [3.0 + 1e-12, 2.0], [3.0, 19.0]]),
+            poly(vec![[1e9, 1.5], [1e9 + 7.25, 1.5], [1e9 + 3.0, 9.0]]),
+            poly(vec![[2.0, 5.0], [9.0, 5.0], [9.0, 6.0], [2.0, 6.0]]),
+        ];
+        for _ in 0..200 {
+            let n = 3 + (next() * 3.0) as usize;
+            let (cx, cy) = (next() * 60.0, next() * 60.0);
+            // a convex polygon: points on an ellipse in angle order
+            let (a, b) = (0.1 + next() * 20.0, 0.1 + next() * 20.0);
+            let mut angles: Vec<f64> = (0..n).map(|_| next() * std::f64::consts::TAU).collect();
+            angles.sort_by(f64::total_cmp);
+            polygons.push(poly(
+                angles
+                    .iter()
+                    .map(|t| [cx + a * t.cos(), cy + b * t.sin()])
+                    .collect(),
+            ));
+        }
+        let mut ts = Vec::new();
+        for (k, p) in polygons.iter().enumerate() {
+            let first = ts.len() as u32 + 1;
+            ts.extend(trapezia(p, k as u32, 1, first));
+        }
+        let edges = edge_list(&ts, 1);
+        for rows in [0..90, 7..90, 13..14] {
+            let mut want = Vec::new();
+            scan_rows_of(&ts, &edges, rows.clone(), 1, |v| {
+                if let Visit::Fill(row, t) = v {
+                    if let Some(s) = Slice::of(t, row) {
+                        want.push((t.id, s));
+                    }
+                }
+            });
+            let mut got = Vec::new();
+            scan_slices_of(&ts, &edges, rows, |v| {
+                if let SliceVisit::Fill(s, t) = v {
+                    got.push((t.id, *s));
+                }
+            });
+            assert!(!want.is_empty());
+            assert_eq!(got.len(), want.len());
+            for (g, w) in got.iter().zip(&want) {
+                // bit for bit (`==` on f64 would let -0.0 pass for 0.0)
+                assert_eq!(format!("{g:?}"), format!("{w:?}"));
+                let bits = |s: &Slice| {
+                    [
+                        s.y0,
+                        s.y1,
+                        s.left.lo,
+                        s.left.hi,
+                        s.left.at_top,
+                        s.left.at_bottom,
+                        s.right.lo,
+                        s.right.hi,
+                        s.right.at_top,
+                        s.right.at_bottom,
+                    ]
+                    .map(f64::to_bits)
+                };
+                assert_eq!((g.0, bits(&g.1)), (w.0, bits(&w.1)));
+            }
         }
     }
 }
