@@ -661,13 +661,7 @@ mod tests {
         assert_eq!(claim_chunk(&[0.5], -1.0, 7), 1);
         assert_eq!(claim_chunk(&[0.5], 0.25, 1), 1);
         // against the definition, over a spread of gradients, tolerances and runs
-        let mut seed = 0x9E37_79B9_7F4A_7C15u64;
-        let mut next = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = crate::test_rng::uniform(0x9E37_79B9_7F4A_7C15u64);
         for _ in 0..20_000 {
             let di = [(next() - 0.5) * 10f64.powf(-6.0 * next()), next() * 1e-3];
             let tolerance =

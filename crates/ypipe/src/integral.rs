@@ -459,13 +459,7 @@ mod tests {
     /// wide or high, huge coordinates, vertical and near-horizontal edges, edges that
     /// meet (an apex) or touch a column side, degenerate bands.
     fn stress_rows() -> Vec<RowPlane> {
-        let mut seed = 0x2545_F491_4F6C_DD1Du64;
-        let mut next = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = crate::test_rng::uniform(0x2545_F491_4F6C_DD1Du64);
         let mut rows = vec![
             row(0.0, 1.0, (2.3, 2.3), (2.3 + 1e-12, 2.3 + 1e-12)),
             row(0.0, 1.0, (2.3, 5.7), (2.3 + 1e-12, 5.7 + 1e-12)),

@@ -31,6 +31,8 @@ pub mod exact;
 mod floor;
 pub mod integral;
 pub mod scan;
+#[cfg(test)]
+mod test_rng;
 pub mod trapezoid;
 
 use crate::dofill::{

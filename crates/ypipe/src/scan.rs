@@ -397,13 +397,7 @@ mod tests {
     /// the row: random polygons, slivers, rows starting mid-trapezium, huge coordinates.
     #[test]
     fn the_scans_slices_are_slice_of_bit_for_bit() {
-        let mut seed = 0x0DDB_1A5E_5BAD_5EEDu64;
-        let mut next = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = crate::test_rng::uniform(0x0DDB_1A5E_5BAD_5EEDu64);
         let poly = |v: Vec<[f64; 2]>| Polygon {
             intensity: vec![vec![0.5]; v.len()],
             vertices: v,
