@@ -179,10 +179,11 @@ pub fn write_render_summary(
         + t.output;
     let mut parts = vec![format!("load {}", ms(t.load))];
     parts.extend(stages.iter().map(|(name, d)| format!("{name} {}", ms(*d))));
-    if rendered.array_on_threads {
-        // each thread ran the array on the bands it emitted, interleaved with emitting
+    if rendered.array_in_bands {
+        // each thread (the only one, on one thread) ran the array on the bands it
+        // emitted, interleaved with emitting; the array then took them in, in order
         parts.push(format!(
-            "Y-processor and array in bands on threads {}",
+            "Y-processor and array in bands {}",
             ms(rendered.renderer_time)
         ));
         parts.push(format!("array in order {}", ms(rendered.array_time)));

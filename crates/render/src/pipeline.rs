@@ -1,15 +1,18 @@
-//! The pipeline: a renderer's frames, emitted (in bands, on threads when asked) and fed
-//! to the simulated X-processor array in batches of whole scanlines (checked once, then
-//! executed in one call), with the wall time of each side measured.
+//! The pipeline: a renderer's frames, emitted in bands of rows (on threads when asked)
+//! and run through the simulated X-processor array, with the wall time of each side
+//! measured.
 //!
-//! With `threads > 1`, `threads − 1` workers each take the next band of rows of the frame
+//! On one thread, each band of rows is emitted straight into processors of the array's
+//! ([`BandArray`]: no instruction is copied into a batch) and its scanlines are then
+//! taken in by the array, in order. With `threads > 1`, `threads − 1` workers each take the next band of rows of the frame
 //! and emit it; the calling thread takes the finished bands in, in band order, and while
 //! the band it wants is not ready it emits the next untaken band itself (so with two
 //! threads both cores emit). Each thread also executes the bands it emits, on processors
 //! of its own (`cwisim_xproc::band`): the calling thread only times, records and outputs
 //! their scanlines, in order. A tap that wants every instruction, or an array that takes
-//! no bands (the cycle-stepped engine), gets the bands' instructions instead
-//! ([`PackedStream`]), fed to the array on the calling thread. Either way the array's
+//! no bands (the cycle-stepped engine), gets the instructions instead ([`PackedStream`]
+//! on threads), fed to the array on the calling thread in batches of whole scanlines
+//! (checked once, then executed in one call). Either way the array's
 //! output, statistics and cycles are those of the serial stream: byte-identical at any
 //! thread count.
 
@@ -54,15 +57,15 @@ pub struct Rendered {
     /// The array's statistics.
     pub stats: RunStats,
     /// Wall time in the renderer (emitting instructions): the wall time the array did
-    /// not take on the calling thread. With [`Self::array_on_threads`], it includes the
+    /// not take on the calling thread. With [`Self::array_in_bands`], it includes the
     /// array's execution of the bands, interleaved with their emission.
     pub renderer_time: Duration,
     /// Wall time in the array simulator on the calling thread.
     pub array_time: Duration,
-    /// The bands' scanlines were executed on the threads that emitted them, interleaved
-    /// with their emission: the array's time on the calling thread is only that of
-    /// taking them in (timing, recording and output in order).
-    pub array_on_threads: bool,
+    /// The scanlines were executed in bands, each on the thread that emitted it (the
+    /// calling thread too, on one thread), interleaved with their emission: the array's
+    /// time is only that of taking them in (timing, recording and output in order).
+    pub array_in_bands: bool,
     /// The renderer's figures per pixel row, one entry per frame
     /// ([`FramePlan::row_figures`]; `Null` for a frame without them).
     pub row_figures: Vec<serde_json::Value>,
@@ -72,8 +75,8 @@ pub struct Rendered {
 const BANDS_PER_THREAD: u32 = 8;
 
 /// Renders every frame of `renderer` into the array `array`, handing its scanlines to
-/// `lines`, on `threads` threads (0: as many as the machine has; 1: serially, as the
-/// stream comes).
+/// `lines`, on `threads` threads (0: as many as the machine has; 1: serially, in bands
+/// of rows in stream order).
 pub fn render(
     renderer: &dyn Renderer,
     array: &ArrayConfig,
@@ -118,11 +121,7 @@ pub fn render(
         let band = if threads > 1 {
             feed_parallel(&*plan, header.lines, threads, &mut feed, fault)?
         } else {
-            plan.emit_rows(0..header.lines, &mut feed).map_err(|e| {
-                feed.fault
-                    .take()
-                    .map_or_else(|| fault(e), RenderError::Array)
-            })?
+            feed_serial_bands(&*plan, header.lines, &mut feed, fault)?
         };
         counters.merge(&band);
         // the frame's last scanlines reach the array (and the kept frame) before the
@@ -208,7 +207,7 @@ struct ScanlineFeed<'a, 's> {
     buffered_lines: u64,
     array_time: Duration,
     /// Some band was executed on the thread that emitted it.
-    bands_on_threads: bool,
+    bands_taken: bool,
     lines: u64,
     /// The array's (or a tap's) own failure, told apart from the renderer's.
     fault: Option<io::Error>,
@@ -238,7 +237,7 @@ impl<'a, 's> ScanlineFeed<'a, 's> {
             buffer: Vec::new(),
             buffered_lines: 0,
             array_time: Duration::ZERO,
-            bands_on_threads: false,
+            bands_taken: false,
             lines: 0,
             fault: None,
         })
@@ -261,7 +260,7 @@ impl<'a, 's> ScanlineFeed<'a, 's> {
             stats,
             renderer_time: total.saturating_sub(array_time),
             array_time,
-            array_on_threads: self.bands_on_threads,
+            array_in_bands: self.bands_taken,
             row_figures,
         })
     }
@@ -314,7 +313,7 @@ impl<'a, 's> ScanlineFeed<'a, 's> {
         if !taken? {
             return Ok(false);
         }
-        self.bands_on_threads = true;
+        self.bands_taken = true;
         for _ in 0..band.scanlines() {
             self.lines += 1;
             if let Some(p) = self.taps.progress.as_deref_mut() {
@@ -379,6 +378,73 @@ impl TraceWrite for ScanlineFeed<'_, '_> {
         }
         Ok(())
     }
+}
+
+/// Rows per band when one thread emits and executes them ([`feed_serial_bands`]). Measured
+/// on the pot at 1024² (docs/PERFORMANCE.md): 8 to 64 rows are alike, 4 rows and one band
+/// for the whole frame slower; 16 rows of 1024 RGB pixels are 384 KB of values.
+const SERIAL_BAND_ROWS: u32 = 16;
+
+/// One frame on one thread, in bands: each band of rows is emitted straight into the
+/// array's processors ([`BandArray`]: each instruction checked and executed as it comes,
+/// never copied into a batch) and its scanlines are then taken in, in order
+/// ([`EngineWriter::absorb`]). Each band starts with negative accumulation as the one
+/// before left it ([`BandArray::start_after`]), so the engine takes every band in. When
+/// the array takes no bands or a tap wants every instruction, the rows go through the
+/// feed instead, as does a band the array refuses or that failed.
+fn feed_serial_bands(
+    plan: &dyn FramePlan,
+    rows: u32,
+    feed: &mut ScanlineFeed<'_, '_>,
+    fault: impl Fn(io::Error) -> RenderError,
+) -> Result<Counters, RenderError> {
+    let Some(mut array) = feed.band_arrays(1).and_then(|mut a| a.pop()) else {
+        return emit_into_feed(plan, 0..rows, feed, &fault);
+    };
+    let (mut previous, mut spare) = (Band::default(), Band::default());
+    let mut counters = Counters::default();
+    let mut first = 0;
+    while first < rows {
+        let band_rows = first..first.saturating_add(SERIAL_BAND_ROWS).min(rows);
+        first = band_rows.end;
+        array.start_after(std::mem::take(&mut spare), &previous);
+        let executed = plan
+            .emit_rows(band_rows.clone(), &mut array)
+            .and_then(|c| Ok((array.take().map_err(io::Error::other)?, c)));
+        let taken = match executed {
+            Ok((band, band_counters)) => {
+                let taken = feed.take_in(&band).map_err(RenderError::Array)?;
+                spare = std::mem::replace(&mut previous, band);
+                taken.then_some(band_counters)
+            }
+            Err(_) => None,
+        };
+        counters.merge(&match taken {
+            Some(c) => c,
+            None => {
+                // whatever the stream did with negative accumulation, the next band
+                // assumes it off (if wrong, it too is refused and emitted again here)
+                previous.clear();
+                emit_into_feed(plan, band_rows, feed, &fault)?
+            }
+        });
+    }
+    Ok(counters)
+}
+
+/// Rows emitted into the feed (the array, batched, and every tap); an error of the
+/// array's or a tap's own is told apart from the renderer's.
+fn emit_into_feed(
+    plan: &dyn FramePlan,
+    rows: std::ops::Range<u32>,
+    feed: &mut ScanlineFeed<'_, '_>,
+    fault: &dyn Fn(io::Error) -> RenderError,
+) -> Result<Counters, RenderError> {
+    plan.emit_rows(rows, feed).map_err(|e| {
+        feed.fault
+            .take()
+            .map_or_else(|| fault(e), RenderError::Array)
+    })
 }
 
 /// A band of rows as a thread emitted it: either its instructions, for the feeding thread
@@ -506,11 +572,7 @@ fn feed_parallel(
                 let band_counters = match emitted {
                     Ok(c) => c,
                     // not taken, or failed on its thread: again here, as on one thread
-                    Err(()) => plan.emit_rows(band_rows(want as u32), feed).map_err(|e| {
-                        feed.fault
-                            .take()
-                            .map_or_else(|| fault(e), RenderError::Array)
-                    })?,
+                    Err(()) => emit_into_feed(plan, band_rows(want as u32), feed, &fault)?,
                 };
                 counters.merge(&band_counters);
                 want += 1;

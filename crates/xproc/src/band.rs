@@ -9,9 +9,11 @@
 //! order ([`crate::Engine::absorb`]), timing and recording each scanline in one step, as
 //! if the instructions had run there.
 //!
-//! A band assumes negative accumulation off at its start, as at the start of a trace. If
-//! the stream left it on, the engine refuses the band and its instructions must run
-//! there instead; so does an engine that is not between scanlines. Output, statistics and
+//! A band assumes negative accumulation off at its start, as at the start of a trace,
+//! unless it is started after the band before it ([`BandArray::start_after`], bands
+//! emitted in order on one thread). If the stream left the bit otherwise, the engine
+//! refuses the band and its instructions must run there instead; so does an engine that
+//! is not between scanlines. Output, statistics and
 //! cycles are those of the serial run, bit for bit (`tests/bands.rs`).
 
 use crate::arith::Arith;
@@ -30,6 +32,7 @@ pub struct Band<T> {
     values: Vec<T>,
     /// Instructions executed into the band.
     instructions: u64,
+    negative_at_start: bool,
     negative_at_end: bool,
 }
 
@@ -64,6 +67,7 @@ impl<T> Band<T> {
             lines: Vec::new(),
             values: Vec::new(),
             instructions: 0,
+            negative_at_start: false,
             negative_at_end: false,
         }
     }
@@ -73,6 +77,7 @@ impl<T> Band<T> {
         self.lines.clear();
         self.values.clear();
         self.instructions = 0;
+        self.negative_at_start = false;
         self.negative_at_end = false;
     }
 
@@ -86,10 +91,10 @@ impl<T> Band<T> {
         self.instructions
     }
 
-    /// Whether the band assumed negative accumulation on at its start: never (see the
-    /// module documentation).
+    /// Whether the band assumed negative accumulation on at its start: off, unless it
+    /// was started after the band before it ([`BandArray::start_after`]).
     pub fn negative_at_start(&self) -> bool {
-        false
+        self.negative_at_start
     }
 
     /// Whether negative accumulation is on after the band's last scanline.
@@ -141,12 +146,24 @@ impl<T: Sample> BandArray<T> {
     /// Starts a band in `band`'s buffers (emptied; [`Band::new`] for new ones), the
     /// processors between scanlines, negative accumulation off.
     pub fn start(&mut self, band: Band<T>) {
+        self.start_assuming(band, false);
+    }
+
+    /// Starts a band that follows `previous` in the stream, on one thread: it assumes
+    /// negative accumulation as `previous` left it, so that the engine, having taken
+    /// `previous` in, takes this one too whatever the stream did with the bit.
+    pub fn start_after(&mut self, band: Band<T>, previous: &Band<T>) {
+        self.start_assuming(band, previous.negative_at_end);
+    }
+
+    fn start_assuming(&mut self, band: Band<T>, negative: bool) {
         self.band = band;
         self.band.clear();
+        self.band.negative_at_start = negative;
         if !self.processors.between() {
             self.processors.reset();
         }
-        self.processors.set_negative(false);
+        self.processors.set_negative(negative);
     }
 
     /// The band executed since [`Self::start`]; [`OpenScanline`] if its last instruction

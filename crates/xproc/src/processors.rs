@@ -197,8 +197,9 @@ impl<A: Arith> Processors<A> {
         self.flags[p] |= 1 << slot;
     }
 
-    fn eval0(&mut self, x: usize, dx: usize, v: &[A::Reg; MAX_CHANNELS]) -> u64 {
-        let c = self.channels;
+    fn eval0<const C: usize>(&mut self, x: usize, dx: usize, v: &[A::Reg; MAX_CHANNELS]) -> u64 {
+        debug_assert_eq!(C, self.channels);
+        let c = C;
         let cur = self.evals + 1;
         let mut suppressed = 0;
         for p in x..x + dx {
@@ -206,7 +207,8 @@ impl<A: Arith> Processors<A> {
                 suppressed += 1;
                 continue;
             }
-            self.acc[p * c..p * c + c].copy_from_slice(&v[..c]);
+            // `C` known here: a fixed-size store, not a call to `memcpy` per pixel
+            self.acc[p * c..p * c + c].copy_from_slice(&v[..C]);
             self.flags[p] |= LOCKED;
         }
         self.any_flags |= dx > 0;
@@ -365,7 +367,7 @@ impl<A: Arith> Processors<A> {
             Opcode::Eval0 => {
                 let v =
                     operands::<A, C>(&self.arith, Register::Acc, instr.value(0), &mut w.overflows);
-                w.suppressed = self.eval0(x, dx, &v);
+                w.suppressed = self.eval0::<C>(x, dx, &v);
                 w.updates = dx as u64;
                 self.touch(x, x + dx);
                 self.evals += 1;

@@ -3,7 +3,8 @@
 //! the same scanlines, the same statistics, the same cycle of every event — on random
 //! traces cut into random bands, on random machines, in every numeric format. A band the
 //! engine refuses (negative accumulation left on before it, or the engine caught inside
-//! a scanline) has its instructions executed instead, as a pipeline would.
+//! a scanline) has its instructions executed instead, as a pipeline would; bands chained
+//! in order on one thread are never refused.
 
 mod common;
 
@@ -85,6 +86,50 @@ fn in_bands(
     ((bits(sink), stats), refused)
 }
 
+/// The trace cut into bands of whole scanlines (each cut moved back to just after a
+/// `Refresh`), executed in order on one band array, each band started after the one
+/// before ([`BandArray::start_after`]) and taken in; the instructions after the last
+/// `Refresh` executed by the engine. Returns the outcome and how many bands were refused.
+fn in_chained_bands(
+    header: &TraceHeader,
+    machine: &Machine,
+    numeric: &Numeric,
+    trace: &[Instruction],
+    cuts: &[usize],
+) -> (Outcome, usize) {
+    let mut sink = image_sink(header);
+    let mut e = numeric_engine(header, machine, Timing::Fast, numeric).unwrap();
+    let mut array = e.band_array().unwrap();
+    let after_refresh = |c: usize| {
+        trace[..c.min(trace.len())]
+            .iter()
+            .rposition(|i| i.op == Opcode::Refresh)
+            .map_or(0, |i| i + 1)
+    };
+    let mut bounds: Vec<usize> = cuts.iter().map(|&c| after_refresh(c)).collect();
+    bounds.push(0);
+    bounds.push(after_refresh(trace.len()));
+    bounds.sort_unstable();
+    let (mut previous, mut spare) = (Band::new(), Band::new());
+    let mut refused = 0;
+    for w in bounds.windows(2) {
+        let part = &trace[w[0]..w[1]];
+        array.start_after(spare, &previous);
+        for i in part {
+            array.write(i).unwrap();
+        }
+        let band = array.take().unwrap();
+        if !e.absorb(&band, &mut sink) {
+            refused += 1;
+            e.execute_all(part, &mut sink);
+        }
+        spare = std::mem::replace(&mut previous, band);
+    }
+    e.execute_all(&trace[*bounds.last().unwrap()..], &mut sink);
+    let stats = e.finish(&mut sink);
+    ((bits(sink), stats), refused)
+}
+
 fn case() -> impl Strategy<Value = (Numeric, TraceHeader, Machine, Vec<Instruction>, Vec<usize>)> {
     (
         prop_oneof![3 => Just(Numeric::F64), 1 => common::numeric()],
@@ -131,6 +176,17 @@ proptest! {
         (numeric, header, machine, trace, cuts) in case()
     ) {
         let (banded, _) = in_bands(&header, &machine, &numeric, &trace, &cuts);
+        prop_assert_eq!(banded, serial(&header, &machine, &numeric, &trace));
+    }
+
+    /// Bands emitted in order on one thread, each started after the one before, are all
+    /// taken in, whatever the stream does with negative accumulation.
+    #[test]
+    fn chained_bands_are_never_refused_and_are_the_serial_run(
+        (numeric, header, machine, trace, cuts) in case()
+    ) {
+        let (banded, refused) = in_chained_bands(&header, &machine, &numeric, &trace, &cuts);
+        prop_assert_eq!(refused, 0);
         prop_assert_eq!(banded, serial(&header, &machine, &numeric, &trace));
     }
 }

@@ -75,11 +75,12 @@ pub struct RenderArgs {
     /// Print nothing (errors still go to standard error).
     #[arg(short, long)]
     pub quiet: bool,
-    /// Threads: with N > 1, exact visibility runs on N threads, then every thread emits
-    /// bands of scanlines and runs each through an array of its own while one takes
-    /// their scanlines in, in order (0: one per core). With a trace, a cost map or the
-    /// stepped engine the bands' instructions go to that one thread instead. The output,
-    /// trace and statistics are identical to the serial run's, byte for byte.
+    /// Threads: the Y-processor emits bands of scanlines and runs each through processors
+    /// of its own, whose scanlines the array takes in, in order; with N > 1, exact
+    /// visibility runs on N threads, then N threads emit and run bands while one takes
+    /// them in (0: one per core). With a trace, a cost map or the stepped engine the
+    /// instructions go to the array itself instead. The output, trace and statistics are
+    /// identical at any N, byte for byte.
     #[arg(long, default_value_t = 1, value_name = "N")]
     pub threads: usize,
 }
