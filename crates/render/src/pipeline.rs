@@ -4,17 +4,17 @@
 //!
 //! On one thread, each band of rows is emitted straight into processors of the array's
 //! ([`BandArray`]: no instruction is copied into a batch) and its scanlines are then
-//! taken in by the array, in order. With `threads > 1`, `threads − 1` workers each take the next band of rows of the frame
-//! and emit it; the calling thread takes the finished bands in, in band order, and while
-//! the band it wants is not ready it emits the next untaken band itself (so with two
-//! threads both cores emit). Each thread also executes the bands it emits, on processors
-//! of its own (`cwisim_xproc::band`): the calling thread only times, records and outputs
-//! their scanlines, in order. A tap that wants every instruction, or an array that takes
-//! no bands (the cycle-stepped engine), gets the instructions instead ([`PackedStream`]
-//! on threads), fed to the array on the calling thread in batches of whole scanlines
-//! (checked once, then executed in one call). Either way the array's
-//! output, statistics and cycles are those of the serial stream: byte-identical at any
-//! thread count.
+//! taken in by the array, in order. With `threads > 1`, `threads − 1` workers each take
+//! the next band of rows of the frame and emit it; the calling thread takes the finished
+//! bands in, in band order, and while the band it wants is not ready it emits the next
+//! untaken band itself (so with two threads both cores emit). Each thread also executes
+//! the bands it emits, on processors of its own (`cwisim_xproc::band`): the calling
+//! thread only times, records and outputs their scanlines, in order. A tap that wants
+//! every instruction, or an array that takes no bands (the cycle-stepped engine), gets
+//! the instructions instead ([`PackedStream`] on threads), fed to the array on the
+//! calling thread in batches of whole scanlines (checked once, then executed in one
+//! call). Either way the array's output, statistics and cycles are those of the serial
+//! stream: byte-identical at any thread count.
 
 use crate::error::RenderError;
 use crate::renderer::{Counters, FramePlan, Renderer};

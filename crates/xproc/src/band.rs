@@ -13,8 +13,8 @@
 //! unless it is started after the band before it ([`BandArray::start_after`], bands
 //! emitted in order on one thread). If the stream left the bit otherwise, the engine
 //! refuses the band and its instructions must run there instead; so does an engine that
-//! is not between scanlines. Output, statistics and
-//! cycles are those of the serial run, bit for bit (`tests/bands.rs`).
+//! is not between scanlines. Output, statistics and cycles are those of the serial run,
+//! bit for bit (`tests/bands.rs`).
 
 use crate::arith::Arith;
 use crate::processors::{LineEnd, Processors};
