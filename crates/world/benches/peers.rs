@@ -17,7 +17,9 @@
 //!   stream with flat shading, into an instruction counter (no array).
 //! * `cwisim/array_flat`, `cwisim/array_gouraud` — the Y-processor and the array (fast
 //!   engine with its timing model, `f64` registers, `EngineWriter` + `ImageSink`), flat and
-//!   Gouraud shading.
+//!   Gouraud shading, each instruction fed to the array as it comes.
+//! * `cwisim/bands_flat`, `cwisim/bands_gouraud` — the same as `cwisim render` runs it on
+//!   one thread: bands of 16 rows executed as emitted, each taken in by the array in order.
 //!
 //! What exactly is compared, and the accuracy of each (not timed here):
 //! `tests/peers/mod.rs` and `cargo run --release -p cwisim-world --example peer_accuracy`.
@@ -28,7 +30,7 @@ mod peers;
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use cwisim_scene::ScreenScene;
 use cwisim_ypipe::Shading;
-use peers::{cwisim_image, fill, outlines, ypipe_only, Mode, Peer};
+use peers::{cwisim_image, cwisim_image_in_bands, fill, outlines, ypipe_only, Mode, Peer};
 use std::hint::black_box;
 
 const SIZE: u32 = 1024;
@@ -54,6 +56,14 @@ fn set(c: &mut Criterion, name: &str, scene: &ScreenScene, modes: &[Mode]) {
     ] {
         group.bench_function(id, |b| {
             b.iter(|| black_box(cwisim_image(black_box(scene), shading)))
+        });
+    }
+    for (id, shading) in [
+        ("cwisim/bands_flat", Shading::Flat),
+        ("cwisim/bands_gouraud", Shading::Gouraud),
+    ] {
+        group.bench_function(id, |b| {
+            b.iter(|| black_box(cwisim_image_in_bands(black_box(scene), shading)))
         });
     }
     group.finish();

@@ -75,3 +75,26 @@ fn a_misplaced_fill_is_beyond_the_ceiling() {
         }
     }
 }
+
+/// The array fed in bands of rows (as `cwisim render` on one thread) draws the image it
+/// draws fed instruction by instruction, bit for bit, flat and Gouraud, on all three sets.
+#[test]
+fn bands_of_rows_draw_the_image_instruction_by_instruction_draws() {
+    let sets = [
+        ("pot", peers::pot(256)),
+        ("random", peers::random(256, 60, 0x5EED_CAFE)),
+        ("mesh", cwisim_scene::grid::warped_grid(8, 256)),
+    ];
+    for (name, scene) in &sets {
+        for shading in [cwisim_ypipe::Shading::Flat, cwisim_ypipe::Shading::Gouraud] {
+            let bits = |v: Vec<f64>| v.into_iter().map(f64::to_bits).collect::<Vec<_>>();
+            let one = bits(peers::cwisim_image(scene, shading));
+            assert!(one.iter().any(|&b| b != 0), "{name}: something drawn");
+            assert_eq!(
+                bits(peers::cwisim_image_in_bands(scene, shading)),
+                one,
+                "{name} {shading:?}"
+            );
+        }
+    }
+}

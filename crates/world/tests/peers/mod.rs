@@ -15,7 +15,8 @@
 //! polygon's exact box-filtered coverage** of a pixel (its area ∩ pixel), which exceeds 1
 //! where polygons overlap. The reference is [`Exact`]: `cwisim_ypipe::exact::coverage` per
 //! polygon, summed. cwisim's value is the array's output for the scene with intensity 1 on
-//! every vertex and flat shading ([`coverage_scene`], [`cwisim_image`]).
+//! every vertex and flat shading ([`coverage_scene`], [`cwisim_image`]; the same in bands
+//! of rows, as `cwisim render` runs it, [`cwisim_image_in_bands`]).
 //!
 //! The peers are driven two ways ([`Mode`]):
 //!
@@ -40,10 +41,10 @@ use cwisim_isa::{Instruction, TraceWrite};
 use cwisim_scene::{Polygon, ScreenScene};
 use cwisim_world::embedded::embedded;
 use cwisim_world::{parse_any, to_screen, AnyScene, Visibility};
-use cwisim_xproc::{EngineWriter, ImageSink, Machine, Timing};
+use cwisim_xproc::{Band, EngineWriter, ImageSink, Machine, Timing};
 use cwisim_ypipe::clip::clip_to_rect;
 use cwisim_ypipe::exact::coverage;
-use cwisim_ypipe::{emit, header, Antialias, Claim, Options, Shading};
+use cwisim_ypipe::{emit, emit_rows, header, Antialias, Claim, Options, ScanPlan, Shading};
 use std::io;
 
 // ---------------------------------------------------------------------------------------
@@ -528,6 +529,42 @@ pub fn cwisim_image(scene: &ScreenScene, shading: Shading) -> Vec<f64> {
         "one frame"
     );
     image
+}
+
+/// Rows per band in [`cwisim_image_in_bands`]: as `cwisim render` on one thread.
+const BAND_ROWS: u32 = 16;
+
+/// [`cwisim_image`] as `cwisim render` runs it on one thread: the rows emitted in bands of
+/// 16 into processors of the array's own (`BandArray`, each band started after the one
+/// before), each band's scanlines then taken in by the array, in order (`absorb`).
+pub fn cwisim_image_in_bands(scene: &ScreenScene, shading: Shading) -> Vec<f64> {
+    let h = header(scene);
+    let options = options(shading);
+    let plan = ScanPlan::new(scene, &options);
+    let mut sink = ImageSink::new(
+        h.width as usize,
+        h.channel_count(),
+        ImageSink::DEFAULT_LIMIT_BYTES,
+    );
+    {
+        let mut array = EngineWriter::<f64>::new(&h, &Machine::default(), Timing::Fast, &mut sink)
+            .expect("the default machine");
+        let mut processors = array.band_array().expect("the fast engine takes bands");
+        let (mut previous, mut spare) = (Band::new(), Band::new());
+        for first in (0..scene.height).step_by(BAND_ROWS as usize) {
+            let rows = first..(first + BAND_ROWS).min(scene.height);
+            processors.start_after(spare, &previous);
+            emit_rows(&plan, &options, rows, &mut processors).expect("the stream fits");
+            let band = processors.take().expect("whole scanlines");
+            assert!(
+                array.absorb(&band).expect("the array takes bands"),
+                "chained"
+            );
+            spare = std::mem::replace(&mut previous, band);
+        }
+        array.finish().expect("the array finishes");
+    }
+    sink.finish().expect("the image fits").data
 }
 
 // ---------------------------------------------------------------------------------------
