@@ -510,25 +510,9 @@ pub fn ypipe_only(scene: &ScreenScene, shading: Shading) -> u64 {
 /// The Y-processor and the array (fast engine, its timing model, `f64` registers) into an
 /// image: `width × height × channels` values, row-major.
 pub fn cwisim_image(scene: &ScreenScene, shading: Shading) -> Vec<f64> {
-    let h = header(scene);
-    let mut sink = ImageSink::new(
-        h.width as usize,
-        h.channel_count(),
-        ImageSink::DEFAULT_LIMIT_BYTES,
-    );
-    {
-        let mut array = EngineWriter::<f64>::new(&h, &Machine::default(), Timing::Fast, &mut sink)
-            .expect("the default machine");
-        emit(scene, &options(shading), &mut array).expect("the stream fits the header");
-        array.finish().expect("the array finishes");
-    }
-    let image = sink.finish().expect("the image fits").data;
-    assert_eq!(
-        image.len(),
-        scene.width as usize * scene.height as usize * usize::from(scene.channels),
-        "one frame"
-    );
-    image
+    array_image(scene, |array| {
+        emit(scene, &options(shading), array).expect("the stream fits the header");
+    })
 }
 
 /// Rows per band in [`cwisim_image_in_bands`]: as `cwisim render` on one thread.
@@ -538,17 +522,9 @@ const BAND_ROWS: u32 = 16;
 /// 16 into processors of the array's own (`BandArray`, each band started after the one
 /// before), each band's scanlines then taken in by the array, in order (`absorb`).
 pub fn cwisim_image_in_bands(scene: &ScreenScene, shading: Shading) -> Vec<f64> {
-    let h = header(scene);
     let options = options(shading);
     let plan = ScanPlan::new(scene, &options);
-    let mut sink = ImageSink::new(
-        h.width as usize,
-        h.channel_count(),
-        ImageSink::DEFAULT_LIMIT_BYTES,
-    );
-    {
-        let mut array = EngineWriter::<f64>::new(&h, &Machine::default(), Timing::Fast, &mut sink)
-            .expect("the default machine");
+    array_image(scene, |array| {
         let mut processors = array.band_array().expect("the fast engine takes bands");
         let (mut previous, mut spare) = (Band::new(), Band::new());
         for first in (0..scene.height).step_by(BAND_ROWS as usize) {
@@ -558,13 +534,35 @@ pub fn cwisim_image_in_bands(scene: &ScreenScene, shading: Shading) -> Vec<f64> 
             let band = processors.take().expect("whole scanlines");
             assert!(
                 array.absorb(&band).expect("the array takes bands"),
-                "chained"
+                "a band started after the one before is taken"
             );
             spare = std::mem::replace(&mut previous, band);
         }
+    })
+}
+
+/// The image the array (the default machine, fast engine, `f64`) draws for `scene` when
+/// `feed` drives it.
+fn array_image(scene: &ScreenScene, feed: impl FnOnce(&mut EngineWriter<'_, f64>)) -> Vec<f64> {
+    let h = header(scene);
+    let mut sink = ImageSink::new(
+        h.width as usize,
+        h.channel_count(),
+        ImageSink::DEFAULT_LIMIT_BYTES,
+    );
+    {
+        let mut array = EngineWriter::<f64>::new(&h, &Machine::default(), Timing::Fast, &mut sink)
+            .expect("the default machine");
+        feed(&mut array);
         array.finish().expect("the array finishes");
     }
-    sink.finish().expect("the image fits").data
+    let image = sink.finish().expect("the image fits").data;
+    assert_eq!(
+        image.len(),
+        scene.width as usize * scene.height as usize * usize::from(scene.channels),
+        "one frame"
+    );
+    image
 }
 
 // ---------------------------------------------------------------------------------------
