@@ -77,7 +77,9 @@ fn prepare(w: &WorldScene, visibility: Visibility, threads: usize) -> ScreenScen
 /// renderer interface and the pipeline as `cwisim render` runs them.
 fn render(screen: ScreenScene, visibility: Visibility, threads: usize, image: bool) -> u64 {
     let h = header(&screen);
-    let mut img = ImageSink::new(h.width as usize, h.channel_count(), 1 << 34);
+    // as `cwisim render` collects it: room for the frame reserved up front
+    let mut img =
+        ImageSink::new(h.width as usize, h.channel_count(), 1 << 34).with_room_for(h.lines.into());
     let mut null = NullSink;
     let sink: &mut dyn cwisim_xproc::LineSink<f64> = if image { &mut img } else { &mut null };
     let settings = Settings {

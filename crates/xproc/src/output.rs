@@ -80,6 +80,20 @@ impl ImageSink {
         }
     }
 
+    /// Room for `lines` scanlines reserved up front — as many as the limit allows, and
+    /// none if the allocator refuses — so that the image is not copied as it grows. The
+    /// image collected is the same either way.
+    pub fn with_room_for(mut self, lines: u64) -> Self {
+        let row = (self.image.width * self.image.channels) as u64;
+        let within_limit = self.limit_bytes / 8 / row.max(1);
+        let values = lines.min(within_limit).saturating_mul(row);
+        if let Ok(values) = usize::try_from(values) {
+            // a hint: on refusal the image grows as it comes
+            let _ = self.image.data.try_reserve_exact(values);
+        }
+        self
+    }
+
     /// The image, or the limit it ran into.
     pub fn finish(self) -> Result<Image, ImageLimit> {
         match self.overflow {
@@ -113,5 +127,55 @@ impl<T: Sample> LineSink<T> for ImageSink {
             *d = s.to_f64();
         }
         self.image.lines += 1;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn line(index: u64, values: &[f64]) -> LineOut<'_, f64> {
+        LineOut {
+            index,
+            span: (1, 1 + values.len()),
+            values,
+        }
+    }
+
+    #[test]
+    fn room_reserved_up_front_within_the_limit_collects_the_same_image() {
+        let collect = |sink: ImageSink| {
+            let mut sink = sink;
+            for k in 0..3 {
+                LineSink::<f64>::line(&mut sink, line(k, &[0.5, k as f64]));
+            }
+            sink
+        };
+        // four values per scanline, 32 bytes: a limit of 100 bytes holds 3 scanlines
+        let plain = collect(ImageSink::new(4, 1, 100));
+        let roomy = ImageSink::new(4, 1, 100).with_room_for(1 << 40);
+        assert_eq!(
+            roomy.image.data.capacity(),
+            12,
+            "no more than the limit allows"
+        );
+        let roomy = collect(roomy);
+        assert_eq!(roomy.image.data.capacity(), 12, "not grown");
+        assert_eq!(plain.finish().unwrap(), roomy.finish().unwrap());
+        // a scanline past the limit is refused the same way with room reserved
+        let mut over = ImageSink::new(4, 1, 100).with_room_for(2);
+        for k in 0..4 {
+            LineSink::<f64>::line(&mut over, line(k, &[1.0]));
+        }
+        assert_eq!(over.finish().unwrap_err().line, 3);
+        // an empty row reserves nothing
+        assert_eq!(
+            ImageSink::new(0, 1, 100)
+                .with_room_for(5)
+                .image
+                .data
+                .capacity(),
+            0
+        );
     }
 }

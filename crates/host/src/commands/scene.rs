@@ -163,16 +163,16 @@ pub fn run_render(
         Some(path) => Some(encode(renderer, path)?),
         None => None,
     };
+    let frames_lines = u64::from(h.lines) * u64::from(renderer.frames());
+    // room for every frame's scanlines up front: the image is not copied as it grows
     let mut sink = ImageSink::new(
         h.width as usize,
         h.channel_count(),
         ImageSink::DEFAULT_LIMIT_BYTES,
-    );
+    )
+    .with_room_for(frames_lines);
     let mut cost = args.cost.wanted().then(|| CostMap::new(h.width as usize));
-    let mut progress = Progress::scanlines(
-        u64::from(h.lines) * u64::from(renderer.frames()),
-        progress && !args.quiet,
-    );
+    let mut progress = Progress::scanlines(frames_lines, progress && !args.quiet);
     let rendered = render(
         renderer,
         &array,
