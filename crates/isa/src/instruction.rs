@@ -61,13 +61,6 @@ impl Intensity {
         usize::from(self.len)
     }
 
-    /// Every value finite, tested without a branch per channel: the lanes past
-    /// [`Self::len`] are 0 (every constructor writes them so), so all of them are tested.
-    #[inline]
-    fn all_lanes_finite(&self) -> bool {
-        self.values.iter().fold(true, |ok, v| ok & v.is_finite())
-    }
-
     /// True for [`Intensity::NONE`].
     pub fn is_empty(&self) -> bool {
         self.len == 0
@@ -410,13 +403,11 @@ impl Instruction {
                     });
                     ((slots == 0) | (header.channels == 1)) & (present & slots == slots) & finite
                 }
-                Values::Wide(w) => {
-                    let channels = header.channel_count();
-                    (0..3).fold(true, |ok, s| {
-                        ok & ((slots & (1 << s) == 0)
-                            | ((w[s].len() == channels) & w[s].all_lanes_finite()))
-                    })
-                }
+                Values::Wide(w) => (0..3).all(|s| {
+                    slots & (1 << s) == 0
+                        || (w[s].len() == header.channel_count()
+                            && w[s].as_slice().iter().all(|f| f.is_finite()))
+                }),
             }
     }
 
