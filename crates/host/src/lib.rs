@@ -32,6 +32,7 @@
 #![warn(missing_docs)]
 
 pub mod cli;
+pub mod collect;
 pub mod commands;
 pub mod cost_args;
 pub mod demo;

@@ -41,9 +41,10 @@ pub struct Image {
     pub data: Vec<f64>,
 }
 
-/// The output would exceed the collector's limit.
+/// The output would exceed the collector's limit (of bytes held: 8 a value for an exact
+/// image, 1 for 8-bit samples).
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("the output image would exceed {limit_bytes} bytes at scanline {line} ({width} × {channels} f64 values per scanline); write statistics only, or raise the limit")]
+#[error("the output image would exceed {limit_bytes} bytes at scanline {line} ({width} × {channels} values per scanline); write statistics only, or raise the limit")]
 pub struct ImageLimit {
     /// The limit.
     pub limit_bytes: u64,

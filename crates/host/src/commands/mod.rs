@@ -16,10 +16,11 @@ pub mod stats;
 pub mod tradeoff;
 pub mod vcd;
 
+use crate::collect::{Collected, OutputSink};
 use crate::error::CliError;
 use crate::output;
 use clap::Args;
-use cwisim_xproc::{Image, Machine};
+use cwisim_xproc::Machine;
 use std::path::PathBuf;
 
 /// `-o OUT.png` and `--npy OUT.npy`: where the image goes (`run` and `render`).
@@ -64,14 +65,27 @@ impl ImageArgs {
         Ok(())
     }
 
-    /// Writes the outputs asked for (PNG checked first, so that either both or neither
-    /// is written when the PNG cannot be).
-    pub fn write(&self, image: &Image) -> Result<(), CliError> {
-        if let Some(path) = &self.output {
-            output::check_png(image)?;
-            output::write_png(path, image)?;
+    /// The collector of what the outputs asked for need, for scanlines of `width`
+    /// pixels of `channels` values, with room for `lines` of them (a hint): the exact
+    /// image for `--npy`, the PNG's samples for `-o`, nothing for neither.
+    pub fn sink(&self, width: usize, channels: usize, lines: u64) -> OutputSink {
+        OutputSink::new(
+            width,
+            channels,
+            self.npy.is_some(),
+            self.output.is_some(),
+            lines,
+        )
+    }
+
+    /// Writes the outputs asked for from what [`Self::sink`] collected (PNG checked
+    /// first, so that either both or neither is written when the PNG cannot be).
+    pub fn write(&self, collected: &Collected) -> Result<(), CliError> {
+        if let (Some(path), Some(samples)) = (&self.output, &collected.png) {
+            samples.check()?;
+            output::write_png_samples(path, samples)?;
         }
-        if let Some(path) = &self.npy {
+        if let (Some(path), Some(image)) = (&self.npy, &collected.exact) {
             output::write_npy(path, image)?;
         }
         Ok(())

@@ -11,8 +11,7 @@ use clap::{Args, ValueEnum};
 use cwisim_isa::{Encoding, FileReader, TraceRead};
 use cwisim_study::cost::{CostMap, CostReader};
 use cwisim_xproc::{
-    replay_streaming, Image, ImageSink, LineRecords, NullSink, Numeric, ReplayError, RunStats,
-    Timing,
+    replay_streaming, LineRecords, NullSink, Numeric, ReplayError, RunStats, Timing,
 };
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -89,15 +88,6 @@ pub struct RunArgs {
     pub draw: crate::draw::DrawArgs,
 }
 
-/// What a successful replay produced.
-#[derive(Debug)]
-pub struct Replayed {
-    /// The statistics.
-    pub stats: RunStats,
-    /// The image, if one was asked for.
-    pub image: Option<Image>,
-}
-
 /// Runs `cwisim run`: statistics go to `stdout` (with `--stats`), warnings to `stderr`.
 /// `progress` allows the progress bar (it still needs a terminal and a run of over a
 /// second). Nothing is written unless the whole trace replayed without error, except with
@@ -128,13 +118,12 @@ pub fn run(
         ))),
         None => None,
     };
-    let replayed = {
+    let (stats, collected) = {
         let mut bar = Progress::new(size, progress);
-        let want_image = args.image.wanted();
         let mut costed;
         let reader: &mut dyn TraceRead = match &mut cost {
-            Some(map) => {
-                costed = CostReader::new(&mut *reader, map);
+            Some(cost) => {
+                costed = CostReader::new(&mut *reader, cost);
                 &mut costed
             }
             None => &mut *reader,
@@ -151,60 +140,45 @@ pub fn run(
             }
             None => LineRecords::Drop,
         };
-        if args.keep_partial && want_image {
-            let mut sink = ImageSink::new(
-                header.width as usize,
-                header.channel_count(),
-                ImageSink::DEFAULT_LIMIT_BYTES,
-            );
-            let result = replay_streaming(
-                reader,
-                &machine,
-                timing,
-                &args.numeric,
-                keep_lines,
-                &mut sink,
-                &mut |bytes| bar.update(bytes),
-            );
-            match result {
-                Ok(stats) => Replayed {
-                    stats,
-                    image: Some(sink.finish()?),
-                },
-                Err(ReplayError::Trace(error)) => {
-                    drop(bar);
-                    let image = sink.finish()?;
-                    let note = if image.lines == 0 {
-                        "no scanline was completed before the error: no image written".to_string()
-                    } else {
-                        args.image.write(&image)?;
-                        format!(
-                            "the image is incomplete: it holds the {} scanline(s) completed \
+        // only what the outputs need, with room for a frame up front
+        let mut sink = args.image.sink(
+            header.width as usize,
+            header.channel_count(),
+            u64::from(header.lines),
+        );
+        let result = replay_streaming(
+            reader,
+            &machine,
+            timing,
+            &args.numeric,
+            keep_lines,
+            &mut sink,
+            &mut |bytes| bar.update(bytes),
+        );
+        match result {
+            Ok(stats) => (stats, sink.finish()?),
+            Err(ReplayError::Trace(error)) if args.keep_partial && args.image.wanted() => {
+                drop(bar);
+                let collected = sink.finish()?;
+                let note = if collected.lines() == 0 {
+                    "no scanline was completed before the error: no image written".to_string()
+                } else {
+                    args.image.write(&collected)?;
+                    format!(
+                        "the image is incomplete: it holds the {} scanline(s) completed \
 before the error (a frame has {})",
-                            image.lines, header.lines
-                        )
-                    };
-                    // A lost warning is no reason to hide the error.
-                    let _ = writeln!(stderr, "warning: --keep-partial: {note}");
-                    return Err(CliError::from(ReplayError::Trace(error)));
-                }
-                Err(other) => return Err(other.into()),
+                        collected.lines(),
+                        header.lines
+                    )
+                };
+                // A lost warning is no reason to hide the error.
+                let _ = writeln!(stderr, "warning: --keep-partial: {note}");
+                return Err(CliError::from(ReplayError::Trace(error)));
             }
-        } else {
-            replay_file_streaming(
-                reader,
-                &machine,
-                timing,
-                &args.numeric,
-                want_image,
-                keep_lines,
-                &mut |bytes| bar.update(bytes),
-            )?
+            Err(other) => return Err(other.into()),
         }
     };
-    if let Some(image) = &replayed.image {
-        args.image.write(image)?;
-    }
+    args.image.write(&collected)?;
     if let Some(cost) = &cost {
         let name = match &args.trace {
             Some(path) => display_name(path),
@@ -212,7 +186,7 @@ before the error (a frame has {})",
         };
         args.cost.write(cost, &name)?;
     }
-    let stats = &replayed.stats;
+    let stats = &stats;
     if let Some(path) = &args.stats_json {
         let report = StatsReport {
             trace: (&header).into(),
@@ -272,63 +246,23 @@ fn demo_trace_bytes() -> Vec<u8> {
     bytes
 }
 
-/// Replays an open trace on `machine`, collecting the image (up to
-/// [`ImageSink::DEFAULT_LIMIT_BYTES`]) when `want_image`.
+/// Replays an open trace on `machine` for its statistics, every scanline's record kept.
 pub fn replay_file(
     reader: &mut dyn TraceRead,
     machine: &cwisim_xproc::Machine,
     timing: Timing,
     numeric: &Numeric,
-    want_image: bool,
     progress: &mut dyn FnMut(u64),
-) -> Result<Replayed, CliError> {
-    replay_file_streaming(
+) -> Result<RunStats, CliError> {
+    Ok(replay_streaming(
         reader,
         machine,
         timing,
         numeric,
-        want_image,
         LineRecords::Keep,
+        &mut NullSink,
         progress,
-    )
-}
-
-/// [`replay_file`], the record of each scanline going where `keep_lines` says.
-pub fn replay_file_streaming(
-    reader: &mut dyn TraceRead,
-    machine: &cwisim_xproc::Machine,
-    timing: Timing,
-    numeric: &Numeric,
-    want_image: bool,
-    keep_lines: LineRecords,
-    progress: &mut dyn FnMut(u64),
-) -> Result<Replayed, CliError> {
-    let header = *reader.header();
-    if want_image {
-        let mut sink = ImageSink::new(
-            header.width as usize,
-            header.channel_count(),
-            ImageSink::DEFAULT_LIMIT_BYTES,
-        );
-        let stats = replay_streaming(
-            reader, machine, timing, numeric, keep_lines, &mut sink, progress,
-        )?;
-        Ok(Replayed {
-            stats,
-            image: Some(sink.finish()?),
-        })
-    } else {
-        let stats = replay_streaming(
-            reader,
-            machine,
-            timing,
-            numeric,
-            keep_lines,
-            &mut NullSink,
-            progress,
-        )?;
-        Ok(Replayed { stats, image: None })
-    }
+    )?)
 }
 
 /// Refuses outputs that would overwrite the trace or each other.

@@ -15,7 +15,7 @@ use clap::Args;
 use cwisim_isa::{Encoding, TraceWrite};
 use cwisim_render::{render, ArrayConfig, Renderer, Taps};
 use cwisim_study::cost::CostMap;
-use cwisim_xproc::{ImageSink, Numeric, Timing};
+use cwisim_xproc::{Numeric, Timing};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -164,13 +164,9 @@ pub fn run_render(
         None => None,
     };
     let frames_lines = u64::from(h.lines) * u64::from(renderer.frames());
-    // room for every frame's scanlines up front: the image is not copied as it grows
-    let mut sink = ImageSink::new(
-        h.width as usize,
-        h.channel_count(),
-        ImageSink::DEFAULT_LIMIT_BYTES,
-    )
-    .with_room_for(frames_lines);
+    // only what the outputs need, with room for every frame's scanlines up front: it is
+    // not copied as it grows
+    let mut sink = image_args.sink(h.width as usize, h.channel_count(), frames_lines);
     let mut cost = args.cost.wanted().then(|| CostMap::new(h.width as usize));
     let mut progress = Progress::scanlines(frames_lines, progress && !args.quiet);
     let rendered = render(
@@ -185,8 +181,7 @@ pub fn run_render(
     )?;
     drop(progress);
     let start = Instant::now();
-    let image = sink.finish()?;
-    image_args.write(&image)?;
+    image_args.write(&sink.finish()?)?;
     if let Some(cost) = &cost {
         let name = match drawn.source.path() {
             Some(p) => display_name(p),

@@ -161,15 +161,14 @@ pub fn run(
         Input::Trace => {
             let (mut reader, _) = open_trace(Some(&args.input))?;
             let header = *reader.header();
-            let replayed = replay_file(
+            let stats = replay_file(
                 &mut *reader,
                 &machine,
                 timing,
                 &cwisim_xproc::Numeric::F64,
-                false,
                 &mut |_| {},
             )?;
-            (header, replayed.stats)
+            (header, stats)
         }
         Input::Scene => {
             let drawn = args.draw.draw(Some(&args.input))?;
