@@ -9,12 +9,18 @@
 //!   runs without `--quiet` print the command's own stage times (its summary's `time`
 //!   line) to standard error.
 //!
+//! * `cli_process/pot_1024/exact`, `cli_process/pot_1024/eval0` — the same command as a
+//!   fresh process of the built `cwisim` binary, as a user runs it: the process's start,
+//!   its first touch of every page it writes (the image, the buffers) and its exit
+//!   included. Five more runs print the process's own stage times to standard error.
+//!
 //! The figures are in docs/PERFORMANCE.md.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use cwisim_host::cli::run_cli_with;
 use std::ffi::OsString;
 use std::hint::black_box;
+use std::process::Command;
 use std::time::Duration;
 
 fn cli_render(c: &mut Criterion) {
@@ -61,5 +67,41 @@ fn cli_render(c: &mut Criterion) {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-criterion_group!(benches, cli_render);
+fn cli_process(c: &mut Criterion) {
+    let dir = std::env::temp_dir().join(format!("cwisim-bench-process-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temporary directory");
+    let png = dir.join("pot.png");
+    let mut g = c.benchmark_group("cli_process");
+    g.sample_size(20).measurement_time(Duration::from_secs(6));
+    for vis in ["exact", "eval0"] {
+        let run = |quiet: bool| {
+            let mut cmd = Command::new(env!("CARGO_BIN_EXE_cwisim"));
+            cmd.args(["render", "pot", "--size", "1024x1024", "--threads", "1"])
+                .args(["--visibility", vis, "-o"])
+                .arg(&png);
+            if quiet {
+                cmd.arg("--quiet");
+            }
+            let out = cmd.output().expect("the cwisim binary runs");
+            assert!(
+                out.status.success(),
+                "{}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+            out.stdout
+        };
+        g.bench_function(BenchmarkId::new("pot_1024", vis), |b| {
+            b.iter(|| black_box(run(true)))
+        });
+        for _ in 0..5 {
+            let out = String::from_utf8(run(false)).expect("utf-8");
+            let times = out.lines().find(|l| l.starts_with("time")).unwrap_or("");
+            eprintln!("cli_process {vis}: {times}");
+        }
+    }
+    g.finish();
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+criterion_group!(benches, cli_render, cli_process);
 criterion_main!(benches);
