@@ -307,7 +307,11 @@ impl<R: BufRead> BinaryReader<R> {
     /// Records decoded here stay in the buffer (`self.pending` bytes of it) until the
     /// buffer is used up or the byte-by-byte path needs the input: then they go into
     /// the checksum in one piece and are consumed ([`Self::settle`]).
-    #[inline]
+    ///
+    /// Always inlined: out of line, the record came back through memory, written as
+    /// 8-byte fields and copied on with 16-byte loads, which store forwarding cannot
+    /// serve (a stall per instruction, half of `read_batch`'s time).
+    #[inline(always)]
     fn decode_buffered(&mut self) -> Option<Instruction> {
         if let Some(i) = self.decode_at_pending() {
             return Some(i);
