@@ -114,6 +114,7 @@ pub fn check_png_shape(
 ///
 /// Written all-or-nothing ([`write_atomic`]).
 pub fn write_png(path: &Path, image: &Image) -> Result<(), CliError> {
+    check_png(image)?;
     write_png_samples(path, &PngSamples::of(image))
 }
 

@@ -18,23 +18,8 @@ use cwisim_xproc::{
 };
 use std::hint::black_box;
 
-/// A small deterministic generator (xorshift64*), so the trace is the same every run.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
-    }
-    fn below(&mut self, n: u64) -> u64 {
-        self.next() % n
-    }
-    fn unit(&mut self) -> f64 {
-        (self.next() >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
+mod common;
+use common::{short_spans, Rng};
 
 fn frame_trace(width: u32, lines: u32) -> Vec<Instruction> {
     let mut rng = Rng(0x9E37_79B9_7F4A_7C15);
@@ -95,7 +80,7 @@ fn bench(c: &mut Criterion) {
         c,
         "numeric_short_spans_1024x1024",
         &header,
-        &short_span_trace(1024, 1024),
+        &short_spans(1024, 1024, None, None),
     );
     overhead(c, &header);
 
@@ -157,33 +142,6 @@ fn numeric_group(c: &mut Criterion, name: &str, header: &TraceHeader, trace: &[I
     group.finish();
 }
 
-/// Short spans, as the edge pixels of a box-filtered scene produce: per scanline 64
-/// Evals of 4–16 processors each (~640 processor updates), the same mix of orders as
-/// [`frame_trace`], no preloads, then a Refresh.
-fn short_span_trace(width: u32, lines: u32) -> Vec<Instruction> {
-    let mut rng = Rng(0xD1B5_4A32_D192_ED03);
-    let mut out = Vec::new();
-    let g = Intensity::grey;
-    for _ in 0..lines {
-        for _ in 0..64 {
-            let dx = 4 + rng.below(13) as u32;
-            let x = rng.below(u64::from(width - dx + 1)) as u32;
-            let (i, di, ddi) = (
-                rng.unit(),
-                (rng.unit() - 0.5) / 16.0,
-                (rng.unit() - 0.5) / 256.0,
-            );
-            out.push(match rng.below(4) {
-                0 => Instruction::eval1(x, dx, g(i)),
-                1 => Instruction::eval3(x, dx, g(i), g(di), g(ddi)),
-                _ => Instruction::eval2(x, dx, g(i), g(di)),
-            });
-        }
-        out.push(Instruction::refresh());
-    }
-    out
-}
-
 /// What an instruction costs beyond its processor updates: the short-span frame with
 /// every span emptied (`dx = 0`: issued, timed and counted, no processor touched),
 /// replayed by the engine alone (`engine`, as `cwisim run` after its decoder's check)
@@ -196,7 +154,7 @@ fn short_span_trace(width: u32, lines: u32) -> Vec<Instruction> {
 /// is the overhead of an instruction that does work, plus one update). Throughput in
 /// instructions.
 fn overhead(c: &mut Criterion, header: &TraceHeader) {
-    let trace: Vec<Instruction> = short_span_trace(header.width, header.lines)
+    let trace: Vec<Instruction> = short_spans(header.width, header.lines, None, None)
         .into_iter()
         .map(|mut i| {
             i.dx = 0;

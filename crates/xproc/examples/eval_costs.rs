@@ -26,60 +26,13 @@
 //! processor updates per second. docs/PERFORMANCE.md ("What an Eval costs") quotes it.
 
 use cwisim_isa::io::read_all;
-use cwisim_isa::{FileReader, Instruction, Intensity, Opcode, TraceHeader, TraceWrite};
+use cwisim_isa::{FileReader, Instruction, Opcode, TraceHeader, TraceWrite};
 use cwisim_xproc::{numeric_engine, Band, Machine, NullSink, Numeric, Timing};
 use std::path::PathBuf;
 use std::time::Instant;
 
-/// xorshift64*: the same frames every run.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
-    }
-    fn below(&mut self, n: u64) -> u64 {
-        self.next() % n
-    }
-    fn unit(&mut self) -> f64 {
-        (self.next() >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
-
-/// A frame of short spans: `order` 1–3 for all, or the bench's random mix; span length
-/// `dx` for all, or random in 4–16.
-fn frame(order: Option<u64>, dx: Option<u32>) -> Vec<Instruction> {
-    let mut rng = Rng(0xD1B5_4A32_D192_ED03);
-    let g = Intensity::grey;
-    let mut out = Vec::new();
-    for _ in 0..1024 {
-        for _ in 0..64 {
-            let random_dx = 4 + rng.below(13) as u32;
-            let dx = dx.unwrap_or(random_dx);
-            let x = rng.below(u64::from(1024 - dx + 1)) as u32;
-            let (i, di, ddi) = (
-                rng.unit(),
-                (rng.unit() - 0.5) / 16.0,
-                (rng.unit() - 0.5) / 256.0,
-            );
-            let mix = match rng.below(4) {
-                0 => 1,
-                1 => 3,
-                _ => 2,
-            };
-            out.push(match order.unwrap_or(mix) {
-                1 => Instruction::eval1(x, dx, g(i)),
-                3 => Instruction::eval3(x, dx, g(i), g(di), g(ddi)),
-                _ => Instruction::eval2(x, dx, g(i), g(di)),
-            });
-        }
-        out.push(Instruction::refresh());
-    }
-    out
-}
+#[path = "../benches/common/mod.rs"]
+mod common;
 
 /// How a variant is fed to the array.
 #[derive(Clone, Copy)]
@@ -153,7 +106,7 @@ fn main() {
     let synthetic = |name: &str, order, dx| Variant {
         name: name.to_string(),
         header: grey,
-        instrs: frame(order, dx),
+        instrs: common::short_spans(1024, 1024, order, dx),
         feed: Feed::Engine,
         times: Vec::new(),
         updates: 0,

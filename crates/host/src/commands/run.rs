@@ -122,8 +122,8 @@ pub fn run(
         let mut bar = Progress::new(size, progress);
         let mut costed;
         let reader: &mut dyn TraceRead = match &mut cost {
-            Some(cost) => {
-                costed = CostReader::new(&mut *reader, cost);
+            Some(map) => {
+                costed = CostReader::new(&mut *reader, map);
                 &mut costed
             }
             None => &mut *reader,
