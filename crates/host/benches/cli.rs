@@ -57,11 +57,7 @@ fn cli_render(c: &mut Criterion) {
         // the command's own account of its stages, in this process after the warm-up
         // (the figures to hold against `stages_1024`)
         let loud: Vec<OsString> = args.iter().filter(|a| *a != "--quiet").cloned().collect();
-        for _ in 0..5 {
-            let out = String::from_utf8(run(&loud)).expect("utf-8");
-            let times = out.lines().find(|l| l.starts_with("time")).unwrap_or("");
-            eprintln!("cli_render {vis}: {times}");
-        }
+        print_stage_times("cli_render", vis, || run(&loud));
     }
     g.finish();
     let _ = std::fs::remove_dir_all(&dir);
@@ -93,14 +89,20 @@ fn cli_process(c: &mut Criterion) {
         g.bench_function(BenchmarkId::new("pot_1024", vis), |b| {
             b.iter(|| black_box(run(true)))
         });
-        for _ in 0..5 {
-            let out = String::from_utf8(run(false)).expect("utf-8");
-            let times = out.lines().find(|l| l.starts_with("time")).unwrap_or("");
-            eprintln!("cli_process {vis}: {times}");
-        }
+        print_stage_times("cli_process", vis, || run(false));
     }
     g.finish();
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The `time` line of five more runs' summaries, to standard error: the command's own
+/// account of its stages, after the warm-up (the figures to hold against `stages_1024`).
+fn print_stage_times(group: &str, vis: &str, mut run: impl FnMut() -> Vec<u8>) {
+    for _ in 0..5 {
+        let out = String::from_utf8(run()).expect("utf-8");
+        let times = out.lines().find(|l| l.starts_with("time")).unwrap_or("");
+        eprintln!("{group} {vis}: {times}");
+    }
 }
 
 criterion_group!(benches, cli_render, cli_process);

@@ -6,7 +6,7 @@
 //! grey), and a fresh process pays a page fault for every 4 KB it first writes: collecting
 //! the `f64` image only to map it to bytes at the end cost `cwisim render` about 4 ms of
 //! its "array in order" stage on the pot at 1024², and the mapping pass another 3 ms
-//! (docs/PERFORMANCE.md, "What the user runs").
+//! (docs/PERFORMANCE.md, "Fifth round: what the user runs").
 
 use crate::output::{png_sample, PngSamples};
 use cwisim_xproc::{Image, ImageLimit, ImageSink, LineOut, LineSink};
@@ -114,11 +114,7 @@ impl OutputSink {
 impl LineSink<f64> for OutputSink {
     fn line(&mut self, line: LineOut<'_, f64>) {
         if let Some(png) = &mut self.png {
-            png.line(LineOut {
-                index: line.index,
-                span: line.span,
-                values: line.values,
-            });
+            png.line(line);
         }
         if let Some(exact) = &mut self.exact {
             exact.line(line);

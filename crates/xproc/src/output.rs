@@ -6,6 +6,7 @@ use crate::sample::Sample;
 ///
 /// Only `span` may hold non-zero values; every pixel outside it is exactly `+0.0`. This
 /// lets an engine skip processors that no instruction reached.
+#[derive(Clone, Copy, Debug)]
 pub struct LineOut<'a, T> {
     /// Scanline number over the whole trace (frame × lines per frame + row).
     pub index: u64,

@@ -78,11 +78,11 @@ impl ImageArgs {
         )
     }
 
-    /// Writes the outputs asked for from what [`Self::sink`] collected (PNG checked
-    /// first, so that either both or neither is written when the PNG cannot be).
+    /// Writes the outputs asked for from what [`Self::sink`] collected, the PNG first:
+    /// it is checked before its file is made, so that either both or neither is written
+    /// when the PNG cannot be.
     pub fn write(&self, collected: &Collected) -> Result<(), CliError> {
         if let (Some(path), Some(samples)) = (&self.output, &collected.png) {
-            samples.check()?;
             output::write_png_samples(path, samples)?;
         }
         if let (Some(path), Some(image)) = (&self.npy, &collected.exact) {
