@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs Debian's Chromium for the browser test of `cwisim inspect`'s page
-# (crates/host/tests/browser.rs), when it is not installed yet. Run by .ci/run; run it by
-# hand once before `cargo test --workspace` on a new machine.
+# (crates/host/tests/browser.rs), when it is not installed yet. The test runs it itself when
+# it finds no Chromium, so `cargo test --workspace` needs nothing installed by hand; .ci/run
+# runs it first so that its output stands apart from the tests'.
 set -euo pipefail
 if command -v chromium >/dev/null 2>&1; then
     echo "chromium: $(chromium --version 2>/dev/null || echo present)"

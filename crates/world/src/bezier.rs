@@ -9,7 +9,7 @@
 //! `S(u, v) = Σ_row Σ_col B_row(v) · B_col(u) · points[row][col]` with the cubic
 //! Bernstein polynomials `B_k`. The normal is `∂S/∂u × ∂S/∂v`, normalized: seen from
 //! the side it points to, `u` grows to the right and `v` upward. On Newell's teapot
-//! ([`patches_from`] on `shared/data/teapot-spd.json`) that is outward on every patch.
+//! ([`patches_from`] on `tests/data/teapot-spd.json`, the project's copy of `shared/data/teapot-spd.json`) that is outward on every patch.
 //!
 //! Degenerate patches: the teapot's lid top and bottom collapse a whole row of control
 //! points to one point (a pole), where `∂S/∂u` vanishes; [`Patch::normal`] takes the
@@ -429,7 +429,7 @@ pub fn tessellate(patch: &Patch, n: usize) -> Grid {
 }
 
 /// Builds patches from control points and 4×4 index lists (row-major: entry `j` is
-/// `points[j / 4][j % 4]`), the shape of `shared/data/teapot-spd.json`'s `vertices` and
+/// `points[j / 4][j % 4]`), the shape of `tests/data/teapot-spd.json`'s `vertices` and
 /// `patches`.
 ///
 /// Errors name the fault: an index out of range (patch `k`, entry `j`), or a vertex that
@@ -475,14 +475,12 @@ mod tests {
         patch_groups: Vec<String>,
     }
 
-    const TEAPOT: &str = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../../shared/data/teapot-spd.json"
-    );
+    /// The project's copy of `shared/data/teapot-spd.json` (public domain), so that the
+    /// tests read nothing outside the repository.
+    const TEAPOT: &str = include_str!("../tests/data/teapot-spd.json");
 
     fn teapot_data() -> Teapot {
-        let text = std::fs::read_to_string(TEAPOT).unwrap_or_else(|e| panic!("{TEAPOT}: {e}"));
-        serde_json::from_str(&text).unwrap()
+        serde_json::from_str(TEAPOT).unwrap()
     }
 
     fn teapot() -> Vec<Patch> {
