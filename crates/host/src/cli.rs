@@ -18,8 +18,10 @@ use std::io::Write;
 use std::process::ExitCode;
 
 const AFTER_HELP: &str = "\
-Exit status: 0 on success, 2 for a malformed trace or machine file or bad arguments, \
-1 when an output could not be written. Errors are one line on standard error: \
+Exit status: 0 on success; 1 only from `diff`, when the two sides differ; 2 for bad input \
+(a malformed trace, scene or machine file, bad arguments, a size over a budget); 3 when an \
+output could not be written; 4 for an internal error (a bug in cwisim); 130 when \
+interrupted (partial outputs removed). Errors are one line on standard error: \
 `error: FILE:LINE:COL: …` (text, JSON Lines) or `error: FILE: byte N: …` (binary).";
 
 /// The `cwisim` command line.
@@ -166,10 +168,10 @@ and PSNR against the full-quality image (render --shading phong --aa box) and th
 list's bytes against a frame buffer's; then the naive sequence, every phase's renderer in full \
 (the paper's figure 1).\n\n\
 --plot draws error against cumulative cycles (with the naive sequence) and busy cycles per \
-scanline of each frame against the line period; --cost-images writes each phase's cost image; \
+scanline of each frame against the line period; --cost-image-dir writes each phase's cost image; \
 --frames-png each frame; --ids the polygon-ID view (which polygon owns each pixel: false-colour .png, or the identifiers as .npy); --sweep NAME=V1,V2,… repeats the run per value of one threshold. \
 docs/RENDERERS.md (\"refine\") and docs/REPRODUCTION.md have the results.\n\n\
-Example:\n  cwisim refine pot --plot quality.png --cost-images costs/",
+Example:\n  cwisim refine pot --plot quality.png --cost-image-dir costs/",
         after_help = AFTER_HELP
     )]
     Refine(refine::RefineArgs),
@@ -200,7 +202,7 @@ against the display's deadline; negative slack is an overrun, marked LATE. Print
 draws a PNG: one bar per scanline, its bus cycles stacked by opcode group (count × the \
 opcode's issue cost) with the stall cycles on top, the line period as a horizontal line, a \
 red marker on every overrun. --csv writes the table with a column for each of the 14 \
-opcodes; --json the selected scanlines' records, their sums, each opcode's issue cost and \
+opcodes; --stats-json the selected scanlines' records, their sums, each opcode's issue cost and \
 the run's totals.\n\n\
 Example:\n  cwisim stats traces/overrun.cwt --machine traces/overrun.machine.json --plot overrun.png",
         after_help = AFTER_HELP
@@ -304,8 +306,9 @@ Example:\n  cwisim machine --set clock_hz=2e8 --lines 768 > fast.json",
 }
 
 /// Runs `cwisim` with `args` (program name first, like [`std::env::args_os`]), writing
-/// to `stdout` and `stderr`, and returns the exit code: 0 on success, 2 for bad input or
-/// usage, 1 when an output could not be written.
+/// to `stdout` and `stderr`, and returns the exit code ([`crate::error`]'s constants: 0 on
+/// success, 1 only for `diff`'s "different", 2 for bad input or usage, 3 when an output
+/// could not be written, 4 for an internal error).
 ///
 /// `--help` and `--version` go to `stdout` (exit 0); usage errors to `stderr` (exit 2).
 /// Every other error is one line, `error: <message>`, on `stderr`.
@@ -329,17 +332,31 @@ pub fn run_cli_with(
         Ok(cli) => cli,
         Err(e) => {
             let text = e.render().to_string();
-            let stream: &mut dyn Write = if e.use_stderr() {
-                &mut *stderr
-            } else {
-                &mut *stdout
+            if e.use_stderr() {
+                let _ = stderr.write_all(text.as_bytes());
+                let _ = stderr.flush();
+                return u8::try_from(e.exit_code()).unwrap_or(crate::error::EXIT_BAD_INPUT);
+            }
+            // --help and --version: a closed pipe is fine, a full disk is a failure
+            return match stdout.write_all(text.as_bytes()).and_then(|()| stdout.flush()) {
+                Ok(()) => 0,
+                Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => 0,
+                Err(e) => {
+                    let _ = writeln!(stderr, "error: {}", CliError::Stdout(e).one_line());
+                    crate::error::EXIT_WRITE_FAILED
+                }
             };
-            let _ = stream.write_all(text.as_bytes());
-            let _ = stream.flush();
-            return u8::try_from(e.exit_code()).unwrap_or(crate::error::EXIT_BAD_INPUT);
         }
     };
-    match dispatch(&cli.command, stdout, stderr, progress) {
+    let result = crate::files::transaction(|| {
+        let code = dispatch(&cli.command, stdout, stderr, progress)?;
+        // what is still buffered: a reader gone keeps the command's code (`diff`'s 1)
+        match stdout.flush() {
+            Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(CliError::Stdout(e)),
+            _ => Ok(code),
+        }
+    });
+    match result {
         Ok(code) => code,
         // The reader went away (`cwisim dump t.cwb | head`): nothing more to say.
         Err(CliError::Stdout(e)) if e.kind() == std::io::ErrorKind::BrokenPipe => 0,
@@ -348,6 +365,49 @@ pub fn run_cli_with(
             let _ = stderr.flush();
             e.exit_code()
         }
+    }
+}
+
+/// Standard output for a command whose exit code is its answer (`diff`): when the reader
+/// goes away (`cwisim diff a b | head -1`) the rest of the report is dropped and the
+/// command still finishes, so its code says "different" even under `pipefail`. Any other
+/// write error still fails.
+struct ReaderMayLeave<'a> {
+    inner: &'a mut dyn Write,
+    gone: bool,
+}
+
+impl<'a> ReaderMayLeave<'a> {
+    fn new(inner: &'a mut dyn Write) -> Self {
+        ReaderMayLeave { inner, gone: false }
+    }
+
+    fn guard<T>(&mut self, done: T, r: std::io::Result<T>) -> std::io::Result<T> {
+        match r {
+            Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {
+                self.gone = true;
+                Ok(done)
+            }
+            other => other,
+        }
+    }
+}
+
+impl Write for ReaderMayLeave<'_> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        if self.gone {
+            return Ok(buf.len());
+        }
+        let r = self.inner.write(buf);
+        self.guard(buf.len(), r)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        if self.gone {
+            return Ok(());
+        }
+        let r = self.inner.flush();
+        self.guard((), r)
     }
 }
 
@@ -372,14 +432,16 @@ fn dispatch(
         Command::History(args) => history::run(args, stdout).map(|()| 0),
         Command::Inspect(args) => inspect::run(args, stdout).map(|()| 0),
         Command::Vcd(args) => vcd::run(args).map(|()| 0),
-        // equal: 0, different: 1
-        Command::Diff(args) => diff::run(args, stdout).map(|equal| u8::from(!equal)),
+        // equal: 0, different: 1, even when the reader of the report went away
+        Command::Diff(args) => diff::run(args, &mut ReaderMayLeave::new(stdout))
+            .map(|equal| if equal { 0 } else { crate::error::EXIT_DIFFERENT }),
         Command::Dump(args) => dump::run(args, stdout).map(|()| 0),
     }
 }
 
 /// The `cwisim` program: [`run_cli`] on the process's arguments and standard streams.
 pub fn main() -> ExitCode {
+    crate::files::install_interrupt_cleanup();
     let code = run_cli(
         std::env::args_os(),
         &mut std::io::stdout(),

@@ -22,6 +22,10 @@ pub struct CostArgs {
 
 /// Refuses an output whose extension is not `ext` (case-insensitive).
 pub fn check_extension(flag: &str, path: &Path, ext: &str) -> Result<(), CliError> {
+    if crate::files::is_special(path) {
+        // a device or FIFO (`/dev/null`, `/dev/stdout`) has no extension to check
+        return Ok(());
+    }
     let got = path.extension().and_then(|e| e.to_str()).unwrap_or("");
     if got.eq_ignore_ascii_case(ext) {
         Ok(())

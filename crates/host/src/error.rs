@@ -7,11 +7,20 @@ use cwisim_study::StudyError;
 use cwisim_xproc::{ImageLimit, MachineError, ReplayError};
 use std::path::PathBuf;
 
-/// Exit code for bad input or usage: a malformed trace or machine file, bad arguments.
+/// Exit code of `cwisim diff` when the two sides differ — and of nothing else, so that a
+/// snapshot check can tell "different" from every failure.
+pub const EXIT_DIFFERENT: u8 = 1;
+/// Exit code for bad input or usage: a malformed trace, scene or machine file, bad
+/// arguments, or a size over a budget.
 pub const EXIT_BAD_INPUT: u8 = 2;
-/// Exit code when the input was fine but an output could not be written, or cwisim
-/// itself failed (an internal fault: a bug, never the input's doing).
-pub const EXIT_OUTPUT_FAILED: u8 = 1;
+/// Exit code when the input was fine but an output could not be written (a file, or
+/// standard output: a full disk, a read-only directory, `/dev/full`).
+pub const EXIT_WRITE_FAILED: u8 = 3;
+/// Exit code when cwisim itself failed: an internal fault, a bug, never the input's doing.
+pub const EXIT_INTERNAL: u8 = 4;
+/// Exit code of a command interrupted by SIGINT, SIGTERM or SIGHUP (128 + SIGINT, as
+/// shells report it); its partial outputs are removed and no old file is replaced.
+pub const EXIT_INTERRUPTED: u8 = 130;
 
 /// Why a command failed. Every message is one line and names the file involved.
 #[derive(Debug, thiserror::Error)]
@@ -91,7 +100,8 @@ impl From<ReplayError> for CliError {
 
 impl CliError {
     /// The process exit code: [`EXIT_BAD_INPUT`] (2) for bad input or usage,
-    /// [`EXIT_OUTPUT_FAILED`] (1) when writing an output failed or cwisim itself failed.
+    /// [`EXIT_WRITE_FAILED`] (3) when writing an output failed, [`EXIT_INTERNAL`] (4) when
+    /// cwisim itself failed.
     pub fn exit_code(&self) -> u8 {
         match self {
             CliError::Trace(_)
@@ -99,9 +109,8 @@ impl CliError {
             | CliError::Scene(_)
             | CliError::ImageLimit(_)
             | CliError::Usage(_) => EXIT_BAD_INPUT,
-            CliError::Write { .. } | CliError::Stdout(_) | CliError::Internal(_) => {
-                EXIT_OUTPUT_FAILED
-            }
+            CliError::Write { .. } | CliError::Stdout(_) => EXIT_WRITE_FAILED,
+            CliError::Internal(_) => EXIT_INTERNAL,
         }
     }
 
@@ -154,9 +163,11 @@ mod tests {
         assert_eq!(e.one_line(), "first second");
         let e = CliError::write("out.png", std::io::Error::other("disk full"));
         assert_eq!(e.one_line(), "out.png: cannot write: disk full");
-        assert_eq!(e.exit_code(), 1);
+        assert_eq!(e.exit_code(), EXIT_WRITE_FAILED);
+        let e = CliError::Stdout(std::io::Error::other("disk full"));
+        assert_eq!(e.exit_code(), EXIT_WRITE_FAILED);
         let e: CliError = RenderError::Array(std::io::Error::other("refused")).into();
-        assert_eq!(e.exit_code(), 1);
+        assert_eq!(e.exit_code(), EXIT_INTERNAL);
         assert!(
             e.one_line().starts_with("internal error"),
             "{}",

@@ -1,49 +1,271 @@
 //! Writing output files all-or-nothing, and telling whether two paths name one file.
+//!
+//! Every output of a command goes through [`write_atomic`]:
+//!
+//! - A **regular file** (or a new path) is written to a hidden sibling (`.NAME.partial`)
+//!   and renamed over the path only when the whole command succeeded: inside
+//!   [`transaction`] (which `cwisim`'s dispatch wraps around every command) the renames
+//!   wait for the command's end, so the outputs of one command are all written or none is
+//!   (`render -o old.png --npy ro/x.npy` keeps `old.png` when the NumPy file cannot be
+//!   made).
+//! - A **symbolic link** is followed: its target is what gets written (replaced the same
+//!   way), and the link stays a link.
+//! - A **device, FIFO or socket** (`/dev/null`, `/dev/stdout`, a named pipe) is written in
+//!   place, as its bytes are made: it is never replaced by a regular file, and what it was
+//!   sent cannot be taken back.
+//! - An **interrupted** command (SIGINT, SIGTERM) removes every partial file it had made
+//!   ([`install_interrupt_cleanup`]) and exits with [`crate::error::EXIT_INTERRUPTED`].
 
 use crate::error::CliError;
-use std::fs::File;
+use std::cell::RefCell;
+use std::fs::{File, OpenOptions};
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
-/// Writes `path` through `fill`, all or nothing.
+/// Every partial file alive in the process, on any thread: what an interruption removes.
+static LIVE_PARTIALS: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+fn register_partial(path: &Path) {
+    if let Ok(mut live) = LIVE_PARTIALS.lock() {
+        live.push(path.to_path_buf());
+    }
+}
+
+fn unregister_partial(path: &Path) {
+    if let Ok(mut live) = LIVE_PARTIALS.lock() {
+        if let Some(i) = live.iter().rposition(|p| p == path) {
+            live.swap_remove(i);
+        }
+    }
+}
+
+/// A hidden file beside an output that holds bytes before they are final (the partial of
+/// [`write_atomic`], the scanline records of `--stats-json`). Registered so that an
+/// interruption removes it; removed when dropped unless [`Self::persist`] renamed it.
+pub struct PartialFile {
+    path: PathBuf,
+    done: bool,
+}
+
+impl PartialFile {
+    /// Creates (or truncates) `path`, registered for removal.
+    pub fn create(path: PathBuf) -> io::Result<(PartialFile, File)> {
+        register_partial(&path);
+        let partial = PartialFile { path, done: false };
+        let file = File::create(&partial.path)?;
+        Ok((partial, file))
+    }
+
+    /// Its path.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Renames it to `target`; on failure it is still removed when dropped.
+    fn persist(mut self, target: &Path) -> io::Result<()> {
+        std::fs::rename(&self.path, target)?;
+        self.done = true;
+        unregister_partial(&self.path);
+        Ok(())
+    }
+}
+
+impl Drop for PartialFile {
+    fn drop(&mut self) {
+        if !self.done {
+            let _ = std::fs::remove_file(&self.path);
+            unregister_partial(&self.path);
+        }
+    }
+}
+
+/// Removes every partial file on SIGINT or SIGTERM (SIGHUP too), then exits with
+/// [`crate::error::EXIT_INTERRUPTED`]: an interrupted command leaves nothing behind and
+/// replaces nothing. Installed once by `cwisim`'s `main`; a second call does nothing.
+pub fn install_interrupt_cleanup() {
+    let _ = ctrlc::set_handler(|| {
+        if let Ok(live) = LIVE_PARTIALS.lock() {
+            for p in live.iter() {
+                let _ = std::fs::remove_file(p);
+            }
+        }
+        let _ = writeln!(io::stderr(), "error: interrupted; no output was written");
+        std::process::exit(i32::from(crate::error::EXIT_INTERRUPTED));
+    });
+}
+
+/// The regular files written by [`write_atomic`] inside the [`transaction`] of this
+/// thread, waiting for its end to be renamed over their paths.
+type Pending = Vec<(PartialFile, PathBuf)>;
+
+thread_local! {
+    static TRANSACTION: RefCell<Option<Pending>> = const { RefCell::new(None) };
+}
+
+/// Runs `command` so that the outputs it writes with [`write_atomic`] (on this thread) are
+/// all-or-nothing: each is written to its partial file as the command goes, and only when
+/// `command` returns `Ok` are they renamed over their paths, in the order written. On an
+/// error nothing is renamed and every partial is removed. Devices and FIFOs are written in
+/// place and are not held back. Not reentrant: an inner transaction joins the outer one.
+pub fn transaction<T>(command: impl FnOnce() -> Result<T, CliError>) -> Result<T, CliError> {
+    let outer = TRANSACTION.with(|t| t.borrow().is_some());
+    if outer {
+        return command();
+    }
+    TRANSACTION.with(|t| *t.borrow_mut() = Some(Vec::new()));
+    let result = command();
+    let pending = TRANSACTION
+        .with(|t| t.borrow_mut().take())
+        .unwrap_or_default();
+    let value = result?;
+    // the renames: every partial is complete and synced; a rename fails only when the
+    // directory changed under us, and then the rest are still removed on drop
+    for (partial, target) in pending {
+        partial
+            .persist(&target)
+            .map_err(|e| CliError::write(&target, e))?;
+    }
+    Ok(value)
+}
+
+/// Renames every output the current [`transaction`] holds over its path now, so that it
+/// stays even though the command then fails: `run --keep-partial` keeps the image of the
+/// scanlines completed before a bad instruction, and still exits 2. Outside a transaction
+/// there is nothing pending.
+pub fn commit_pending() -> Result<(), CliError> {
+    let pending = TRANSACTION.with(|t| t.borrow_mut().as_mut().map(std::mem::take));
+    for (partial, target) in pending.unwrap_or_default() {
+        partial
+            .persist(&target)
+            .map_err(|e| CliError::write(&target, e))?;
+    }
+    Ok(())
+}
+
+/// Where writing `path` really goes: symbolic links followed (to a target that need not
+/// exist yet), at most 40 deep.
+pub fn resolve_output(path: &Path) -> Result<PathBuf, CliError> {
+    let mut current = path.to_path_buf();
+    for _ in 0..40 {
+        match std::fs::symlink_metadata(&current) {
+            Ok(m) if m.file_type().is_symlink() => {
+                let link = std::fs::read_link(&current).map_err(|e| CliError::write(path, e))?;
+                current = match current.parent() {
+                    Some(dir) if link.is_relative() => dir.join(link),
+                    _ => link,
+                };
+            }
+            _ => return Ok(current),
+        }
+    }
+    Err(CliError::write(
+        path,
+        io::Error::other("too many levels of symbolic links"),
+    ))
+}
+
+/// What kind of thing an output path names, after [`resolve_output`].
+enum OutputKind {
+    /// Nothing yet, or a regular file: written all-or-nothing.
+    Regular,
+    /// A device, FIFO or socket: written in place.
+    InPlace,
+}
+
+/// `path`'s kind; `stat` follows every link, the kernel's `/proc/self/fd` links included.
+fn output_kind(path: &Path) -> Result<OutputKind, CliError> {
+    match std::fs::metadata(path) {
+        Ok(m) if m.is_dir() => Err(CliError::write(
+            path,
+            io::Error::new(io::ErrorKind::IsADirectory, "is a directory"),
+        )),
+        Ok(m) if !m.is_file() => Ok(OutputKind::InPlace),
+        _ => Ok(OutputKind::Regular),
+    }
+}
+
+/// True when `path` names an existing device, FIFO or socket (after links): an output
+/// written in place, whose name need not carry the format's extension.
+pub fn is_special(path: &Path) -> bool {
+    matches!(output_kind(path), Ok(OutputKind::InPlace))
+}
+
+/// Writes `path` through `fill`, all or nothing (see the module's documentation).
 ///
-/// The bytes go to a hidden sibling file (`.NAME.partial`) that is renamed over `path` only
-/// once `fill` succeeded and everything was flushed; on any error it is removed, so an
-/// interrupted or failed command never leaves a half-written output (nor clobbers an
-/// existing one).
+/// A regular file's bytes go to a hidden sibling (`.NAME.partial`), flushed and synced,
+/// then renamed over the path: at once outside a [`transaction`], at its successful end
+/// inside one. On any error the partial is removed and the old file is untouched. A
+/// symbolic link is followed; a device or FIFO is written in place.
 pub fn write_atomic<F>(path: &Path, fill: F) -> Result<(), CliError>
 where
     F: FnOnce(&mut dyn Write) -> Result<(), CliError>,
 {
-    let tmp = partial_path(path)?;
-    let file = File::create(&tmp).map_err(|e| CliError::write(path, e))?;
-    let mut out = BufWriter::new(file);
-    let result = fill(&mut out).and_then(|()| {
-        let file = out
-            .into_inner()
-            .map_err(|e| CliError::write(path, e.into_error()))?;
-        file.sync_all().map_err(|e| CliError::write(path, e))?;
-        drop(file);
-        std::fs::rename(&tmp, path).map_err(|e| CliError::write(path, e))
-    });
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
+    if let OutputKind::InPlace = output_kind(path)? {
+        let file = OpenOptions::new()
+            .write(true)
+            .open(path)
+            .map_err(|e| CliError::write(path, e))?;
+        let mut out = BufWriter::new(file);
+        fill(&mut out)?;
+        return out
+            .flush()
+            .map_err(|e| CliError::write(path, e));
     }
-    result
+    let target = resolve_output(path)?;
+    let (partial, file) =
+        PartialFile::create(partial_path(&target, path)?).map_err(|e| CliError::write(path, e))?;
+    let mut out = BufWriter::new(file);
+    fill(&mut out)?;
+    let file = out
+        .into_inner()
+        .map_err(|e| CliError::write(path, e.into_error()))?;
+    file.sync_all().map_err(|e| CliError::write(path, e))?;
+    drop(file);
+    let held = TRANSACTION.with(|t| match t.borrow_mut().as_mut() {
+        Some(pending) => {
+            pending.push((partial, target.clone()));
+            None
+        }
+        None => Some(partial),
+    });
+    match held {
+        Some(partial) => partial.persist(&target).map_err(|e| CliError::write(path, e)),
+        None => Ok(()),
+    }
 }
 
-/// The temporary sibling `write_atomic` fills before renaming it to `path`.
-fn partial_path(path: &Path) -> Result<PathBuf, CliError> {
-    let name = path.file_name().ok_or_else(|| {
+/// The temporary sibling `write_atomic` fills before renaming it to `target` (`shown` is
+/// the path as the user gave it, for messages).
+fn partial_path(target: &Path, shown: &Path) -> Result<PathBuf, CliError> {
+    let name = target.file_name().ok_or_else(|| {
         CliError::write(
-            path,
+            shown,
             io::Error::new(io::ErrorKind::InvalidInput, "the output path names no file"),
         )
     })?;
     let mut tmp = std::ffi::OsString::from(".");
     tmp.push(name);
     tmp.push(".partial");
-    Ok(path.with_file_name(tmp))
+    Ok(target.with_file_name(tmp))
+}
+
+/// Checks, before any work, that `path` can be written: its directory exists and takes a
+/// new file (a probe file is made and removed at once), or it is a device or FIFO. So a
+/// command whose output cannot be written fails at its start, not after the whole render.
+pub fn check_writable(path: &Path) -> Result<(), CliError> {
+    if let OutputKind::InPlace = output_kind(path)? {
+        return Ok(());
+    }
+    let target = resolve_output(path)?;
+    let probe = partial_path(&target, path)?;
+    let mut name = probe.file_name().unwrap_or_default().to_os_string();
+    name.push(format!(".probe-{}", std::process::id()));
+    let probe = probe.with_file_name(name);
+    let (partial, file) = PartialFile::create(probe).map_err(|e| CliError::write(path, e))?;
+    drop(file);
+    drop(partial);
+    Ok(())
 }
 
 /// True when `a` and `b` name the same file, also when the file does not exist yet
@@ -67,7 +289,8 @@ fn resolve(p: &Path) -> PathBuf {
     }
 }
 
-/// Refuses outputs that would overwrite the input or one another. `input` is what is read
+/// Refuses outputs that would overwrite the input or one another, and outputs that cannot
+/// be written at all ([`check_writable`]), before any work is done. `input` is what is read
 /// and what to call it in the message (`"trace being read"`, `"scene"`); `outputs` pairs
 /// each option (`-o`, `--npy`, …) with the path it was given, if any.
 pub fn check_outputs(
@@ -88,13 +311,16 @@ pub fn check_outputs(
             }
         }
         for (other, other_path) in &given[..i] {
-            if same_file(path, other_path) {
+            if same_file(path, other_path) && !is_special(path) {
                 return Err(CliError::Usage(format!(
                     "{other} and {flag} both name {}; give each output its own file",
                     path.display()
                 )));
             }
         }
+    }
+    for (_, path) in &given {
+        check_writable(path)?;
     }
     Ok(())
 }

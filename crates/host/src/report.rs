@@ -6,7 +6,7 @@ use cwisim_xproc::{LineStats, Machine, RunStats, Timing};
 use serde::Serialize;
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// The name of a timing model on the command line and in reports.
 pub fn timing_name(timing: Timing) -> &'static str {
@@ -93,7 +93,7 @@ impl StatsReport<'_> {
 /// objects indented as the elements of `stats.lines`, separated by `,\n`. Removed when
 /// dropped.
 pub struct LineSpill {
-    path: PathBuf,
+    file: crate::files::PartialFile,
     out: Option<BufWriter<File>>,
     count: u64,
     error: Option<io::Error>,
@@ -109,11 +109,20 @@ impl LineSpill {
         let mut hidden = std::ffi::OsString::from(".");
         hidden.push(name);
         hidden.push(".lines.partial");
-        let path = output.with_file_name(hidden);
-        let file = File::create(&path)?;
+        let path = if crate::files::is_special(output) {
+            // beside a device or FIFO there may be no room for a file: the temporary
+            // directory instead
+            hidden.push(format!(".{}", std::process::id()));
+            std::env::temp_dir().join(hidden)
+        } else {
+            let target = crate::files::resolve_output(output)
+                .map_err(|e| io::Error::other(e.one_line()))?;
+            target.with_file_name(hidden)
+        };
+        let (file, out) = crate::files::PartialFile::create(path)?;
         Ok(LineSpill {
-            path,
-            out: Some(BufWriter::new(file)),
+            file,
+            out: Some(BufWriter::new(out)),
             count: 0,
             error: None,
             buf: Vec::new(),
@@ -167,7 +176,7 @@ impl LineSpill {
             .into_inner()
             .map_err(|e| e.into_error())?;
         drop(file);
-        let mut file = File::open(&self.path)?;
+        let mut file = File::open(self.file.path())?;
         io::copy(&mut file, out)?;
         Ok(())
     }
@@ -175,8 +184,8 @@ impl LineSpill {
 
 impl Drop for LineSpill {
     fn drop(&mut self) {
+        // closed before its `PartialFile` removes it
         self.out = None;
-        let _ = std::fs::remove_file(&self.path);
     }
 }
 
@@ -185,6 +194,38 @@ pub fn unrefreshed_warning(stats: &RunStats) -> Option<String> {
     let n = stats.totals.unrefreshed_instructions;
     (n > 0).then(|| {
         format!("warning: {n} instruction(s) after the last Refresh never reached the output (add a Refresh to see them)")
+    })
+}
+
+/// The overflow events of a narrow numeric format, in words: how many, in how many
+/// scanlines, and the first scanline that had one (from the per-scanline records, when
+/// they were kept). `None` when there were none.
+pub fn overflow_note(stats: &RunStats) -> Option<String> {
+    let n = stats.totals.overflows;
+    if n == 0 {
+        return None;
+    }
+    let mut hit = stats.lines.iter().filter(|l| l.overflows > 0);
+    Some(match hit.next() {
+        Some(first) => format!(
+            "{n} overflow event(s) in {} scanline(s), the first in scanline {} (the registers are too narrow: see `cwisim fit`)",
+            1 + hit.count(),
+            first.line
+        ),
+        None => format!(
+            "{n} overflow event(s) (the registers are too narrow: see `cwisim fit`)"
+        ),
+    })
+}
+
+/// When every scanline is late because a token cannot even cross the array within one
+/// line period, the reason in words.
+pub fn late_reason(stats: &RunStats) -> Option<String> {
+    (stats.totals.late_lines > 0 && stats.traversal_cycles >= stats.line_period).then(|| {
+        format!(
+            "a token needs {} cycles to cross the array, not less than the line period of {} cycles: no scanline can be ready in time (a narrower image, a faster clock or a longer line period)",
+            stats.traversal_cycles, stats.line_period
+        )
     })
 }
 
@@ -230,7 +271,10 @@ pub fn write_summary(
             t.lines, t.frames, t.partial_frame_lines
         ),
     )?;
-    row(out, "late lines", &t.late_lines)?;
+    match late_reason(stats) {
+        Some(why) => row(out, "late lines", &format!("{} ({why})", t.late_lines))?,
+        None => row(out, "late lines", &t.late_lines)?,
+    }
     let worst = match (t.worst_slack, t.worst_line) {
         (Some(s), Some(l)) => format!("{s} cycles (line {l})"),
         _ => "- (no scanline)".to_string(),
@@ -239,6 +283,10 @@ pub fn write_summary(
     row(out, "processor updates", &t.processor_updates)?;
     row(out, "dropped negatives", &t.dropped_negative)?;
     row(out, "suppressed", &t.suppressed)?;
+    match overflow_note(stats) {
+        Some(note) => row(out, "overflows", &note)?,
+        None => row(out, "overflows", &0)?,
+    }
     row(out, "unrefreshed instructions", &t.unrefreshed_instructions)?;
     Ok(())
 }
@@ -271,7 +319,8 @@ mod tests {
         assert!(!text.contains("Eval3"), "{text}");
         assert!(text.contains("unrefreshed instructions  1\n"), "{text}");
         assert!(text.contains("(line 0)"), "{text}");
-        assert_eq!(text.lines().count(), 16, "{text}");
+        assert!(text.contains("overflows                 0\n"), "{text}");
+        assert_eq!(text.lines().count(), 17, "{text}");
     }
 
     #[test]

@@ -171,6 +171,15 @@ pub fn write_render_summary(
             ),
         )?;
     }
+    if let Some(why) = crate::report::late_reason(stats) {
+        row(out, "late", why)?;
+    }
+    match crate::report::overflow_note(stats) {
+        Some(note) => row(out, "overflows", note)?,
+        // narrow registers that held: say so too (f64 counts none)
+        None if *numeric != Numeric::F64 => row(out, "overflows", format!("none in {numeric}"))?,
+        None => {}
+    }
     let stages = d.renderer.stage_times();
     let total = t.load
         + stages.iter().map(|(_, d)| *d).sum::<Duration>()

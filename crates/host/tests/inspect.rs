@@ -1,7 +1,7 @@
 //! `cwisim inspect`: the page's embedded data read back and held to the other tools'
 //! outputs — the image to `run --npy`, the costs to `--cost-npy`, every history of the
 //! window to `cwisim history`, every scanline's disassembly to `cwisim dump`, the
-//! timeline to `stats --json` — and the same input giving the same bytes. The page in a
+//! timeline to `stats --stats-json` — and the same input giving the same bytes. The page in a
 //! real browser is `tests/browser.rs`.
 
 mod common;
@@ -195,7 +195,7 @@ fn the_timeline_is_stats_figures() {
     let (t, m) = (trace.to_str().unwrap(), machine.to_str().unwrap());
     let said = cwisim_ok(&dir, &["inspect", t, "--machine", m, "-o", "o.html"]);
     assert!(said.contains("1 late scanline(s)"), "{said}");
-    cwisim_ok(&dir, &["stats", t, "--machine", m, "--json", "s.json"]);
+    cwisim_ok(&dir, &["stats", t, "--machine", m, "--stats-json", "s.json"]);
     let stats: Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("s.json")).unwrap()).unwrap();
     let data = page(&dir, "o.html");

@@ -23,7 +23,7 @@ fn refine_prints_the_phase_table_and_writes_its_files() {
             "t.cwb",
             "--frames-png",
             "frames",
-            "--cost-images",
+            "--cost-image-dir",
             "costs",
         ],
     );

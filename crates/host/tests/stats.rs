@@ -120,7 +120,7 @@ fn the_table_and_json_equal_the_stats_json_of_run() {
     let run = json(dir.join("run.json"));
     let out = cwisim_ok(
         &dir,
-        &overrun_args(&["--json", "s.json", "--csv", "s.csv"], &t, &m),
+        &overrun_args(&["--stats-json", "s.json", "--csv", "s.csv"], &t, &m),
     );
     let records = run["stats"]["lines"].as_array().expect("lines");
     let tab = table(&out);
@@ -230,7 +230,7 @@ fn every_checked_in_trace_matches_run_on_both_timings() {
         assert!(out.status.success(), "{}", text(&out).1);
         let run = json(dir.join("run.json"));
         for timing in ["fast", "stepped"] {
-            let args = with(&["stats", &t, "--json", "s.json", "--timing", timing]);
+            let args = with(&["stats", &t, "--stats-json", "s.json", "--timing", timing]);
             let args: Vec<&str> = args.iter().map(String::as_str).collect();
             let out = cwisim(&dir, &args);
             assert!(out.status.success(), "{}", text(&out).1);
@@ -254,7 +254,7 @@ fn a_scene_is_rendered_first_like_render_does() {
     let render = json(dir.join("render.json"));
     let out = cwisim_ok(
         &dir,
-        &["stats", &scene, "--json", "s.json", "--csv", "s.csv"],
+        &["stats", &scene, "--stats-json", "s.json", "--csv", "s.csv"],
     );
     let records = render["stats"]["lines"].as_array().expect("lines");
     assert_eq!(records.len(), 14);
@@ -299,7 +299,7 @@ fn lines_selects_exactly_the_range() {
         let out = cwisim_ok(
             &dir,
             &overrun_args(
-                &["--lines", range, "--csv", "s.csv", "--json", "s.json"],
+                &["--lines", range, "--csv", "s.csv", "--stats-json", "s.json"],
                 &t,
                 &m,
             ),
@@ -370,7 +370,7 @@ fn the_plot_decodes_and_is_deterministic() {
 fn outputs_are_deterministic_and_hold_no_paths() {
     let dir = scratch("stats-determinism");
     let (t, m) = (trace("overrun.cwt"), trace("overrun.machine.json"));
-    let args = overrun_args(&["--json", "s.json", "--csv", "s.csv"], &t, &m);
+    let args = overrun_args(&["--stats-json", "s.json", "--csv", "s.csv"], &t, &m);
     let first = cwisim_ok(&dir, &args);
     let (j, c) = (read(dir.join("s.json")), read(dir.join("s.csv")));
     assert_eq!(first, cwisim_ok(&dir, &args));
@@ -414,7 +414,7 @@ fn bad_input_exits_2_with_one_error_line() {
             "would overwrite the input",
         ),
         (
-            &["stats", "t.cwt", "--csv", "o.x", "--json", "./o.x"],
+            &["stats", "t.cwt", "--csv", "o.x", "--stats-json", "./o.x"],
             "both name",
         ),
         (&["stats", "missing.cwt"], "error: missing.cwt: cannot open"),

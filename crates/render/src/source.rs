@@ -23,11 +23,19 @@ pub enum Source {
 
 impl Source {
     /// A file if `arg` names one; otherwise the embedded scene of that name; none: the
-    /// default scene.
+    /// default scene. A trace file (`.cwt`, `.jsonl`, `.cwb`) is refused, saying so: it
+    /// is not a scene, whatever JSON parser error reading it as one would give.
     pub fn resolve(arg: Option<&Path>) -> Result<Source, RenderError> {
         let Some(arg) = arg else {
             return Ok(Source::Embedded(DEFAULT_SCENE));
         };
+        if cwisim_isa::Encoding::from_path(arg).is_ok() {
+            return Err(RenderError::Usage(format!(
+                "{}: a trace, not a scene: this command draws a scene (a .json scene file or an embedded scene's name; `cwisim scenes` lists them); `cwisim run {}` replays a trace",
+                arg.display(),
+                arg.display()
+            )));
+        }
         if arg.exists() {
             return Ok(Source::File(arg.to_path_buf()));
         }

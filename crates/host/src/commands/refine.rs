@@ -64,7 +64,7 @@ pub struct RefineArgs {
     pub frames_png: Option<PathBuf>,
     /// Write each phase's cost image (instructions per pixel) as DIR/phase-K-NAME-cost.png.
     #[arg(long, value_name = "DIR")]
-    pub cost_images: Option<PathBuf>,
+    pub cost_image_dir: Option<PathBuf>,
     /// Write the polygon-ID view: which polygon of the display list owns each pixel
     /// (the paper's ID buffer), as a false-colour .png or the identifiers as .npy
     /// (uint32; 0 none, k the display list's polygon k-1).
@@ -106,7 +106,7 @@ fn create_dir(flag: &str, dir: &Path) -> Result<(), CliError> {
 fn default_plot(args: &RefineArgs) -> Result<Option<PathBuf>, CliError> {
     let any = args.trace.is_some()
         || args.frames_png.is_some()
-        || args.cost_images.is_some()
+        || args.cost_image_dir.is_some()
         || args.csv.is_some()
         || args.ids.is_some()
         || args.plot.is_some();
@@ -145,7 +145,7 @@ pub fn run(args: &RefineArgs, stdout: &mut dyn Write, progress: bool) -> Result<
         for (flag, given) in [
             ("--trace", args.trace.is_some()),
             ("--frames-png", args.frames_png.is_some()),
-            ("--cost-images", args.cost_images.is_some()),
+            ("--cost-image-dir", args.cost_image_dir.is_some()),
             ("--ids", args.ids.is_some()),
         ] {
             if given {
@@ -194,7 +194,7 @@ pub fn run(args: &RefineArgs, stdout: &mut dyn Write, progress: bool) -> Result<
             phases: phases.clone(),
             machine: machine.clone(),
             naive: k == 0,
-            cost_maps: args.cost_images.is_some(),
+            cost_maps: args.cost_image_dir.is_some(),
             ids: args.ids.is_some(),
         };
         let mut report = |lines: u64| bar.update(done_before + lines);
@@ -232,8 +232,8 @@ pub fn run(args: &RefineArgs, stdout: &mut dyn Write, progress: bool) -> Result<
             write_png(&dir.join(format!("{}.png", stem(k, first))), frame)?;
         }
     }
-    if let Some(dir) = &args.cost_images {
-        create_dir("--cost-images", dir)?;
+    if let Some(dir) = &args.cost_image_dir {
+        create_dir("--cost-image-dir", dir)?;
         for (k, map) in first.cost_maps.iter().enumerate() {
             let name = format!("{}, {}", first.scene, stem(k, first));
             let img = render_cost_image(map, &name)?;

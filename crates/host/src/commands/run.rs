@@ -164,6 +164,8 @@ pub fn run(
                     "no scanline was completed before the error: no image written".to_string()
                 } else {
                     args.image.write(&collected)?;
+                    // kept although the command fails: what --keep-partial asks for
+                    crate::files::commit_pending()?;
                     format!(
                         "the image is incomplete: it holds the {} scanline(s) completed \
 before the error (a frame has {})",

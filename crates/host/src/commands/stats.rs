@@ -49,9 +49,10 @@ pub struct StatsArgs {
     #[arg(long, value_name = "OUT.csv")]
     pub csv: Option<PathBuf>,
 
-    /// Write the selected scanlines' records, their sums and the run's totals as JSON.
-    #[arg(long, value_name = "OUT.json")]
-    pub json: Option<PathBuf>,
+    /// Write the selected scanlines' records, their sums and the run's totals as JSON
+    /// (the same flag as `run --stats-json` and `render --stats-json`).
+    #[arg(long = "stats-json", value_name = "OUT.json")]
+    pub stats_json: Option<PathBuf>,
 
     /// The machine model.
     #[command(flatten)]
@@ -116,7 +117,7 @@ impl Selected {
     }
 }
 
-/// The `--json` document. Deterministic: the input's file name only, no times.
+/// The `--stats-json` document. Deterministic: the input's file name only, no times.
 #[derive(Debug, Serialize)]
 pub struct StatsDocument<'a> {
     /// The input's file name.
@@ -230,7 +231,7 @@ pub fn run(
                 .map_err(|e| CliError::write(path, e))
         })?;
     }
-    if let Some(path) = &args.json {
+    if let Some(path) = &args.stats_json {
         let cost = issue_costs(&timeline);
         let doc = StatsDocument {
             input: name.clone(),
@@ -275,7 +276,7 @@ fn check_outputs(args: &StatsArgs) -> Result<(), CliError> {
         &[
             ("--plot", args.plot.as_deref()),
             ("--csv", args.csv.as_deref()),
-            ("--json", args.json.as_deref()),
+            ("--stats-json", args.stats_json.as_deref()),
         ],
     )
 }
