@@ -17,6 +17,17 @@ pub enum Location {
     Byte(u64),
     /// The file as a whole (opening it, choosing its encoding).
     File,
+    /// The end of the file, after its last instruction (a trace that ends short of the
+    /// frames its header announces).
+    End,
+}
+
+impl Location {
+    /// Whether an error's display names this location: [`Location::File`] and
+    /// [`Location::End`] are said by the message itself.
+    fn is_shown(self) -> bool {
+        !matches!(self, Location::File | Location::End)
+    }
 }
 
 impl fmt::Display for Location {
@@ -25,6 +36,7 @@ impl fmt::Display for Location {
             Location::Line { line, column } => write!(f, "{line}:{column}"),
             Location::Byte(b) => write!(f, "byte {b}"),
             Location::File => Ok(()),
+            Location::End => f.write_str("end of file"),
         }
     }
 }
@@ -34,8 +46,13 @@ impl fmt::Display for Location {
 pub enum ErrorKind {
     /// Reading the file failed.
     Io,
-    /// The file ends before the trace does (cut short).
+    /// The file ends before the trace does (cut short inside a record, or before the
+    /// binary end marker).
     Truncated,
+    /// Every record is whole, but the trace ends short of the frames its header announces:
+    /// its `Refresh` count is not a positive multiple of the header's `lines` (a file cut
+    /// at a line's end, or a writer that stopped early).
+    Incomplete,
     /// The bytes are not a trace of this format (bad magic, bad checksum, trailing data…).
     Corrupt,
     /// Malformed text or JSON.
@@ -114,14 +131,14 @@ impl fmt::Display for TraceError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         if let Some(p) = &self.path {
             write!(f, "{}", printable(&p.display().to_string()))?;
-            if self.location != Location::File {
+            if self.location.is_shown() {
                 match self.location {
                     Location::Byte(_) => write!(f, ": {}", self.location)?,
                     _ => write!(f, ":{}", self.location)?,
                 }
             }
             write!(f, ": ")?;
-        } else if self.location != Location::File {
+        } else if self.location.is_shown() {
             write!(f, "{}: ", self.location)?;
         }
         f.write_str(&printable(&self.message))
@@ -168,6 +185,10 @@ mod tests {
         let e = TraceError::new(ErrorKind::Encoding, Location::File, "unknown")
             .in_file(Path::new("t.txt"));
         assert_eq!(e.to_string(), "t.txt: unknown");
+        let e = TraceError::new(ErrorKind::Incomplete, Location::End, "the trace ends")
+            .in_file(Path::new("t.cwt"));
+        assert_eq!(e.to_string(), "t.cwt: the trace ends");
+        assert_eq!(Location::End.to_string(), "end of file");
     }
 }
 

@@ -362,4 +362,31 @@ mod tests {
         let e = read("{\"op\":\"Eval1\",\"x\":0,\"dx\":1,\n").unwrap_err();
         assert_eq!(e.kind, ErrorKind::Truncated);
     }
+
+    /// A file cut anywhere inside a record (mid-number included: `0.176` cut to `0.`) is
+    /// refused; a cut only reads back whole records when it falls at a record's end.
+    #[test]
+    fn a_file_cut_inside_a_record_is_refused() {
+        let body = "{\"op\":\"Eval2\",\"x\":0,\"dx\":4,\"I\":[0.176],\"dI\":[-1e-7]}\n{\"op\":\"Refresh\"}\n";
+        let whole = format!("{HEAD}{body}");
+        for cut in HEAD.len()..whole.len() {
+            let part = &whole[..cut];
+            let got = JsonlReader::new(part.as_bytes()).and_then(|mut r| read_all(&mut r));
+            let at_a_record_end = part.ends_with('}') || part.ends_with('\n');
+            match got {
+                Ok(v) => {
+                    assert!(at_a_record_end, "cut {cut} `{part}` accepted");
+                    assert_eq!(v.len(), part.matches('}').count() - 1);
+                }
+                Err(e) => {
+                    assert!(!at_a_record_end, "cut {cut}: {e}");
+                    assert_eq!(e.kind, ErrorKind::Truncated, "cut {cut}: {e}");
+                    assert!(
+                        matches!(e.location, Location::Line { line: 2 | 3, .. }),
+                        "{e}"
+                    );
+                }
+            }
+        }
+    }
 }

@@ -49,7 +49,7 @@ pub mod packed;
 pub mod text;
 
 pub use checked::{refusal, CheckedStream, Unfit};
-pub use encoding::{create_trace, Encoding, FileReader};
+pub use encoding::{create_trace, Completeness, Encoding, FileReader, Incomplete};
 pub use error::{printable, ErrorKind, Location, TraceError};
 pub use header::{HeaderFault, TraceHeader, FORMAT_VERSION, MAX_CHANNELS, MAX_LINES, MAX_WIDTH};
 pub use instruction::{Instruction, Intensity, OperandError};

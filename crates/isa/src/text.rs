@@ -10,7 +10,9 @@
 //!
 //! Operands follow [`Opcode::operands`]. An intensity is its channel values joined by
 //! commas without spaces (`0.5,0.25,1.0` for RGB). Values are written in Rust's shortest
-//! round-trip form, so text → value → text is exact.
+//! round-trip form, so text → value → text is exact. A value is read as
+//! `[+-]digits[.digits][(e|E)[+-]digits]`: `0.`, `.5`, `1e` (a number cut short) are
+//! refused, located at the missing digit.
 
 use crate::error::{operand_error, ErrorKind, Location, TraceError};
 use crate::header::{HeaderFault, TraceHeader, FORMAT_VERSION};
@@ -336,8 +338,9 @@ pub fn parse_instruction(
                 let mut vals = [0.0; crate::header::MAX_CHANNELS];
                 let mut col = tok.column;
                 for (k, p) in parts.iter().enumerate() {
-                    vals[k] = parse_f64(p, kind.name())
-                        .map_err(|(kind, m)| TraceError::new(kind, at(col), m))?;
+                    vals[k] = parse_f64(p, kind.name()).map_err(|(kind, offset, m)| {
+                        TraceError::new(kind, at(col + offset as u64), m)
+                    })?;
                     col += p.len() as u64 + 1;
                 }
                 values[kind.value_slot().expect("value")] = Intensity::new(&vals[..channels]);
@@ -361,7 +364,50 @@ fn parse_u32(text: &str, name: &str) -> Result<u32, String> {
         .map_err(|_| format!("`{name}` = {text} does not fit in 32 bits"))
 }
 
-fn parse_f64(text: &str, name: &str) -> Result<f64, (ErrorKind, String)> {
+/// Where `text` first departs from the number grammar
+/// `[+-]? digits ('.' digits)? ([eE] [+-]? digits)?` (digits: one or more ASCII digits),
+/// as its byte offset and what was expected there; `None` when it is a number. So `0.`,
+/// `.5`, `1e` and `1e-` (a number cut short, or half written) are refused, and every form
+/// [`format_value`] writes (`1.0`, `-0.0`, `1e-7`, `1e16`) is read.
+fn number_fault(text: &str) -> Option<(usize, &'static str)> {
+    let b = text.as_bytes();
+    let digits = |i: &mut usize| {
+        let start = *i;
+        while b.get(*i).is_some_and(u8::is_ascii_digit) {
+            *i += 1;
+        }
+        *i > start
+    };
+    let mut i = usize::from(matches!(b.first(), Some(b'+' | b'-')));
+    if !digits(&mut i) {
+        let what = if b.get(i) == Some(&b'.') {
+            "a digit before the decimal point"
+        } else {
+            "a digit"
+        };
+        return Some((i, what));
+    }
+    if b.get(i) == Some(&b'.') {
+        i += 1;
+        if !digits(&mut i) {
+            return Some((i, "a digit after the decimal point"));
+        }
+    }
+    if matches!(b.get(i), Some(b'e' | b'E')) {
+        i += 1;
+        if matches!(b.get(i), Some(b'+' | b'-')) {
+            i += 1;
+        }
+        if !digits(&mut i) {
+            return Some((i, "a digit in the exponent"));
+        }
+    }
+    (i < b.len()).then_some((i, "the end of the number"))
+}
+
+/// One channel value: a finite number of the grammar of [`number_fault`]. A refusal
+/// gives the kind, the byte offset in `text` where it was found, and the message.
+fn parse_f64(text: &str, name: &str) -> Result<f64, (ErrorKind, usize, String)> {
     let looks_numeric = !text.is_empty()
         && text
             .bytes()
@@ -379,18 +425,32 @@ fn parse_f64(text: &str, name: &str) -> Result<f64, (ErrorKind, String)> {
         };
         return Err((
             kind,
+            0,
             format!("expected a finite number for `{name}`, found `{text}`"),
+        ));
+    }
+    if let Some((at, expected)) = number_fault(text) {
+        let found = match text[at..].chars().next() {
+            Some(c) => format!("found `{c}`"),
+            None => "found its end".to_string(),
+        };
+        return Err((
+            ErrorKind::Syntax,
+            at,
+            format!("expected {expected} in the number `{text}` for `{name}`, {found}"),
         ));
     }
     let v: f64 = text.parse().map_err(|_| {
         (
             ErrorKind::Syntax,
+            0,
             format!("expected a finite number for `{name}`, found `{text}`"),
         )
     })?;
     if !v.is_finite() {
         return Err((
             ErrorKind::NonFinite,
+            0,
             format!("`{name}` = {text} overflows f64"),
         ));
     }
@@ -478,5 +538,80 @@ mod tests {
         assert_eq!(e.kind, ErrorKind::Header);
         let e = read("").unwrap_err();
         assert_eq!(e.kind, ErrorKind::Truncated);
+    }
+
+    /// The first value of `Eval1 0 4 <value>`, or the error; the value starts at column 11.
+    fn value(v: &str) -> Result<f64, TraceError> {
+        let src = format!("cwisim-trace version=1 width=8 lines=2 channels=1\nEval1 0 4 {v}\n");
+        read(&src).map(|(_, i)| i[0].i().as_slice()[0])
+    }
+
+    #[test]
+    fn numbers_cut_short_are_refused_where_the_digit_is_missing() {
+        for (v, column, expected) in [
+            ("0.", 13, "expected a digit after the decimal point in the number `0.` for `I`, found its end"),
+            ("-3.e5", 14, "expected a digit after the decimal point in the number `-3.e5` for `I`, found `e`"),
+            (".5", 11, "expected a digit before the decimal point in the number `.5` for `I`, found `.`"),
+            ("-.5", 12, "expected a digit before the decimal point in the number `-.5` for `I`, found `.`"),
+            ("1e", 13, "expected a digit in the exponent in the number `1e` for `I`, found its end"),
+            ("1e-", 14, "expected a digit in the exponent in the number `1e-` for `I`, found its end"),
+            ("1.5E+", 16, "expected a digit in the exponent in the number `1.5E+` for `I`, found its end"),
+            ("-", 12, "expected a digit in the number `-` for `I`, found its end"),
+            ("+-1", 12, "expected a digit in the number `+-1` for `I`, found `-`"),
+            ("1.0.0", 14, "expected the end of the number in the number `1.0.0` for `I`, found `.`"),
+            ("1-2", 12, "expected the end of the number in the number `1-2` for `I`, found `-`"),
+        ] {
+            let e = value(v).unwrap_err();
+            assert_eq!(e.kind, ErrorKind::Syntax, "{v}: {e}");
+            assert_eq!(e.location, Location::Line { line: 2, column }, "{v}: {e}");
+            assert_eq!(e.message, expected);
+        }
+        // in a channel after the first: located in that channel
+        let src = "cwisim-trace version=1 width=8 lines=2 channels=3\nEval1 0 4 1.0,0.,2.0\n";
+        let e = read(src).unwrap_err();
+        assert_eq!(
+            e.location,
+            Location::Line {
+                line: 2,
+                column: 17
+            },
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn every_form_the_writer_writes_and_the_documented_ones_are_read() {
+        for (v, want) in [
+            ("1.0", 1.0),
+            ("-0.0", -0.0),
+            ("1e-7", 1e-7),
+            ("1e16", 1e16),
+            ("1E5", 1e5),
+            ("1e+5", 1e5),
+            ("+0.5", 0.5),
+            ("0", 0.0),
+            ("007", 7.0),
+            ("5e-324", 5e-324),
+            ("1.7976931348623157e308", f64::MAX),
+        ] {
+            let got = value(v).unwrap_or_else(|e| panic!("{v}: {e}"));
+            assert_eq!(got.to_bits(), want.to_bits(), "{v}");
+        }
+        for v in [
+            0.1,
+            -0.0,
+            1e-7,
+            1e300,
+            5e-324,
+            f64::MIN_POSITIVE,
+            0.176,
+            -12345.678,
+        ] {
+            assert_eq!(value(&format_value(v)).unwrap().to_bits(), v.to_bits());
+        }
+        // as before: the non-finite are refused as such
+        for v in ["inf", "-inf", "NaN", "infinity", "1e999"] {
+            assert_eq!(value(v).unwrap_err().kind, ErrorKind::NonFinite, "{v}");
+        }
     }
 }

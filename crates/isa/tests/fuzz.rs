@@ -7,7 +7,8 @@
 //! located (line and column for text and JSON Lines, a byte offset within the input for
 //! binary; `Location::File` only where a file could not be opened) with a one-line,
 //! non-empty message; and every acceptance re-encodes, in every encoding, to a trace that
-//! reads back equal.
+//! reads back equal. Through `FileReader`, a file reads as it does in memory, except that
+//! a trace that is not a whole number of frames is refused at its end.
 //!
 //! Cases per run (debug, 2 cores: about 1 s in all): `arbitrary_bytes` 512 (× 3
 //! encodings), `arbitrary_text` 512 (× 2), `after_a_valid_header` 512 (× 3),
@@ -18,7 +19,9 @@ use cwisim_fuzzing::{
     config, delete_member, duplicate_member, json_members, number_tokens, EXTREMES, TIME_BOUND,
 };
 use cwisim_isa::io::read_all;
-use cwisim_isa::{Encoding, FileReader, Instruction, Location, TraceError, TraceHeader};
+use cwisim_isa::{
+    Encoding, ErrorKind, FileReader, Instruction, Location, Opcode, TraceError, TraceHeader,
+};
 use proptest::prelude::*;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
@@ -465,7 +468,18 @@ proptest! {
         let in_memory = decode(enc, &b);
         std::fs::remove_file(&path).ok();
         match (result, in_memory) {
-            (Ok(v), Ok((_, w))) => prop_assert_eq!(v, w),
+            (Ok(v), Ok((h, w))) => {
+                prop_assert!(whole_frames(&h, &w), "accepted {} lines per frame: {w:?}", h.lines);
+                prop_assert_eq!(v, w);
+            }
+            // what the in-memory reader reads, the file reader refuses at its end when
+            // it is not a whole number of frames
+            (Err(e), Ok((h, w))) if e.kind == ErrorKind::Incomplete => {
+                prop_assert!(!whole_frames(&h, &w), "{e}");
+                prop_assert_eq!(e.location, Location::End);
+                prop_assert_eq!(e.path.as_deref(), Some(path.as_path()));
+                check_message(&e, &b)?;
+            }
             (Err(e), Err(f)) => {
                 check_message(&e, &b)?;
                 prop_assert_eq!(e.path.as_deref(), Some(path.as_path()));
@@ -475,6 +489,12 @@ proptest! {
             (r, m) => prop_assert!(false, "file and memory disagree: {r:?} vs {m:?}"),
         }
     }
+}
+
+/// Whether a trace holds a positive whole number of frames (what `FileReader` accepts).
+fn whole_frames(header: &TraceHeader, instrs: &[Instruction]) -> bool {
+    let refreshes = instrs.iter().filter(|i| i.op == Opcode::Refresh).count() as u64;
+    refreshes > 0 && refreshes.is_multiple_of(u64::from(header.lines))
 }
 
 /// An unknown extension and a missing file are refused, naming the file.
