@@ -338,7 +338,10 @@ pub fn run_cli_with(
                 return u8::try_from(e.exit_code()).unwrap_or(crate::error::EXIT_BAD_INPUT);
             }
             // --help and --version: a closed pipe is fine, a full disk is a failure
-            return match stdout.write_all(text.as_bytes()).and_then(|()| stdout.flush()) {
+            return match stdout
+                .write_all(text.as_bytes())
+                .and_then(|()| stdout.flush())
+            {
                 Ok(()) => 0,
                 Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => 0,
                 Err(e) => {
@@ -433,8 +436,13 @@ fn dispatch(
         Command::Inspect(args) => inspect::run(args, stdout).map(|()| 0),
         Command::Vcd(args) => vcd::run(args).map(|()| 0),
         // equal: 0, different: 1, even when the reader of the report went away
-        Command::Diff(args) => diff::run(args, &mut ReaderMayLeave::new(stdout))
-            .map(|equal| if equal { 0 } else { crate::error::EXIT_DIFFERENT }),
+        Command::Diff(args) => diff::run(args, &mut ReaderMayLeave::new(stdout)).map(|equal| {
+            if equal {
+                0
+            } else {
+                crate::error::EXIT_DIFFERENT
+            }
+        }),
         Command::Dump(args) => dump::run(args, stdout).map(|()| 0),
     }
 }

@@ -208,9 +208,7 @@ where
             .map_err(|e| CliError::write(path, e))?;
         let mut out = BufWriter::new(file);
         fill(&mut out)?;
-        return out
-            .flush()
-            .map_err(|e| CliError::write(path, e));
+        return out.flush().map_err(|e| CliError::write(path, e));
     }
     let target = resolve_output(path)?;
     let (partial, file) =
@@ -230,7 +228,9 @@ where
         None => Some(partial),
     });
     match held {
-        Some(partial) => partial.persist(&target).map_err(|e| CliError::write(path, e)),
+        Some(partial) => partial
+            .persist(&target)
+            .map_err(|e| CliError::write(path, e)),
         None => Ok(()),
     }
 }

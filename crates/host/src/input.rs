@@ -45,14 +45,23 @@ impl InputKind {
 /// A reader on the input's instructions: the trace file, or the scene's stream as
 /// `draw` renders it.
 pub fn open(input: &Path, draw: &DrawArgs) -> Result<Box<dyn TraceRead>, CliError> {
-    open_sized(input, draw).map(|(reader, _)| reader)
+    open_sized(input, draw, false).map(|(reader, _)| reader)
 }
 
 /// [`open`], and the size in bytes of what the reader reads (for progress).
-pub fn open_sized(input: &Path, draw: &DrawArgs) -> Result<(Box<dyn TraceRead>, u64), CliError> {
+/// `allow_incomplete` (`--keep-partial`): a trace file that ends short of whole frames is
+/// read to its end without an error, and the reader's `incomplete()` says where it ended.
+pub fn open_sized(
+    input: &Path,
+    draw: &DrawArgs,
+    allow_incomplete: bool,
+) -> Result<(Box<dyn TraceRead>, u64), CliError> {
     match InputKind::of(input)? {
         InputKind::Trace => {
-            let reader = FileReader::open(input)?;
+            let mut reader = FileReader::open(input)?;
+            if allow_incomplete {
+                reader.allow_incomplete();
+            }
             let size = reader.size();
             Ok((Box::new(reader), size))
         }

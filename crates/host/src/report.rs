@@ -115,8 +115,8 @@ impl LineSpill {
             hidden.push(format!(".{}", std::process::id()));
             std::env::temp_dir().join(hidden)
         } else {
-            let target = crate::files::resolve_output(output)
-                .map_err(|e| io::Error::other(e.one_line()))?;
+            let target =
+                crate::files::resolve_output(output).map_err(|e| io::Error::other(e.one_line()))?;
             target.with_file_name(hidden)
         };
         let (file, out) = crate::files::PartialFile::create(path)?;

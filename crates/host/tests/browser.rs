@@ -39,8 +39,12 @@ fn chromium() -> Option<PathBuf> {
     if let Some(p) = chromium_on_path() {
         return Some(p);
     }
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/browser/install-chromium.sh");
-    eprintln!("the browser test needs Chromium: running {}", script.display());
+    let script =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/browser/install-chromium.sh");
+    eprintln!(
+        "the browser test needs Chromium: running {}",
+        script.display()
+    );
     let status = Command::new("bash").arg(&script).status();
     let installed = status.as_ref().is_ok_and(|s| s.success());
     match chromium_on_path() {

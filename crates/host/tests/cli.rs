@@ -387,22 +387,36 @@ fn rgb_traces_make_rgb_pngs() {
 }
 
 #[test]
-fn a_trace_without_refresh_has_no_png_but_an_empty_npy() {
+fn a_trace_without_refresh_is_refused_naming_the_file() {
     let dir = scratch("no-refresh");
     std::fs::write(
         dir.join("t.cwt"),
         "cwisim-trace version=1 width=8 lines=2 channels=1\nEval1 0 8 1.0\n",
     )
     .expect("write trace");
-    let out = cwisim(&dir, &["run", "t.cwt", "-o", "t.png"]);
+    for args in [
+        &["run", "t.cwt", "-o", "t.png"][..],
+        &["run", "t.cwt", "--npy", "t.npy"],
+    ] {
+        let out = cwisim(&dir, args);
+        let (_, stderr) = text(&out);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        assert_eq!(
+            stderr,
+            "error: t.cwt: the trace ends before its first scanline (no Refresh; the header \
+announces 2 lines per frame): it is incomplete (cut short?)\n"
+        );
+    }
+    assert!(!dir.join("t.png").exists() && !dir.join("t.npy").exists());
+    // --keep-partial: the image of no scanline, which a PNG cannot hold
+    let out = cwisim(&dir, &["run", "t.cwt", "-o", "t.png", "--keep-partial"]);
     let (_, stderr) = text(&out);
     assert_eq!(out.status.code(), Some(2));
     assert!(
         stderr.ends_with("error: the trace output no scanline (no Refresh); nothing to write\n"),
         "{stderr}"
     );
-    assert!(!dir.join("t.png").exists());
-    let out = cwisim(&dir, &["run", "t.cwt", "--npy", "t.npy"]);
+    let out = cwisim(&dir, &["run", "t.cwt", "--npy", "t.npy", "--keep-partial"]);
     assert_eq!(out.status.code(), Some(0));
     assert_eq!(read_npy(dir.join("t.npy")), (vec![0, 8, 1], vec![]));
 }

@@ -94,7 +94,7 @@ fn every_kind_of_instruction_counts_what_it_addresses() {
     let dir = scratch("cost-kinds");
     std::fs::write(
         dir.join("k.cwt"),
-        "cwisim-trace version=1 width=10 lines=2 channels=1
+        "cwisim-trace version=1 width=10 lines=3 channels=1
 SetI 2 0.5
 SetdI 2 0.5
 SetPI 1 4 0.25
@@ -233,12 +233,21 @@ fn a_trace_without_refresh_has_an_empty_map_but_no_image() {
         "cwisim-trace version=1 width=5 lines=2 channels=1\nEval1 0 5 0.5\n",
     )
     .expect("write");
+    // a trace without Refresh is incomplete: only --keep-partial replays it
     let out = cwisim(&dir, &["run", "n.cwt", "--cost-npy", "n.npy"]);
+    assert_eq!(out.status.code(), Some(2));
+    let out = cwisim(
+        &dir,
+        &["run", "n.cwt", "--cost-npy", "n.npy", "--keep-partial"],
+    );
     assert!(out.status.success(), "{}", text(&out).1);
     let (shape, data) = counts(dir.join("n.npy"));
     assert_eq!(shape, [0, 5]);
     assert!(data.is_empty());
-    let out = cwisim(&dir, &["run", "n.cwt", "--cost-image", "n.png"]);
+    let out = cwisim(
+        &dir,
+        &["run", "n.cwt", "--cost-image", "n.png", "--keep-partial"],
+    );
     let (_, stderr) = text(&out);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(

@@ -195,7 +195,10 @@ fn the_timeline_is_stats_figures() {
     let (t, m) = (trace.to_str().unwrap(), machine.to_str().unwrap());
     let said = cwisim_ok(&dir, &["inspect", t, "--machine", m, "-o", "o.html"]);
     assert!(said.contains("1 late scanline(s)"), "{said}");
-    cwisim_ok(&dir, &["stats", t, "--machine", m, "--stats-json", "s.json"]);
+    cwisim_ok(
+        &dir,
+        &["stats", t, "--machine", m, "--stats-json", "s.json"],
+    );
     let stats: Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("s.json")).unwrap()).unwrap();
     let data = page(&dir, "o.html");

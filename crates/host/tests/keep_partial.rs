@@ -63,8 +63,27 @@ fn the_completed_scanlines_are_kept_and_the_error_names_the_bad_line() {
     );
     let png = image::open(dir.join("a.png")).expect("a PNG").to_luma8();
     assert_eq!((png.width(), png.height()), (6, 3));
-    // equal to the good prefix replayed on its own
-    cwisim_ok(&dir, &["run", "good.cwt", "-o", "b.png", "--npy", "b.npy"]);
+    // equal to the good prefix replayed on its own: three of a frame's four lines, an
+    // incomplete trace that --keep-partial replays with a warning
+    let out = cwisim(
+        &dir,
+        &[
+            "run",
+            "good.cwt",
+            "-o",
+            "b.png",
+            "--npy",
+            "b.npy",
+            "--keep-partial",
+        ],
+    );
+    let (_, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(0), "{stderr}");
+    assert_eq!(
+        stderr,
+        "warning: --keep-partial: good.cwt: the trace ends after 3 scanlines, inside frame 0 \
+(3 of its 4 lines); the outputs hold its 3 scanline(s)\n"
+    );
     assert_eq!(
         std::fs::read(dir.join("a.png")).unwrap(),
         std::fs::read(dir.join("b.png")).unwrap()
@@ -93,9 +112,11 @@ fn a_trace_bad_before_its_first_scanline_keeps_nothing() {
 #[test]
 fn a_truncated_binary_trace_keeps_its_complete_scanlines() {
     let dir = scratch("keep-partial-cwb");
-    std::fs::write(dir.join("good.cwt"), trace(4, "")).unwrap();
+    // one line a frame: three and four scanlines are both whole traces
+    let one_a_frame = |n| trace(n, "").replace("lines=4", "lines=1");
+    std::fs::write(dir.join("good.cwt"), one_a_frame(4)).unwrap();
     cwisim_ok(&dir, &["convert", "good.cwt", "good.cwb"]);
-    std::fs::write(dir.join("three.cwt"), trace(3, "")).unwrap();
+    std::fs::write(dir.join("three.cwt"), one_a_frame(3)).unwrap();
     cwisim_ok(&dir, &["convert", "three.cwt", "three.cwb"]);
     let bytes = std::fs::read(dir.join("good.cwb")).unwrap();
     let three = std::fs::read(dir.join("three.cwb")).unwrap().len();
@@ -112,4 +133,34 @@ fn a_truncated_binary_trace_keeps_its_complete_scanlines() {
     assert!(stderr.contains("byte"), "located by byte offset: {stderr}");
     let values = npy_values(&std::fs::read(dir.join("a.npy")).unwrap());
     assert_eq!(values.len(), 3 * 6, "the three complete scanlines");
+}
+
+#[test]
+fn a_trace_cut_between_records_is_refused_unless_kept() {
+    let dir = scratch("keep-partial-short");
+    // `head -c` at the end of a line: every record whole, the frame short
+    std::fs::write(dir.join("short.cwt"), trace(2, "")).unwrap();
+    for args in [
+        &["run", "short.cwt", "-o", "a.png"][..],
+        &["stats", "short.cwt"],
+        &["dump", "short.cwt", "--lines", "0"],
+        &["history", "short.cwt", "--x", "0", "--line", "0"],
+        &["vcd", "short.cwt", "--line", "0", "-o", "a.vcd"],
+    ] {
+        let out = cwisim(&dir, args);
+        let (_, stderr) = text(&out);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(
+            stderr.ends_with(
+                "error: short.cwt: the trace ends after 2 scanlines, inside frame 0 (2 of its \
+4 lines): it is incomplete (cut short?)\n"
+            ),
+            "{args:?}: {stderr}"
+        );
+        assert!(!dir.join("a.png").exists() && !dir.join("a.vcd").exists());
+    }
+    let out = cwisim(&dir, &["run", "short.cwt", "-o", "a.png", "--keep-partial"]);
+    assert_eq!(out.status.code(), Some(0), "{:?}", text(&out));
+    let png = image::open(dir.join("a.png")).expect("a PNG").to_luma8();
+    assert_eq!((png.width(), png.height()), (6, 2));
 }

@@ -193,7 +193,7 @@ malformed! {
     cwt_overflowing_value: "t.cwt", cwt("Eval1 0 8 1e999\n"), [],
         "error: t.cwt:2:11: ", ["`I` = 1e999 overflows f64"], Other;
     cwt_not_a_number: "t.cwt", cwt("Eval1 0 8 0.5.5\n"), [],
-        "error: t.cwt:2:11: ", ["finite number for `I`, found `0.5.5`"], Other;
+        "error: t.cwt:2:14: ", ["expected the end of the number in the number `0.5.5` for `I`, found `.`"], Other;
     cwt_grey_value_in_rgb_trace: "t.cwt", b"cwisim-trace version=1 width=8 lines=2 channels=3\nEval1 0 8 0.5\n", [],
         "error: t.cwt:2:11: ", ["I has 1 channel value(s)", "the trace has 3"], Other;
     cwt_non_utf8_bytes: "t.cwt", [&cwt("Refresh\nEval1 0 8 ")[..], b"\xff\xfe\n"].concat(), [],

@@ -106,7 +106,10 @@ fn the_outputs_of_one_command_are_all_written_or_none() {
         let out = cwisim(&dir, &["render", "fig25", "-o", "old.png", "--npy", bad]);
         let (_, stderr) = text(&out);
         assert_eq!(out.status.code(), Some(3), "{bad}: {stderr}");
-        assert!(stderr.starts_with(&format!("error: {bad}: cannot write")), "{stderr}");
+        assert!(
+            stderr.starts_with(&format!("error: {bad}: cannot write")),
+            "{stderr}"
+        );
         assert_eq!(read(dir.join("old.png")), b"old", "{bad}");
         assert_eq!(names(&dir), ["file", "old.png"], "{bad}");
     }
@@ -142,7 +145,10 @@ fn an_interrupted_run_leaves_no_partial_file() {
     let start = Instant::now();
     while !names(&dir).iter().any(|n| n.ends_with(".partial")) {
         assert!(start.elapsed() < Duration::from_secs(60), "no partial file");
-        assert!(child.try_wait().unwrap().is_none(), "the run ended too soon");
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "the run ended too soon"
+        );
         std::thread::sleep(Duration::from_millis(20));
     }
     let kill = Command::new("kill")

@@ -689,7 +689,7 @@ fn bad_inputs_exit_2_with_one_error_line_and_no_file() {
         ],
         "hop_cycles",
     );
-    // A trace with no Refresh outputs no scanline at all.
+    // A trace with no Refresh is incomplete.
     let empty = scratch("vcd-bad-empty");
     std::fs::write(
         empty.join("t.cwt"),
@@ -701,7 +701,8 @@ fn bad_inputs_exit_2_with_one_error_line_and_no_file() {
     assert_eq!(out.status.code(), Some(2));
     assert_eq!(
         stderr,
-        "error: --line 0: t.cwt outputs only 0 scanline(s)\n"
+        "error: t.cwt: the trace ends before its first scanline (no Refresh; the header \
+announces 1 line per frame): it is incomplete (cut short?)\n"
     );
     assert!(!empty.join("x.vcd").exists());
     // Usage errors of the parser itself.

@@ -143,7 +143,8 @@ impl std::fmt::Display for Incomplete {
         if self.scanlines == 0 {
             return write!(
                 f,
-                "the trace ends before its first scanline (no Refresh; the header announces {lines} lines per frame)"
+                "the trace ends before its first scanline (no Refresh; the header announces {lines} line{} per frame)",
+                if lines == 1 { "" } else { "s" }
             );
         }
         write!(
@@ -204,24 +205,6 @@ impl FileReader {
         self.completeness
     }
 
-    /// Reads the rest of the trace to its end without keeping it, checking every
-    /// instruction and the trace's completeness: for a caller that stopped reading early
-    /// (one scanline dumped, one processor's history), so that it never claims success
-    /// on a damaged or truncated file. `Ok` at the end of a whole trace, or of an
-    /// incomplete one after [`Self::allow_incomplete`] (then see [`Self::completeness`]);
-    /// after the end it reports the same again.
-    pub fn check_to_end(&mut self) -> Result<(), TraceError> {
-        const CHUNK: usize = 4096;
-        let mut scratch = Vec::with_capacity(CHUNK);
-        while self.read_batch(&mut scratch, CHUNK)? > 0 {
-            scratch.clear();
-        }
-        match self.completeness {
-            Completeness::Incomplete(i) if !self.allow_incomplete => Err(self.refusal(&i)),
-            _ => Ok(()),
-        }
-    }
-
     fn refusal(&self, incomplete: &Incomplete) -> TraceError {
         incomplete.error().in_file(&self.path)
     }
@@ -250,6 +233,31 @@ impl FileReader {
 }
 
 impl TraceRead for FileReader {
+    /// Reads the rest of the trace to its end without keeping it, checking every
+    /// instruction and the trace's completeness: for a caller that stopped reading early
+    /// (one scanline dumped, one processor's history), so that it never claims success
+    /// on a damaged or truncated file. `Ok` at the end of a whole trace, or of an
+    /// incomplete one after [`Self::allow_incomplete`] (then see [`Self::completeness`]);
+    /// after the end it reports the same again.
+    fn check_to_end(&mut self) -> Result<(), TraceError> {
+        const CHUNK: usize = 4096;
+        let mut scratch = Vec::with_capacity(CHUNK);
+        while self.read_batch(&mut scratch, CHUNK)? > 0 {
+            scratch.clear();
+        }
+        match self.completeness {
+            Completeness::Incomplete(i) if !self.allow_incomplete => Err(self.refusal(&i)),
+            _ => Ok(()),
+        }
+    }
+
+    fn incomplete(&self) -> Option<Incomplete> {
+        match self.completeness {
+            Completeness::Incomplete(i) => Some(i),
+            _ => None,
+        }
+    }
+
     fn header(&self) -> &TraceHeader {
         self.inner.header()
     }

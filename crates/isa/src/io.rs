@@ -34,6 +34,27 @@ pub trait TraceRead {
         }
         Ok(n)
     }
+
+    /// Reads the rest of the trace to its end without keeping it, checking every
+    /// instruction (and, for a file, its completeness: `FileReader`): for a caller that
+    /// stopped reading early (one scanline dumped, one processor's history), so that it
+    /// never claims success on a damaged or truncated file. The default drains the reader.
+    fn check_to_end(&mut self) -> Result<(), TraceError> {
+        let mut scratch = Vec::with_capacity(4096);
+        while self.read_batch(&mut scratch, 4096)? > 0 {
+            scratch.clear();
+        }
+        Ok(())
+    }
+
+    /// Where the trace ended short of whole frames, once its end was reached by a reader
+    /// that was allowed to accept that (`FileReader::allow_incomplete`, for
+    /// `--keep-partial`); `None` for a whole trace, before the end, or for a reader that
+    /// does not count frames (the default: a stream made in memory is whole by
+    /// construction).
+    fn incomplete(&self) -> Option<crate::Incomplete> {
+        None
+    }
 }
 
 /// Reads every remaining instruction.

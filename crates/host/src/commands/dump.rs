@@ -97,8 +97,22 @@ pub fn run(args: &DumpArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
     };
     let mut reader = UntilLine::new(&mut *file, lines.last);
     replay_probed::<f64>(&mut reader, &machine, &mut printer, &mut NullSink)?;
-    match printer.error {
-        Some(e) => Err(CliError::Stdout(e)),
-        None => Ok(()),
+    let output = reader.lines_read();
+    if let Some(e) = printer.error {
+        return Err(CliError::Stdout(e));
     }
+    // the rest of the file, checked though not shown: no success on a damaged trace
+    file.check_to_end()?;
+    if lines.first > 0 && lines.first >= output {
+        return Err(CliError::Usage(format!(
+            "--lines {lines}: {} outputs only {output} scanline(s){}",
+            args.trace.display(),
+            if output == 0 {
+                String::new()
+            } else {
+                format!(" (0..={})", output - 1)
+            }
+        )));
+    }
+    Ok(())
 }

@@ -49,7 +49,10 @@ pub fn run(args: &HistoryArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
             header.width - 1
         )));
     }
-    let visits = match pixel_history(&mut *file, &machine, args.x as usize, args.y)? {
+    let visits = pixel_history(&mut *file, &machine, args.x as usize, args.y)?;
+    // the rest of the file, checked though not replayed: no success on a damaged trace
+    file.check_to_end()?;
+    let visits = match visits {
         Ok(visits) => visits,
         Err(lines) => {
             return Err(CliError::Usage(format!(

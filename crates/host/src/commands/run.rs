@@ -102,7 +102,7 @@ pub fn run(
     let machine = args.machine.load()?;
     let timing = Timing::from(args.timing);
     let (mut reader, size) = match args.trace.as_deref() {
-        Some(path) => crate::input::open_sized(path, &args.draw)?,
+        Some(path) => crate::input::open_sized(path, &args.draw, args.keep_partial)?,
         None => open_trace(None)?,
     };
     let header = *reader.header();
@@ -180,6 +180,15 @@ before the error (a frame has {})",
             Err(other) => return Err(other.into()),
         }
     };
+    if let (Some(incomplete), Some(path)) = (reader.incomplete(), &args.trace) {
+        // A lost warning is no reason to fail the run.
+        let _ = writeln!(
+            stderr,
+            "warning: --keep-partial: {}: {incomplete}; the outputs hold its {} scanline(s)",
+            path.display(),
+            incomplete.scanlines
+        );
+    }
     args.image.write(&collected)?;
     if let Some(cost) = &cost {
         let name = match &args.trace {

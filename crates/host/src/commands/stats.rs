@@ -51,7 +51,7 @@ pub struct StatsArgs {
 
     /// Write the selected scanlines' records, their sums and the run's totals as JSON
     /// (the same flag as `run --stats-json` and `render --stats-json`).
-    #[arg(long = "stats-json", value_name = "OUT.json")]
+    #[arg(long = "stats-json", value_name = "FILE")]
     pub stats_json: Option<PathBuf>,
 
     /// The machine model.

@@ -74,6 +74,8 @@ pub fn run(args: &VcdArgs) -> Result<(), CliError> {
     let header = *file.header();
     let (from, to) = window(args, header.width)?;
     let recorded = record_scanline(&mut *file, &machine, args.line, from as usize, to as usize)?;
+    // the rest of the file, checked though not replayed: no success on a damaged trace
+    file.check_to_end()?;
     let wave = match recorded {
         Ok(wave) => wave,
         Err(lines) => {
