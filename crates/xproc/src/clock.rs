@@ -72,28 +72,29 @@ impl Clock {
         let plain = tally.opcodes.total() - refresh;
         let mut first_issue = None;
         let mut entry = before;
+        // Once per scanline, not per instruction: saturating, since a run's cycles grow
+        // without bound (crate::machine: they stop at u64::MAX rather than wrap).
         if plain > 0 {
             // the first instruction is not the Refresh, which comes last
-            let paced: u64 = tally
-                .opcodes
-                .0
+            let mut counts = tally.opcodes.0;
+            counts[Opcode::Refresh.index()] = 0;
+            let paced = counts
                 .iter()
                 .zip(&self.pace)
-                .map(|(n, p)| n * p)
-                .sum::<u64>()
-                - refresh * self.pace[Opcode::Refresh.index()];
+                .fold(0u64, |sum, (n, p)| sum.saturating_add(n.saturating_mul(*p)));
             first_issue = Some(before.unwrap_or(0));
             entry = Some(match before {
-                Some(b) => b + paced,
+                Some(b) => b.saturating_add(paced),
                 // nothing before it to wait for: the trace's first enters after its cost
-                None => paced - self.pace[first.index()] + self.cost[first.index()],
+                // (pace ≥ cost, and paced includes the first's pace)
+                None => paced - (self.pace[first.index()] - self.cost[first.index()]),
             });
         }
         if refresh > 0 {
             let begin = entry.unwrap_or(0).max(self.timeline.refresh_gate(line));
-            let issued = begin + self.cost[Opcode::Refresh.index()];
+            let issued = begin.saturating_add(self.cost[Opcode::Refresh.index()]);
             first_issue.get_or_insert(begin);
-            entry = Some(issued.max(entry.map_or(0, |e| e + self.timeline.hop)));
+            entry = Some(issued.max(entry.map_or(0, |e| e.saturating_add(self.timeline.hop))));
         }
         self.last_entry = entry;
         Some(IssueTimes {
@@ -141,7 +142,7 @@ mod tests {
                 let times = clock.issue(line, &t).unwrap();
                 assert_eq!(times.last_entry, entry);
                 tallied.issued(line, &t, &times);
-                let ready = entry + timeline.traversal();
+                let ready = timeline.exit(entry);
                 each.ready(line, ready, timeline.deadline(line));
                 tallied.ready(line, ready, timeline.deadline(line));
                 line += 1;
@@ -151,7 +152,7 @@ mod tests {
             tallied.issued(line, &tally, &times);
         }
         assert_eq!(clock.last_entry(), last_entry);
-        let end = last_entry.map_or(0, |e| e + timeline.traversal());
+        let end = last_entry.map_or(0, |e| timeline.exit(e));
         (each.finish(line, end), tallied.finish(line, end))
     }
 
@@ -178,8 +179,8 @@ mod tests {
                 hop_cycles: hop,
                 value_cycles,
                 opcode_cycles: [
-                    ("Refresh".to_string(), refresh_cycles),
-                    ("Eval0".to_string(), eval0_cycles),
+                    (Opcode::Refresh, refresh_cycles),
+                    (Opcode::Eval0, eval0_cycles),
                 ]
                 .into(),
                 line_period_cycles: Some(period),
@@ -202,6 +203,44 @@ mod tests {
         assert!(tallied.lines.iter().all(|l| l.instructions > 0));
         // the second scanline's Refresh waits for the display to take the first
         assert!(tallied.lines[1].stall_cycles > 0);
+    }
+
+    #[test]
+    fn a_scanline_beyond_u64_saturates_instead_of_wrapping() {
+        // 2^62 Eval3s at 13 × 2^16 cycles each: far beyond 2^64 cycles
+        let header = TraceHeader::new(16, 3, 4).unwrap();
+        let machine = Machine {
+            opcode_cycles: [(Opcode::Eval3, 1 << 16)].into(),
+            value_cycles: 1 << 16,
+            ..Machine::default()
+        };
+        let timeline = machine.timeline(&header).unwrap();
+        let mut clock = Clock::new(&timeline);
+        let mut recorder = Recorder::new(&timeline);
+        let mut tally = IssueTally::default();
+        tally.count(Opcode::Eval3);
+        tally.opcodes.0[Opcode::Eval3.index()] = 1 << 62;
+        tally.count(Opcode::Refresh);
+        let times = clock.issue(0, &tally).unwrap();
+        assert_eq!((times.first_issue, times.last_entry), (0, u64::MAX));
+        recorder.issued(0, &tally, &times);
+        recorder.ready(0, timeline.exit(times.last_entry), timeline.deadline(0));
+        // the next scanline starts where the clock stopped
+        let mut next = IssueTally::default();
+        next.count(Opcode::Nop);
+        next.count(Opcode::Refresh);
+        let times = clock.issue(1, &next).unwrap();
+        assert_eq!((times.entry_before, times.last_entry), (u64::MAX, u64::MAX));
+        recorder.issued(1, &next, &times);
+        recorder.ready(1, timeline.exit(times.last_entry), timeline.deadline(1));
+        let s = recorder.finish(2, u64::MAX);
+        let l = &s.lines[0];
+        assert_eq!(
+            (l.busy_cycles, l.ready, l.slack),
+            (u64::MAX, u64::MAX, i64::MIN)
+        );
+        assert_eq!((s.lines[1].busy_cycles, s.lines[1].stall_cycles), (2, 0));
+        assert_eq!((s.totals.late_lines, s.totals.saturated_lines), (2, 2));
     }
 
     #[test]

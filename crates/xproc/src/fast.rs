@@ -55,7 +55,7 @@ impl Scanlines {
             .clock
             .last_entry()
             .expect("a scanline ends with its Refresh");
-        let ready = entry + self.timeline.traversal();
+        let ready = self.timeline.exit(entry);
         self.recorder
             .ready(line, ready, self.timeline.deadline(line));
         sink.line(LineOut {
@@ -153,10 +153,7 @@ impl<A: Arith> Engine<A::Out> for FastEngine<A> {
         let (tally, work) = self.processors.take_open_scanline();
         let mut s = self.scanlines;
         s.record_issue(&tally, work);
-        let end = s
-            .clock
-            .last_entry()
-            .map_or(0, |e| e + s.timeline.traversal());
+        let end = s.clock.last_entry().map_or(0, |e| s.timeline.exit(e));
         s.recorder.finish(s.line, end)
     }
 }

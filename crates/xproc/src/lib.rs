@@ -58,7 +58,7 @@ pub use engine::{
     run_numeric, Engine, ReplayError, Timing,
 };
 pub use feed::EngineWriter;
-pub use machine::{Machine, MachineError, Timeline};
+pub use machine::{Machine, MachineError, OpcodeCycles, Timeline};
 pub use numeric::{
     error_bound, wave_closed_form, FixedFormat, Numeric, NumericError, Overflow, Register, Q,
 };

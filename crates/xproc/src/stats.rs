@@ -70,7 +70,9 @@ pub struct LineStats {
     pub ready: u64,
     /// Cycle the display takes the scanline.
     pub deadline: u64,
-    /// `deadline - ready`; negative is an overrun (a visible fault).
+    /// `deadline - ready`; negative is an overrun (a visible fault). Clamped to the
+    /// range of `i64` (only a scanline whose cycles saturated can reach it:
+    /// [`Totals::saturated_lines`]).
     pub slack: i64,
 }
 
@@ -105,6 +107,11 @@ pub struct Totals {
     pub unrefreshed_instructions: u64,
     /// Cycle the last token left the array (0 for an empty trace).
     pub cycles: u64,
+    /// Scanlines output whose `ready` or `deadline` reached `u64::MAX`: cycle counts
+    /// saturate there rather than wrap (`crate::machine`), so these scanlines' slack is
+    /// only a bound, and if both reached it whether they were late is not known (they are
+    /// not counted late). 0 unless a run outlasts 2⁶⁴ − 1 cycles.
+    pub saturated_lines: u64,
 }
 
 /// Everything a run reports.
@@ -280,6 +287,9 @@ impl Recorder {
             if l.slack < 0 {
                 t.late_lines += 1;
             }
+            if l.ready == u64::MAX || l.deadline == u64::MAX {
+                t.saturated_lines += 1;
+            }
             if t.worst_slack.is_none_or(|w| l.slack < w) {
                 t.worst_slack = Some(l.slack);
                 t.worst_line = Some(l.line);
@@ -303,6 +313,9 @@ impl Recorder {
 
     /// An instruction of scanline `line` started issuing at `begin` and entered the first
     /// processor at `entry` after `cost` bus cycles.
+    ///
+    /// Plain arithmetic: the stepped engine calls this per instruction, with cycles it
+    /// reached one step at a time — far below 2⁶⁴ — and costs below 2²⁰.
     #[inline]
     pub(crate) fn issue(&mut self, line: u64, op: Opcode, begin: u64, entry: u64, cost: u64) {
         let stall = entry - self.last_entry - cost;
@@ -323,22 +336,24 @@ impl Recorder {
     /// cost, and the stall cycles — `entry − previous entry − cost` summed over the
     /// scanline — telescope to its last entry less the entry before its first, less the
     /// busy cycles.
+    ///
+    /// Once per scanline: saturating, as the cycles of [`crate::clock::Clock::issue`] are.
     pub(crate) fn issued(&mut self, line: u64, tally: &IssueTally, times: &IssueTimes) {
-        let busy: u64 = tally
+        let busy = tally
             .opcodes
             .0
             .iter()
             .zip(&self.cost)
-            .map(|(n, c)| n * c)
-            .sum();
+            .fold(0u64, |sum, (n, c)| sum.saturating_add(n.saturating_mul(*c)));
         let l = self.line_mut(line);
         if l.instructions == 0 {
             l.first_issue = times.first_issue;
         }
         l.instructions += tally.opcodes.total();
         l.opcodes.add(&tally.opcodes);
-        l.busy_cycles += busy;
-        l.stall_cycles += times.last_entry - times.entry_before - busy;
+        l.busy_cycles = l.busy_cycles.saturating_add(busy);
+        let stall = (times.last_entry - times.entry_before).saturating_sub(busy);
+        l.stall_cycles = l.stall_cycles.saturating_add(stall);
         self.last_entry = times.last_entry;
     }
 
@@ -357,7 +372,9 @@ impl Recorder {
         let l = self.line_mut(line);
         l.ready = ready;
         l.deadline = deadline;
-        l.slack = deadline as i64 - ready as i64;
+        // exact in i128, clamped to i64 (only a saturated scanline can be beyond it)
+        l.slack = (i128::from(deadline) - i128::from(ready)).clamp(i64::MIN.into(), i64::MAX.into())
+            as i64;
         self.ready_lines = self.ready_lines.max(line + 1);
         self.retire();
     }

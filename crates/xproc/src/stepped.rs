@@ -225,6 +225,9 @@ impl<'p, A: Arith> SteppedEngine<'p, A> {
         out
     }
 
+    /// The clock advances one cycle per step, so `t` stays far below 2⁶⁴, and the plain
+    /// additions to it (a cost below 2²⁰, a hop at most 2¹⁶: `crate::machine`) cannot
+    /// overflow.
     fn next_cycle(&mut self) {
         self.t += 1;
         self.moved = false;

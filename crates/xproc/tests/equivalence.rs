@@ -59,7 +59,7 @@ fn case() -> impl Strategy<Value = (TraceHeader, Machine, Vec<Instruction>)> {
                 let m = Machine {
                     hop_cycles: hop,
                     value_cycles,
-                    opcode_cycles: [("Eval3".to_string(), eval3_cycles)].into(),
+                    opcode_cycles: [(Opcode::Eval3, eval3_cycles)].into(),
                     line_period_cycles: Some(period),
                     vblank_lines: 2,
                     ..Machine::default()
