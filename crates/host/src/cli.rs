@@ -352,6 +352,8 @@ pub fn run_cli_with(
         }
     };
     let result = crate::files::transaction(|| {
+        // a budget variable that is not a size is refused before any work
+        cwisim_scene::budget::Budget::from_env()?;
         let code = dispatch(&cli.command, stdout, stderr, progress)?;
         // what is still buffered: a reader gone keeps the command's code (`diff`'s 1)
         match stdout.flush() {

@@ -92,10 +92,10 @@ pub struct OutputSink {
 
 impl OutputSink {
     /// The exact image when `exact`, the PNG samples when `png`, each with room for
-    /// `lines` scanlines (a hint) and the default limit ([`ImageSink::DEFAULT_LIMIT_BYTES`]
-    /// bytes each).
+    /// `lines` scanlines (a hint) and the memory budget as its limit
+    /// ([`cwisim_scene::budget::Budget::current`], `CWISIM_MAX_MEMORY`).
     pub fn new(width: usize, channels: usize, exact: bool, png: bool, lines: u64) -> Self {
-        let limit = ImageSink::DEFAULT_LIMIT_BYTES;
+        let limit = cwisim_scene::budget::Budget::current().memory_bytes;
         OutputSink {
             exact: exact.then(|| ImageSink::new(width, channels, limit).with_room_for(lines)),
             png: png.then(|| PngSink::new(width, channels, limit).with_room_for(lines)),

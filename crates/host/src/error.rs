@@ -2,6 +2,7 @@
 
 use cwisim_isa::TraceError;
 use cwisim_render::RenderError;
+use cwisim_scene::budget::BudgetError;
 use cwisim_scene::SceneError;
 use cwisim_study::StudyError;
 use cwisim_xproc::{ImageLimit, MachineError, ReplayError};
@@ -37,6 +38,10 @@ pub enum CliError {
     /// The output image would be larger than the collector allows.
     #[error(transparent)]
     ImageLimit(#[from] ImageLimit),
+    /// The work would need more memory, output or threads than the budget
+    /// (`CWISIM_MAX_MEMORY`, `CWISIM_MAX_OUTPUT`), or a budget variable is not a size.
+    #[error(transparent)]
+    Budget(#[from] BudgetError),
     /// Arguments that contradict each other or the trace (same input and output, a
     /// 4-channel PNG, …).
     #[error("{0}")]
@@ -108,6 +113,7 @@ impl CliError {
             | CliError::Machine(_)
             | CliError::Scene(_)
             | CliError::ImageLimit(_)
+            | CliError::Budget(_)
             | CliError::Usage(_) => EXIT_BAD_INPUT,
             CliError::Write { .. } | CliError::Stdout(_) => EXIT_WRITE_FAILED,
             CliError::Internal(_) => EXIT_INTERNAL,

@@ -95,6 +95,10 @@ impl StatsReport<'_> {
 pub struct LineSpill {
     file: crate::files::PartialFile,
     out: Option<BufWriter<File>>,
+    /// Bytes written, and the most the output budget allows (`CWISIM_MAX_OUTPUT`).
+    bytes: u64,
+    budget: cwisim_scene::budget::Budget,
+    over_budget: bool,
     count: u64,
     error: Option<io::Error>,
     buf: Vec<u8>,
@@ -123,6 +127,9 @@ impl LineSpill {
         Ok(LineSpill {
             file,
             out: Some(BufWriter::new(out)),
+            bytes: 0,
+            budget: cwisim_scene::budget::Budget::current(),
+            over_budget: false,
             count: 0,
             error: None,
             buf: Vec::new(),
@@ -131,7 +138,7 @@ impl LineSpill {
 
     /// Appends one record (a write error is kept and reported by [`Self::copy_to`]).
     pub fn push(&mut self, line: &LineStats) {
-        if self.error.is_some() {
+        if self.error.is_some() || self.over_budget {
             return;
         }
         if let Err(e) = self.write_record(line) {
@@ -148,6 +155,13 @@ impl LineSpill {
         }
         // an element of `stats.lines` is three levels deep: six spaces before each of
         // its lines (the record holds no string with a newline)
+        let rows = self.buf.split(|&b| b == b'\n').count() as u64;
+        self.bytes += 2 + self.buf.len() as u64 + 6 * rows;
+        if self.bytes > self.budget.output_bytes {
+            // nothing more on the disk: the run is refused at its end
+            self.over_budget = true;
+            return Ok(());
+        }
         for (k, row) in self.buf.split(|&b| b == b'\n').enumerate() {
             if k > 0 {
                 out.write_all(b"\n")?;
@@ -157,6 +171,15 @@ impl LineSpill {
         }
         self.count += 1;
         Ok(())
+    }
+
+    /// The output budget the records ran past, if they did: `what` names the output.
+    pub fn over_budget(&self, what: &str) -> Option<cwisim_scene::budget::BudgetError> {
+        self.over_budget.then(|| {
+            self.budget
+                .check_output(what, self.bytes)
+                .expect_err("the records ran past the budget")
+        })
     }
 
     /// The records written so far.

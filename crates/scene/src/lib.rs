@@ -13,6 +13,8 @@
 //! * [`predicates`] — exact orientation, segment intersection, polygon simplicity.
 //! * [`settings`] — [`Shading`] and [`Antialias`], the drawing settings every renderer
 //!   and command names the same way.
+//! * [`budget`] — the memory, output and thread budgets every command works within
+//!   (`CWISIM_MAX_MEMORY`, `CWISIM_MAX_OUTPUT`), checked before allocating.
 //! * [`grid`] — a generated tessellated surface (`N × N` warped quads, every edge
 //!   shared), the benchmarks' scene.
 //!
@@ -36,6 +38,7 @@
 
 #![warn(missing_docs)]
 
+pub mod budget;
 pub mod error;
 pub mod grid;
 pub mod locate;

@@ -43,6 +43,30 @@ impl ImageArgs {
         self.output.is_some() || self.npy.is_some()
     }
 
+    /// Refuses, before any work, images the memory budget cannot hold: `lines` scanlines
+    /// (a frame, known from the header) of `width × channels` values, 8 bytes each for
+    /// `--npy`, 1 for `-o`'s PNG.
+    pub fn check_memory(&self, width: u32, channels: usize, lines: u64) -> Result<(), CliError> {
+        let values = lines
+            .saturating_mul(u64::from(width))
+            .saturating_mul(channels as u64);
+        let per_value = 8 * u64::from(self.npy.is_some()) + u64::from(self.output.is_some());
+        if per_value == 0 {
+            return Ok(());
+        }
+        let what = format!(
+            "the image of {lines} scanline(s) of {width} × {channels} value(s) ({})",
+            match (self.npy.is_some(), self.output.is_some()) {
+                (true, true) => "--npy and -o",
+                (true, false) => "--npy",
+                _ => "-o",
+            }
+        );
+        cwisim_scene::budget::Budget::current()
+            .check_memory(&what, values.saturating_mul(per_value))
+            .map_err(CliError::from)
+    }
+
     /// Refuses, before any work, an output whose extension is not the format written
     /// (`-o` writes PNG, `--npy` NumPy: `-o x.jpg` is an error, not PNG bytes in a .jpg)
     /// and a PNG of a channel count PNG cannot hold.

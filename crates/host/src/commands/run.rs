@@ -6,10 +6,13 @@ use crate::demo;
 use crate::error::CliError;
 use crate::files::{check_outputs, write_atomic};
 use crate::progress::Progress;
+use crate::range::Range;
 use crate::report::{timing_name, unrefreshed_warning, write_summary, LineSpill, StatsReport};
 use clap::{Args, ValueEnum};
 use cwisim_isa::{Encoding, FileReader, TraceRead};
+use cwisim_scene::budget::{Budget, BudgetError};
 use cwisim_study::cost::{CostMap, CostReader};
+use cwisim_xproc::LineStats;
 use cwisim_xproc::{
     replay_streaming, LineRecords, NullSink, Numeric, ReplayError, RunStats, Timing,
 };
@@ -107,6 +110,12 @@ pub fn run(
     };
     let header = *reader.header();
     args.image.check(header.channel_count())?;
+    // a trace holds at least one whole frame: that much image is known now
+    args.image.check_memory(
+        header.width,
+        header.channel_count(),
+        u64::from(header.lines),
+    )?;
     args.cost.check()?;
     let mut cost = args
         .cost
@@ -207,6 +216,9 @@ before the error (a frame has {})",
         };
         let spill = spill.as_ref().expect("made with --stats-json");
         let mut spill = spill.lock().expect("not poisoned");
+        if let Some(e) = spill.over_budget(&format!("--stats-json {}", path.display())) {
+            return Err(e.into());
+        }
         write_atomic(path, |w| {
             report
                 .write_json_spilled(w, &mut spill)
@@ -263,17 +275,84 @@ pub fn replay_file(
     machine: &cwisim_xproc::Machine,
     timing: Timing,
     numeric: &Numeric,
+    keep: Range,
     progress: &mut dyn FnMut(u64),
 ) -> Result<RunStats, CliError> {
-    Ok(replay_streaming(
+    let kept = Arc::new(Mutex::new(KeptRecords::new(keep, Budget::current())));
+    let to = Arc::clone(&kept);
+    let mut stats = replay_streaming(
         reader,
         machine,
         timing,
         numeric,
-        LineRecords::Keep,
+        LineRecords::Send(Box::new(move |l| {
+            to.lock().expect("not poisoned").push(l);
+        })),
         &mut NullSink,
         progress,
-    )?)
+    )?;
+    let kept = std::mem::replace(
+        &mut *kept.lock().expect("not poisoned"),
+        KeptRecords::new(keep, Budget::current()),
+    );
+    stats.lines = kept.finish()?;
+    Ok(stats)
+}
+
+/// The per-scanline records of the scanlines in a range, kept within the memory budget:
+/// past it the records are dropped as they come and the run is refused at its end, saying
+/// how many scanlines it had.
+struct KeptRecords {
+    range: Range,
+    budget: Budget,
+    lines: Vec<LineStats>,
+    over: Option<u64>,
+}
+
+impl KeptRecords {
+    fn new(range: Range, budget: Budget) -> Self {
+        KeptRecords {
+            range,
+            budget,
+            lines: Vec::new(),
+            over: None,
+        }
+    }
+
+    fn push(&mut self, line: LineStats) {
+        if !self.range.contains(line.line) {
+            return;
+        }
+        if let Some(n) = &mut self.over {
+            *n += 1;
+            return;
+        }
+        let bytes = (self.lines.len() as u64 + 1) * std::mem::size_of::<LineStats>() as u64;
+        if self.budget.check_memory("", bytes).is_err() {
+            self.over = Some(self.lines.len() as u64 + 1);
+            self.lines = Vec::new();
+            return;
+        }
+        self.lines.push(line);
+    }
+
+    fn finish(self) -> Result<Vec<LineStats>, CliError> {
+        match self.over {
+            None => Ok(self.lines),
+            Some(n) => {
+                let what = format!(
+                    "keeping the records of {n} scanlines ({} each; --lines or --frames selects fewer)",
+                    cwisim_scene::budget::human(std::mem::size_of::<LineStats>() as u64)
+                );
+                Err(BudgetError::Memory {
+                    what,
+                    needed: n.saturating_mul(std::mem::size_of::<LineStats>() as u64),
+                    budget: self.budget.memory_bytes,
+                }
+                .into())
+            }
+        }
+    }
 }
 
 /// Refuses outputs that would overwrite the trace or each other.

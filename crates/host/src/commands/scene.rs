@@ -146,6 +146,7 @@ pub fn run_render(
         ],
     )?;
     args.cost.check()?;
+    cwisim_scene::budget::check_threads(args.threads).map_err(CliError::Usage)?;
     let drawn = args.draw.draw_on(args.scene.as_deref(), args.threads)?;
     let mut image_args = args.image.clone();
     if let Some(png) = default_png(args, &drawn) {
@@ -159,6 +160,7 @@ pub fn run_render(
     };
     let h = renderer.header();
     image_args.check(h.channel_count())?;
+    image_args.check_memory(h.width, h.channel_count(), frames_lines_of(renderer))?;
     let trace_bytes = match &args.trace {
         Some(path) => Some(encode(renderer, path)?),
         None => None,
@@ -246,4 +248,9 @@ pub fn run_render(
         stdout.flush().map_err(CliError::Stdout)?;
     }
     Ok(())
+}
+
+/// The scanlines of every frame a renderer draws.
+fn frames_lines_of(renderer: &dyn cwisim_render::Renderer) -> u64 {
+    u64::from(renderer.header().lines) * u64::from(renderer.frames())
 }

@@ -162,11 +162,15 @@ pub fn run(
         Input::Trace => {
             let (mut reader, _) = open_trace(Some(&args.input))?;
             let header = *reader.header();
+            // only the records of the scanlines asked for are kept
+            let keep = Range::selection(args.lines, args.frames, u64::from(header.lines))
+                .unwrap_or(Range::ALL);
             let stats = replay_file(
                 &mut *reader,
                 &machine,
                 timing,
                 &cwisim_xproc::Numeric::F64,
+                keep,
                 &mut |_| {},
             )?;
             (header, stats)
@@ -198,7 +202,7 @@ pub fn run(
         .cloned()
         .collect();
     if lines.is_empty() && chosen.is_some() {
-        let have = match stats.lines.len() {
+        let have = match stats.totals.lines {
             0 => "the run output no scanline".to_string(),
             1 => "the run output 1 scanline (0)".to_string(),
             n => format!("the run output {n} scanlines (0-{})", n - 1),

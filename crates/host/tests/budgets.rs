@@ -1,0 +1,102 @@
+//! The budgets (`CWISIM_MAX_MEMORY`, `CWISIM_MAX_OUTPUT`, the thread cap): sizes known
+//! before the work are refused before it, sizes that grow with the input are refused as
+//! soon as they pass the budget, each with exit 2 and a message that says what the work
+//! needs and how to raise the budget; nothing is written.
+
+mod common;
+
+use common::{scratch, text};
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn cwisim_env(dir: &Path, env: &[(&str, &str)], args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_cwisim"))
+        .args(args)
+        .envs(env.iter().copied())
+        .current_dir(dir)
+        .output()
+        .expect("run the cwisim binary")
+}
+
+/// A trace of `lines` one-line frames, 16 processors wide.
+fn many_lines(dir: &Path, name: &str, lines: usize) {
+    let mut t = String::from("cwisim-trace version=1 width=16 lines=1 channels=1\n");
+    for _ in 0..lines {
+        t.push_str("Eval1 0 16 0.5\nRefresh\n");
+    }
+    std::fs::write(dir.join(name), t).unwrap();
+}
+
+fn refused(out: &Output, needle: &str) -> String {
+    let (stdout, stderr) = text(out);
+    assert_eq!(out.status.code(), Some(2), "{stdout}{stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(stderr.contains(needle), "{stderr}");
+    stderr
+}
+
+#[test]
+fn a_budget_that_is_not_a_size_is_refused() {
+    let dir = scratch("budget-bad-var");
+    let out = cwisim_env(&dir, &[("CWISIM_MAX_MEMORY", "lots")], &["machine"]);
+    refused(
+        &out,
+        "CWISIM_MAX_MEMORY=\"lots\": unknown unit `lots`; expected a number of bytes",
+    );
+}
+
+#[test]
+fn an_image_known_from_the_header_is_refused_before_reading() {
+    let dir = scratch("budget-header");
+    // the header alone: 65536 lines × 65536 × 4 values is 128 GiB of f64
+    std::fs::write(
+        dir.join("huge.cwt"),
+        "cwisim-trace version=1 width=65536 lines=65536 channels=4\n",
+    )
+    .unwrap();
+    let out = cwisim_env(&dir, &[], &["run", "huge.cwt", "--npy", "h.npy"]);
+    let stderr = refused(
+        &out,
+        "needs 128.0 GiB of memory, over the budget of 4.0 GiB",
+    );
+    assert!(stderr.contains("CWISIM_MAX_MEMORY"), "{stderr}");
+    assert!(!dir.join("h.npy").exists());
+}
+
+#[test]
+fn per_scanline_records_past_the_budget_are_refused_and_a_selection_fits() {
+    let dir = scratch("budget-records");
+    many_lines(&dir, "t.cwt", 5000);
+    let tight = [("CWISIM_MAX_MEMORY", "100K")];
+    let out = cwisim_env(&dir, &tight, &["stats", "t.cwt", "--stats-json", "s.json"]);
+    refused(&out, "keeping the records of 5000 scanlines");
+    assert!(!dir.join("s.json").exists());
+    // the scanlines asked for are all that is kept
+    let out = cwisim_env(&dir, &tight, &["stats", "t.cwt", "--lines", "0..10"]);
+    assert!(out.status.success(), "{:?}", text(&out));
+}
+
+#[test]
+fn an_output_past_the_budget_is_refused_and_not_written() {
+    let dir = scratch("budget-output");
+    many_lines(&dir, "t.cwt", 2000);
+    let out = cwisim_env(
+        &dir,
+        &[("CWISIM_MAX_OUTPUT", "64K")],
+        &["run", "t.cwt", "--stats-json", "s.json"],
+    );
+    refused(&out, "--stats-json s.json would be larger than 64.0 KiB");
+    let left: Vec<_> = std::fs::read_dir(&dir).unwrap().collect();
+    assert_eq!(left.len(), 1, "only the trace: {left:?}");
+    // within the default budget it is written
+    let out = cwisim_env(&dir, &[], &["run", "t.cwt", "--stats-json", "s.json"]);
+    assert!(out.status.success(), "{:?}", text(&out));
+    assert!(std::fs::metadata(dir.join("s.json")).unwrap().len() > 64 << 10);
+}
+
+#[test]
+fn threads_are_capped() {
+    let dir = scratch("budget-threads");
+    let out = cwisim_env(&dir, &[], &["render", "fig25", "--threads", "1000000"]);
+    refused(&out, "--threads 1000000: at most");
+}
