@@ -35,8 +35,8 @@ pub enum CliError {
     /// The scene file is malformed (its message is located).
     #[error(transparent)]
     Scene(#[from] SceneError),
-    /// The output image would be larger than the collector allows.
-    #[error(transparent)]
+    /// The output image would be larger than the collector allows (the memory budget).
+    #[error("{0} (CWISIM_MAX_MEMORY=SIZE raises the memory budget)")]
     ImageLimit(#[from] ImageLimit),
     /// The work would need more memory, output or threads than the budget
     /// (`CWISIM_MAX_MEMORY`, `CWISIM_MAX_OUTPUT`), or a budget variable is not a size.

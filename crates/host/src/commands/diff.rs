@@ -165,10 +165,11 @@ fn load_output(path: &Path, args: &DiffArgs) -> Result<Image, CliError> {
     let machine = args.machine.load()?;
     let mut reader = crate::input::open(path, &args.draw)?;
     let h = *reader.header();
+    // two images are held at once: each gets half the memory budget
     let mut sink = ImageSink::new(
         h.width as usize,
         h.channel_count(),
-        ImageSink::DEFAULT_LIMIT_BYTES,
+        cwisim_scene::budget::Budget::current().memory_bytes / 2,
     );
     replay::<f64>(&mut *reader, &machine, Timing::Fast, &mut sink, &mut |_| {})?;
     Ok(sink.finish()?)
