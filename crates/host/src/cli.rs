@@ -429,7 +429,7 @@ fn dispatch(
         Command::Render(args) => scene::run_render(args, stdout, progress).map(|()| 0),
         Command::Scenes(args) => scenes::run(args, stdout, stderr).map(|()| 0),
         Command::Renderers(args) => renderers::run(args, stdout).map(|()| 0),
-        Command::Tradeoff(args) => tradeoff::run(args, stdout).map(|()| 0),
+        Command::Tradeoff(args) => tradeoff::run(args, stdout, progress).map(|()| 0),
         Command::Refine(args) => refine::run(args, stdout, progress).map(|()| 0),
         Command::Fit(args) => fit::run(args, stdout).map(|()| 0),
         Command::Emit(args) => scene::run_emit(args).map(|()| 0),

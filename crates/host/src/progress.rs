@@ -5,8 +5,9 @@
 //! standard error is not a terminal (pipes, files, tests), so it never pollutes captured
 //! output.
 
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use indicatif::{HumanDuration, ProgressBar, ProgressDrawTarget, ProgressState, ProgressStyle};
 use std::io::IsTerminal;
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 /// How long a run goes before its bar appears.
@@ -16,6 +17,9 @@ pub const SHOW_AFTER: Duration = Duration::from_secs(1);
 pub struct Progress {
     bar: ProgressBar,
     start: Instant,
+    /// The first progress reported, and when: the estimate of the time left counts only
+    /// the work done since (so the set-up before it does not make the rate look slow).
+    first: Arc<Mutex<Option<(Instant, u64)>>>,
     /// Whether the bar may ever appear (standard error is a terminal).
     enabled: bool,
     shown: bool,
@@ -41,15 +45,52 @@ impl Progress {
         )
     }
 
+    /// A bar over `total` steps of a command's work (settings measured, stages done),
+    /// `what` saying what it is doing; the same rules.
+    pub fn steps(total: u64, enabled: bool, what: &str) -> Self {
+        Self::with_template(
+            total,
+            enabled,
+            &format!("{{spinner}} {what} [{{wide_bar}}] {{pos}}/{{len}} {{msg}} ({{eta}} left)"),
+        )
+    }
+
+    /// Runs `f` with the bar hidden, so that what it prints stands above the bar.
+    pub fn suspend<R>(&self, f: impl FnOnce() -> R) -> R {
+        self.bar.suspend(f)
+    }
+
+    /// Says what the current step is (`vanrij, gouraud, f64`).
+    pub fn message(&self, msg: String) {
+        self.bar.set_message(msg);
+    }
+
     fn with_template(total: u64, enabled: bool, template: &str) -> Self {
         let len = (total > 0).then_some(total);
         let bar = ProgressBar::with_draw_target(len, ProgressDrawTarget::hidden());
+        let first: Arc<Mutex<Option<(Instant, u64)>>> = Arc::new(Mutex::new(None));
+        let seen = Arc::clone(&first);
         if let Ok(style) = ProgressStyle::with_template(template) {
-            bar.set_style(style.progress_chars("=> "));
+            bar.set_style(style.progress_chars("=> ").with_key(
+                "eta",
+                move |state: &ProgressState, w: &mut dyn std::fmt::Write| {
+                    let first = seen.lock().ok().and_then(|f| *f);
+                    let left = first.and_then(|(at, at_first)| {
+                        let done = state.pos().saturating_sub(at_first);
+                        let left = state.len()?.saturating_sub(state.pos());
+                        time_left(done, left, at.elapsed())
+                    });
+                    let _ = match left {
+                        Some(d) => write!(w, "{:#}", HumanDuration(d)),
+                        None => write!(w, "?"),
+                    };
+                },
+            ));
         }
         Progress {
             bar,
             start: Instant::now(),
+            first,
             enabled: enabled && std::io::stderr().is_terminal(),
             shown: false,
         }
@@ -57,6 +98,11 @@ impl Progress {
 
     /// `done` bytes (or scanlines) so far.
     pub fn update(&mut self, done: u64) {
+        if done > 0 {
+            if let Ok(mut first) = self.first.lock() {
+                first.get_or_insert((Instant::now(), done));
+            }
+        }
         self.bar.set_position(done);
         if self.enabled && !self.shown && self.start.elapsed() >= SHOW_AFTER {
             self.shown = true;
@@ -68,6 +114,13 @@ impl Progress {
     pub fn is_shown(&self) -> bool {
         self.shown
     }
+}
+
+/// The time the `left` steps still take at the mean rate of the `done` steps that took
+/// `elapsed`: from the work done, not from the last steps' rate (which one slow first band
+/// or a burst of quick ones makes wrong by orders of magnitude). `None` before any step.
+pub fn time_left(done: u64, left: u64, elapsed: Duration) -> Option<Duration> {
+    (done > 0).then(|| elapsed.mul_f64(left as f64 / done as f64))
 }
 
 impl Drop for Progress {
@@ -87,6 +140,25 @@ mod tests {
         p.update(50);
         p.update(100);
         assert!(!p.is_shown());
+    }
+
+    #[test]
+    fn time_left_is_the_mean_rate_of_the_work_done() {
+        assert_eq!(time_left(0, 100, Duration::from_secs(5)), None);
+        assert_eq!(
+            time_left(10, 90, Duration::from_secs(1)),
+            Some(Duration::from_secs(9))
+        );
+        assert_eq!(
+            time_left(100, 0, Duration::from_secs(3)),
+            Some(Duration::ZERO)
+        );
+        // however slow the set-up before the first step (not counted), and however the
+        // steps bunch up, the estimate is the mean
+        assert_eq!(
+            time_left(1000, 2000, Duration::from_millis(500)),
+            Some(Duration::from_secs(1))
+        );
     }
 
     #[test]

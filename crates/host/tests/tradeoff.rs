@@ -203,3 +203,38 @@ fn fit_finds_formats_that_hold_and_cannot_lose_a_bit() {
     let bad = cwisim(&dir, &["fit", "fig25", "--max-error", "0"]);
     assert_eq!(bad.status.code(), Some(2));
 }
+
+#[test]
+fn a_renderer_that_would_repeat_another_is_skipped_saying_so_and_rows_stream() {
+    let dir = scratch("tradeoff-skip");
+    let out = cwisim_ok(
+        &dir,
+        &[
+            "tradeoff",
+            "fig25",
+            "--repeat",
+            "1",
+            "--numeric",
+            "f64",
+            "--renderers",
+            "vanrij,nishita",
+            "--csv",
+            "t.csv",
+        ],
+    );
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(
+        lines[0],
+        "skipped nishita: the scene has no Bézier patches, so it would draw exactly as vanrij"
+    );
+    assert!(lines[1].starts_with("renderer "), "{out}");
+    let (header, rows) = read_csv(&dir.join("t.csv"));
+    assert!(rows.iter().all(|r| r.get(&header, "renderer") == "vanrij"));
+    // the streamed rows, then the Pareto front again, then what was written
+    assert!(out.contains(
+        "Pareto front (no other setting has fewer busy cycles, register bits and RMS error all at once): "
+    ));
+    assert_eq!(lines.last().copied(), Some("wrote t.csv"), "{out}");
+    let streamed = lines[2..].iter().take_while(|l| !l.is_empty()).count();
+    assert_eq!(streamed, rows.len(), "{out}");
+}

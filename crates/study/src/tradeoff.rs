@@ -93,6 +93,26 @@ pub struct Setting {
     pub numeric: Numeric,
 }
 
+impl Setting {
+    /// The setting in words, as a progress line shows it: renderer, shading, filter or
+    /// samples, visibility, tessellation, registers.
+    pub fn describe(&self) -> String {
+        let s = &self.settings;
+        let mut words = vec![self.renderer.name.to_string(), s.shading.name().to_string()];
+        if self.renderer.supersampled {
+            words.push(format!("{}×{} samples", s.samples, s.samples));
+        } else {
+            words.push(s.aa.name().to_string());
+        }
+        words.push(s.visibility.name().to_string());
+        if let Some(n) = s.tessellate {
+            words.push(format!("tessellate {n}"));
+        }
+        words.push(short_numeric(&self.numeric));
+        words.join(" ")
+    }
+}
+
 /// Samples per pixel side tried for a supersampling renderer: from point sampling to
 /// 64 samples per pixel, enough to see the error fall as `l` grows.
 pub const SAMPLES_AXIS: [u32; 4] = [1, 2, 4, 8];
@@ -106,6 +126,9 @@ pub struct Axes {
     pub size: Option<Size>,
     /// Tessellations of the scene's Bézier meshes (empty: as the scene says).
     pub tessellations: Vec<u32>,
+    /// The scene has Bézier patches: a renderer that draws them directly has something
+    /// of its own to draw (without, it would draw exactly as `vanrij`).
+    pub patches: bool,
 }
 
 /// The root tolerances of a renderer that draws Bézier patches directly (Nishita et
@@ -134,8 +157,8 @@ pub fn grid(
         axes.tessellations.iter().map(|&n| Some(n)).collect()
     };
     for &renderer in renderers {
-        if renderer.patches && !axes.world {
-            // no patches to draw: its rows would be vanrij's
+        if renderer.patches && !axes.patches {
+            // no patches to draw: its rows would be vanrij's ([`skipped_renderers`])
             continue;
         }
         if renderer.patches {
@@ -373,6 +396,58 @@ pub fn measure(
     })
 }
 
+/// What [`tradeoff_rows`] reports as it goes, for a progress bar and a table printed row
+/// by row.
+#[derive(Debug)]
+pub enum Step<'a> {
+    /// The grid is known: `total` settings; the renderers left out, each with why.
+    Start {
+        /// Settings to measure.
+        total: usize,
+        /// `(renderer, why)` of every renderer left out because it would draw the scene
+        /// exactly as another.
+        skipped: &'a [(&'static str, String)],
+    },
+    /// Setting `index` of `total` is being measured.
+    Measuring {
+        /// Its index.
+        index: usize,
+        /// Settings in all.
+        total: usize,
+        /// The setting, in words (`vanrij gouraud box f64`).
+        setting: String,
+    },
+    /// Setting `index` was measured: its row (not yet marked Pareto: that needs every
+    /// row).
+    Measured {
+        /// Its index.
+        index: usize,
+        /// Settings in all.
+        total: usize,
+        /// The row.
+        row: &'a Row,
+    },
+}
+
+/// The renderers among `entries` that would draw a scene exactly as another, with why:
+/// one that draws Bézier patches directly, on a scene without patches, draws it as
+/// `vanrij` does.
+pub fn skipped_renderers(
+    entries: &[&'static registry::Entry],
+    axes: &Axes,
+) -> Vec<(&'static str, String)> {
+    entries
+        .iter()
+        .filter(|e| e.patches && !axes.patches)
+        .map(|e| {
+            (
+                e.name,
+                "the scene has no Bézier patches, so it would draw exactly as vanrij".to_string(),
+            )
+        })
+        .collect()
+}
+
 /// Measures every setting of the grid: `renderers` by name (empty: every registered one).
 #[allow(clippy::too_many_arguments)]
 pub fn tradeoff_rows(
@@ -383,7 +458,7 @@ pub fn tradeoff_rows(
     formats: &[Numeric],
     machine: &Machine,
     repeat: u32,
-    progress: &mut dyn FnMut(usize, usize),
+    progress: &mut dyn FnMut(Step<'_>),
 ) -> Result<Vec<Row>, StudyError> {
     // a progressive renderer's frames refine one another: one frame against the exact
     // image says nothing of it (its phases are measured by its own summary)
@@ -414,13 +489,22 @@ pub fn tradeoff_rows(
         } else {
             Vec::new()
         },
+        patches: probe.has_patches(),
     };
     let settings = grid(&entries, &axes, formats);
+    progress(Step::Start {
+        total: settings.len(),
+        skipped: &skipped_renderers(&entries, &axes),
+    });
     // the references made so far, by (Phong, tessellation)
     let mut references: BTreeMap<(bool, Option<u32>), Vec<f64>> = BTreeMap::new();
     let mut rows = Vec::with_capacity(settings.len());
     for (k, setting) in settings.iter().enumerate() {
-        progress(k, settings.len());
+        progress(Step::Measuring {
+            index: k,
+            total: settings.len(),
+            setting: setting.describe(),
+        });
         let measured = measure(scene, setting, machine)?;
         let mut times = vec![measured.time];
         for _ in 1..repeat.max(1) {
@@ -487,6 +571,11 @@ pub fn tradeoff_rows(
             counters: measured.counters,
             pareto: false,
         });
+        progress(Step::Measured {
+            index: k,
+            total: settings.len(),
+            row: rows.last().expect("just pushed"),
+        });
     }
     mark_pareto(&mut rows);
     Ok(rows)
@@ -494,19 +583,32 @@ pub fn tradeoff_rows(
 
 /// The table, as `tradeoff` prints it.
 pub fn write_table(out: &mut dyn Write, rows: &[Row]) -> std::io::Result<()> {
-    let rw = rows
-        .iter()
-        .map(|r| r.renderer.len())
-        .chain([8])
-        .max()
-        .unwrap_or(8);
+    let rw = name_width(rows.iter().map(|r| r.renderer));
+    write_table_header(out, rw)?;
+    for r in rows {
+        write_table_row(out, r, rw)?;
+    }
+    Ok(())
+}
+
+/// The width of the renderer column for these names (at least the header's).
+pub fn name_width<'a>(names: impl Iterator<Item = &'a str>) -> usize {
+    names.map(str::len).chain([8]).max().unwrap_or(8)
+}
+
+/// The table's header line, the renderer column `rw` wide.
+pub fn write_table_header(out: &mut dyn Write, rw: usize) -> std::io::Result<()> {
     writeln!(
         out,
         "{:<rw$} {:>4} {:<8} {:<10} {:>2} {:<5} {:<34} {:>4} {:>8} {:>9} {:>6} {:>4} {:>8} {:>9} {:>9} {:>6} {:>5}  pareto",
         "renderer", "tess", "shading", "aa", "l", "vis", "numeric", "bits", "instr", "busy cyc", "worst", "late", "host ms", "max err", "RMS err", "PSNR", "ovfl"
-    )?;
-    for r in rows {
-        writeln!(
+    )
+}
+
+/// One row of the table, the renderer column `rw` wide; `*` in the last column when the
+/// row is on the Pareto front ([`mark_pareto`]: known only once every row is measured).
+pub fn write_table_row(out: &mut dyn Write, r: &Row, rw: usize) -> std::io::Result<()> {
+    writeln!(
             out,
             "{:<rw$} {:>4} {:<8} {:<10} {:>2} {:<5} {:<34} {:>4} {:>8} {:>9} {:>5.1}% {:>4} {:>8.2} {:>9.2e} {:>9.2e} {:>6} {:>5}  {}",
             r.renderer,
@@ -535,9 +637,7 @@ pub fn write_table(out: &mut dyn Write, rows: &[Row]) -> std::io::Result<()> {
             },
             r.overflows,
             if r.pareto { "*" } else { "" }
-        )?;
-    }
-    Ok(())
+        )
 }
 
 /// The table as CSV (one header line, one line per setting). After the fixed columns
@@ -632,6 +732,7 @@ mod tests {
             world: true,
             size: None,
             tessellations: vec![4, 8],
+            patches: true,
         };
         let g = grid(&[vanrij], &world, &f64_only);
         // 2 tessellations × (exact: phong, gouraud, flat; eval0: gouraud, flat) × 2 aa,

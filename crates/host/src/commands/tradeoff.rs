@@ -8,9 +8,12 @@ use super::MachineArgs;
 use crate::error::CliError;
 use crate::files::{check_outputs, write_atomic};
 use crate::output::write_rgb_png;
+use crate::progress::Progress;
 use clap::Args;
 use cwisim_render::{Size, Source};
-use cwisim_study::tradeoff::{csv, tradeoff_rows, write_table, DEFAULT_FORMATS};
+use cwisim_study::tradeoff::{
+    csv, name_width, tradeoff_rows, write_table_header, write_table_row, Step, DEFAULT_FORMATS,
+};
 use cwisim_study::tradeoff_plot::render_tradeoff_plot;
 use cwisim_xproc::Numeric;
 use std::io::Write;
@@ -52,7 +55,7 @@ pub struct TradeoffArgs {
 }
 
 /// Runs `cwisim tradeoff`.
-pub fn run(args: &TradeoffArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
+pub fn run(args: &TradeoffArgs, stdout: &mut dyn Write, progress: bool) -> Result<(), CliError> {
     check_outputs(
         None,
         &[
@@ -75,6 +78,11 @@ pub fn run(args: &TradeoffArgs, stdout: &mut dyn Write) -> Result<(), CliError> 
     } else {
         args.numeric.clone()
     };
+    // rows are printed as they are measured, a progress bar on a terminal says where the
+    // sweep is; the Pareto front needs every row, so it comes last
+    let width = name_width(cwisim_render::registry::REGISTRY.iter().map(|e| e.name));
+    let mut bar: Option<Progress> = None;
+    let mut failed: Option<std::io::Error> = None;
     let rows = tradeoff_rows(
         args.scene.as_deref(),
         args.size,
@@ -83,20 +91,77 @@ pub fn run(args: &TradeoffArgs, stdout: &mut dyn Write) -> Result<(), CliError> 
         &formats,
         &machine,
         args.repeat,
-        &mut |_, _| {},
+        &mut |step| {
+            if failed.is_some() {
+                return;
+            }
+            let result = match step {
+                Step::Start { total, skipped } => {
+                    bar = Some(Progress::steps(total as u64, progress, "measuring"));
+                    skipped
+                        .iter()
+                        .try_for_each(|(name, why)| writeln!(stdout, "skipped {name}: {why}"))
+                        .and_then(|()| write_table_header(stdout, width))
+                }
+                Step::Measuring { index, setting, .. } => {
+                    if let Some(bar) = &mut bar {
+                        bar.message(setting);
+                        bar.update(index as u64);
+                    }
+                    Ok(())
+                }
+                Step::Measured { index, row, .. } => {
+                    let mut write =
+                        || write_table_row(stdout, row, width).and_then(|()| stdout.flush());
+                    match &mut bar {
+                        Some(bar) => {
+                            bar.update(index as u64 + 1);
+                            // above the bar, not through it
+                            bar.suspend(write)
+                        }
+                        None => write(),
+                    }
+                }
+            };
+            if let Err(e) = result {
+                failed = Some(e);
+            }
+        },
     )?;
-    write_table(stdout, &rows).map_err(CliError::Stdout)?;
+    drop(bar);
+    if let Some(e) = failed {
+        return Err(CliError::Stdout(e));
+    }
+    let front: Vec<_> = rows.iter().filter(|r| r.pareto).collect();
+    writeln!(
+        stdout,
+        "\nPareto front (no other setting has fewer busy cycles, register bits and RMS error \
+all at once): {} of {} settings",
+        front.len(),
+        rows.len()
+    )
+    .map_err(CliError::Stdout)?;
+    write_table_header(stdout, width).map_err(CliError::Stdout)?;
+    for row in front {
+        write_table_row(stdout, row, width).map_err(CliError::Stdout)?;
+    }
+    let mut written = Vec::new();
     if let Some(path) = &args.csv {
         let text = csv(&rows);
         write_atomic(path, |w| {
             w.write_all(text.as_bytes())
                 .map_err(|e| CliError::write(path, e))
         })?;
+        written.push(path.display().to_string());
     }
     if let Some(path) = &args.plot {
         let name = Source::resolve(args.scene.as_deref())?.name();
         let img = render_tradeoff_plot(&rows, &name).map_err(CliError::Usage)?;
         write_rgb_png(path, &img)?;
+        written.push(path.display().to_string());
+    }
+    if !written.is_empty() {
+        writeln!(stdout, "wrote {}", written.join(", ")).map_err(CliError::Stdout)?;
     }
     stdout.flush().map_err(CliError::Stdout)
 }
