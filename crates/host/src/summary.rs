@@ -159,12 +159,17 @@ pub fn write_render_summary(
         } else {
             String::new()
         };
+        // a renderer of several frames: say which frame, and its own row
+        let which = if tot.frames > 1 {
+            format!("frame {}, scanline {}", w.frame, w.row)
+        } else {
+            format!("scanline {}", w.line)
+        };
         row(
             out,
             "worst line",
             format!(
-                "scanline {}: {} bus cycles{share}; {} late scanline(s), worst slack {} cycles",
-                w.line,
+                "{which}: {} bus cycles{share}; {} late scanline(s), worst slack {} cycles",
                 w.busy_cycles,
                 tot.late_lines,
                 tot.worst_slack.unwrap_or(0)
@@ -205,7 +210,15 @@ pub fn write_render_summary(
     row(out, "time", parts.join(" · "))?;
     if !written.is_empty() {
         let names: Vec<String> = written.iter().map(|p| p.display().to_string()).collect();
-        row(out, "wrote", names.join(", "))?;
+        let stacked = if tot.frames > 1 {
+            format!(
+                " (its {} frames stacked top to bottom in the images, {} rows each)",
+                tot.frames, h.lines
+            )
+        } else {
+            String::new()
+        };
+        row(out, "wrote", format!("{}{stacked}", names.join(", ")))?;
     }
     Ok(())
 }

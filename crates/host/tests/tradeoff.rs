@@ -160,7 +160,7 @@ fn fit_finds_formats_that_hold_and_cannot_lose_a_bit() {
     let out = cwisim_ok(&dir, &["fit", "fig25", "--max-error", "1/512"]);
     let format = out
         .lines()
-        .find_map(|l| l.strip_prefix("narrowest"))
+        .find_map(|l| l.strip_prefix("registers"))
         .expect("a format")
         .trim()
         .to_string();

@@ -217,15 +217,28 @@ pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
 }
 
 /// A scene file's text; a file that cannot be read is an [`SceneErrorKind::Io`] error
-/// naming it (what every reader of scene files starts with).
+/// naming it (what every reader of scene files starts with), invalid UTF-8 is located by
+/// byte, line and column, and a file larger than the memory budget
+/// ([`crate::budget::Budget`]) is refused before it is read.
 pub fn read_scene_text(path: &Path) -> Result<String, SceneError> {
-    std::fs::read_to_string(path).map_err(|e| {
-        SceneError::at_field(
-            SceneErrorKind::Io,
-            "",
-            format!("cannot read the scene: {e}"),
-        )
-        .in_file(path)
+    let fail =
+        |message: String| SceneError::at_field(SceneErrorKind::Io, "", message).in_file(path);
+    // the file's size against the memory budget before it is read whole
+    let size = std::fs::metadata(path)
+        .map_err(|e| fail(format!("cannot read the scene: {e}")))?
+        .len();
+    crate::budget::Budget::current()
+        .check_memory("reading the scene file", size)
+        .map_err(|e| fail(e.to_string()))?;
+    let bytes = std::fs::read(path).map_err(|e| fail(format!("cannot read the scene: {e}")))?;
+    String::from_utf8(bytes).map_err(|e| {
+        let at = e.utf8_error().valid_up_to();
+        let text = &e.as_bytes()[..at];
+        let line = 1 + text.iter().filter(|&&b| b == b'\n').count();
+        let column = 1 + text.iter().rev().take_while(|&&b| b != b'\n').count();
+        fail(format!(
+            "invalid UTF-8 at byte {at} (line {line}, column {column}): a scene file is UTF-8 JSON"
+        ))
     })
 }
 

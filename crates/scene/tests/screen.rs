@@ -509,3 +509,18 @@ fn a_repeated_key_is_located() {
     assert!(e.to_string().contains("duplicate field `polygons`"), "{e}");
     assert_eq!((e.line, e.column.is_some()), (Some(1), true), "{e}");
 }
+
+/// Invalid UTF-8 is located by byte, line and column, and the file named.
+#[test]
+fn invalid_utf8_is_located() {
+    let dir = std::env::temp_dir().join(format!("cwisim-scene-utf8-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("bad.json");
+    std::fs::write(&path, b"{\"kind\": \"screen\",\n  \"name\": \"caf\xe9\"}").unwrap();
+    let e = cwisim_scene::load_scene(&path).unwrap_err().to_string();
+    assert!(
+        e.contains("bad.json") && e.contains("invalid UTF-8 at byte 33 (line 2, column 15)"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

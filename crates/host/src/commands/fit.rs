@@ -102,7 +102,8 @@ pub fn run(args: &FitArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
             ),
         )?;
         w(out, "budget", format!("the registers may add at most {:.4e} to any value (against the f64 array)", args.max_error))?;
-        w(out, "narrowest", Numeric::Fixed(fit.format).to_string())?;
+        w(out, "registers", Numeric::Fixed(fit.format).to_string())?;
+        w(out, "search", "no register can lose a bit, no two can each lose one, no register can give two for one more in another: the narrowest the search found, a local minimum (docs/TRADEOFF.md)".to_string())?;
         w(out, "its error", format!("{:.4e} against the f64 array; {:.4e} against the exact image (the f64 array alone: {:.4e}, the Y-processor's approximation)", fit.error, fit.exact_error, fit.f64_error))?;
         let total: u32 = (0..4).map(|k| {
             let q = q(&fit.format, k);

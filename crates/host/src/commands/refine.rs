@@ -260,5 +260,24 @@ pub fn run(args: &RefineArgs, stdout: &mut dyn Write, progress: bool) -> Result<
         let img = render_refine_plot(&results).map_err(CliError::Usage)?;
         write_rgb_png(path, &img)?;
     }
+    let frames = first.frames.len();
+    let written: Vec<String> = [
+        args.trace.as_ref().map(|p| p.display().to_string()),
+        args.frames_png
+            .as_ref()
+            .map(|d| format!("{} ({frames} frame PNGs)", d.display())),
+        args.cost_image_dir
+            .as_ref()
+            .map(|d| format!("{} ({frames} cost images)", d.display())),
+        args.ids.as_ref().map(|p| p.display().to_string()),
+        args.csv.as_ref().map(|p| p.display().to_string()),
+        plot.as_ref().map(|p| p.display().to_string()),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    if !written.is_empty() {
+        writeln!(stdout, "\nwrote {}", written.join(", ")).map_err(CliError::Stdout)?;
+    }
     stdout.flush().map_err(CliError::Stdout)
 }

@@ -100,10 +100,24 @@ pub fn run(args: &VcdArgs) -> Result<(), CliError> {
 fn window(args: &VcdArgs, width: u32) -> Result<(u32, u32), CliError> {
     let last = width.saturating_sub(1);
     let (from, to) = match args.x {
-        Some(r) => (
-            r.first.min(u64::from(u32::MAX)) as u32,
-            r.last.map_or(last, |l| l.min(u64::from(u32::MAX)) as u32),
-        ),
+        Some(r) => {
+            // the range as the user wrote it, in the message: never a clamped copy
+            let outside = || {
+                CliError::Usage(format!(
+                    "--x {r}: the window is outside the array: {} has processors 0..={last}",
+                    args.trace.display(),
+                ))
+            };
+            let from = u32::try_from(r.first).map_err(|_| outside())?;
+            let to = match r.last {
+                Some(l) => u32::try_from(l).map_err(|_| outside())?,
+                None => last,
+            };
+            if from > to || to >= width {
+                return Err(outside());
+            }
+            (from, to)
+        }
         None => {
             if args.from.is_none() && args.to.is_none() && width > MAX_DEFAULT_WINDOW {
                 return Err(CliError::Usage(format!(
