@@ -431,11 +431,11 @@ fn dispatch(
         Command::Renderers(args) => renderers::run(args, stdout).map(|()| 0),
         Command::Tradeoff(args) => tradeoff::run(args, stdout, progress).map(|()| 0),
         Command::Refine(args) => refine::run(args, stdout, progress).map(|()| 0),
-        Command::Fit(args) => fit::run(args, stdout).map(|()| 0),
+        Command::Fit(args) => fit::run(args, stdout, progress).map(|()| 0),
         Command::Emit(args) => scene::run_emit(args).map(|()| 0),
         Command::Stats(args) => stats::run(args, stdout, stderr).map(|()| 0),
         Command::History(args) => history::run(args, stdout).map(|()| 0),
-        Command::Inspect(args) => inspect::run(args, stdout).map(|()| 0),
+        Command::Inspect(args) => inspect::run(args, stdout, progress).map(|()| 0),
         Command::Vcd(args) => vcd::run(args).map(|()| 0),
         // equal: 0, different: 1, even when the reader of the report went away
         Command::Diff(args) => diff::run(args, &mut ReaderMayLeave::new(stdout)).map(|equal| {

@@ -116,6 +116,47 @@ impl Progress {
     }
 }
 
+/// A spinner for a stage whose work has no count the command can see (loading and
+/// preparing a scene, exact visibility, building an inspect page): it appears after
+/// [`SHOW_AFTER`] on a terminal, turning on its own, says what is being done, and is gone
+/// when dropped.
+pub struct Stage {
+    bar: ProgressBar,
+}
+
+impl Stage {
+    /// A spinner saying `what`, if `enabled` and standard error is a terminal.
+    pub fn new(enabled: bool, what: &str) -> Stage {
+        let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::hidden());
+        if let Ok(style) = ProgressStyle::with_template("{spinner} {msg} ({elapsed})") {
+            bar.set_style(style);
+        }
+        bar.set_message(what.to_string());
+        if enabled && std::io::stderr().is_terminal() {
+            let shown = bar.clone();
+            std::thread::spawn(move || {
+                std::thread::sleep(SHOW_AFTER);
+                if !shown.is_finished() {
+                    shown.set_draw_target(ProgressDrawTarget::stderr());
+                    shown.enable_steady_tick(Duration::from_millis(120));
+                }
+            });
+        }
+        Stage { bar }
+    }
+
+    /// Says what is being done now.
+    pub fn message(&self, what: &str) {
+        self.bar.set_message(what.to_string());
+    }
+}
+
+impl Drop for Stage {
+    fn drop(&mut self) {
+        self.bar.finish_and_clear();
+    }
+}
+
 /// The time the `left` steps still take at the mean rate of the `done` steps that took
 /// `elapsed`: from the work done, not from the last steps' rate (which one slow first band
 /// or a burst of quick ones makes wrong by orders of magnitude). `None` before any step.

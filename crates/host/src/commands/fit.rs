@@ -72,8 +72,9 @@ fn parse_error_budget(s: &str) -> Result<f64, String> {
 }
 
 /// Runs `cwisim fit`.
-pub fn run(args: &FitArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
+pub fn run(args: &FitArgs, stdout: &mut dyn Write, progress: bool) -> Result<(), CliError> {
     let machine = args.machine.load()?;
+    let stage = crate::progress::Stage::new(progress, "fit: drawing the scene");
     let drawn = args.draw.draw(args.scene.as_deref())?;
     let exact = exact_image(args.scene.as_deref(), args.draw.size)?;
     let header = drawn.renderer.header();
@@ -84,7 +85,9 @@ pub fn run(args: &FitArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
         OverflowArg::Wrap => Overflow::Wrap,
         OverflowArg::Saturate => Overflow::Saturate,
     };
+    stage.message("fit: replaying the stream in candidate formats");
     let fit = fit_format(&mut bench, args.max_error, overflow)?;
+    drop(stage);
     let out = stdout;
     let w = |out: &mut dyn Write, label: &str, value: String| writeln!(out, "{label:<16}{value}");
     (|| -> std::io::Result<()> {

@@ -9,6 +9,7 @@ use crate::draw::DrawArgs;
 use crate::error::CliError;
 use crate::files::{check_outputs, write_atomic};
 use crate::input::InputKind;
+use crate::progress::Stage;
 use crate::range::{parse_range, Range};
 use crate::summary::{write_render_summary, StageTimes};
 use clap::Args;
@@ -101,7 +102,7 @@ fn window(
 }
 
 /// Runs `cwisim inspect`.
-pub fn run(args: &InspectArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
+pub fn run(args: &InspectArgs, stdout: &mut dyn Write, progress: bool) -> Result<(), CliError> {
     let kind = InputKind::of(&args.input)?;
     check_extension("-o", &args.output, "html")?;
     let input_file = args
@@ -123,6 +124,7 @@ pub fn run(args: &InspectArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
     let name = display_name(&args.input);
     let mut summary = None;
     let mut reference = None;
+    let stage = Stage::new(progress, "inspect: preparing the input");
     let (mut trace, drawn) = match kind {
         InputKind::Trace => (Some(crate::input::open(&args.input, &args.draw)?), None),
         InputKind::Scene => (None, Some(args.draw.draw(Some(&args.input))?)),
@@ -144,6 +146,7 @@ pub fn run(args: &InspectArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
                 numeric: Numeric::F64,
                 timing: Timing::Fast,
             };
+            stage.message("inspect: rendering the scene for its summary");
             let rendered = render(renderer, &array, 1, &mut NullSink, Taps::default())?;
             let mut text = Vec::new();
             write_render_summary(
@@ -168,6 +171,7 @@ pub fn run(args: &InspectArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
             } else {
                 "the exact box-filtered image of the exact visible surfaces"
             };
+            stage.message("inspect: the reference image");
             let image = cwisim_study::tradeoff::reference_image(Some(&args.input), &settings)?;
             reference = Some((image, what));
             let mut bytes = Vec::new();
@@ -181,6 +185,7 @@ pub fn run(args: &InspectArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
         }
         (None, None) => unreachable!("a trace or a scene"),
     };
+    stage.message("inspect: replaying on the stepped model, gathering every pixel's history");
     let page = inspect(
         &mut *reader,
         &machine,
@@ -193,6 +198,7 @@ pub fn run(args: &InspectArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
             reference: reference.as_ref().map(|(r, n)| (r.as_slice(), *n)),
         },
     )?;
+    drop(stage);
     write_atomic(&args.output, |w| {
         w.write_all(page.html.as_bytes())
             .map_err(|e| CliError::write(&args.output, e))

@@ -8,7 +8,7 @@ use crate::cost_args::{display_name, CostArgs};
 use crate::draw::{DrawArgs, Drawn};
 use crate::error::CliError;
 use crate::files::{check_outputs, same_file, write_atomic};
-use crate::progress::Progress;
+use crate::progress::{Progress, Stage};
 use crate::report::{timing_name, write_summary, StatsReport};
 use crate::summary::{write_render_summary, StageTimes};
 use clap::Args;
@@ -147,7 +147,13 @@ pub fn run_render(
     )?;
     args.cost.check()?;
     cwisim_scene::budget::check_threads(args.threads).map_err(CliError::Usage)?;
+    // loading, projecting, lighting and exact visibility come before the first scanline
+    let stage = Stage::new(
+        progress && !args.quiet,
+        "render: loading and preparing the scene (visibility)",
+    );
     let drawn = args.draw.draw_on(args.scene.as_deref(), args.threads)?;
+    drop(stage);
     let mut image_args = args.image.clone();
     if let Some(png) = default_png(args, &drawn) {
         image_args.output = Some(png);
