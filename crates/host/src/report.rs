@@ -303,6 +303,16 @@ pub fn write_summary(
         _ => "- (no scanline)".to_string(),
     };
     row(out, "worst slack", &worst)?;
+    if t.saturated_lines > 0 {
+        row(
+            out,
+            "saturated lines",
+            &format!(
+                "{} (their cycle counts reached 2^64 - 1: slack and lateness there are bounds)",
+                t.saturated_lines
+            ),
+        )?;
+    }
     row(out, "processor updates", &t.processor_updates)?;
     row(out, "dropped negatives", &t.dropped_negative)?;
     row(out, "suppressed", &t.suppressed)?;
