@@ -39,8 +39,12 @@ pub enum View {
     Along(DVec3),
 }
 
-/// How many pieces of a list are tried as its node's splitter (the fewest splits wins).
+/// How many pieces of a list, spread evenly over it, are tried as its node's splitter.
 pub const CANDIDATES: usize = 8;
+/// What a split costs in the choice of a splitter, against one piece of imbalance between
+/// the two sides: splits add pieces, imbalance adds depth (and a tree as deep as its
+/// pieces takes quadratic time to build).
+pub const SPLIT_WEIGHT: u64 = 4;
 
 /// A plane `n·p + d = 0`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -174,9 +178,11 @@ fn split(plane: &Plane, p: &Piece, eps: f64, channels: usize) -> (Piece, Piece) 
 impl Tree {
     /// The tree of `pieces` (triangles or convex polygons with at least three world
     /// points; pieces without a plane are kept in the node of the first plane they meet
-    /// as coplanar). Each node's splitter is, of the first [`CANDIDATES`] pieces of its
-    /// list, the one that splits fewest of the others (ties: the most even sides, then
-    /// the first). `eps`: the distance within which a vertex counts as on a plane.
+    /// as coplanar). Each node's splitter is, of [`CANDIDATES`] pieces spread evenly over
+    /// its list, the one of least cost: [`SPLIT_WEIGHT`] per piece it splits plus the
+    /// difference between its two sides (ties: the first) — the balance keeps the tree's
+    /// depth near `log n`, so that it builds in `O(n log n)`, not `O(n²)`. `eps`: the
+    /// distance within which a vertex counts as on a plane.
     pub fn build(pieces: Vec<Piece>, eps: f64, channels: usize) -> Tree {
         let mut tree = Tree {
             pieces,
@@ -194,13 +200,21 @@ impl Tree {
         let all: Vec<u32> = (0..tree.pieces.len() as u32).collect();
         let mut work = vec![(all, Slot::Root, 1u64)];
         while let Some((list, slot, depth)) = work.pop() {
-            // the splitter: of the first CANDIDATES pieces with a plane, the one that
-            // splits fewest (then balances best; then the first)
-            let candidates: Vec<(usize, Plane)> = list
-                .iter()
-                .enumerate()
-                .filter_map(|(i, &k)| Plane::of(&tree.pieces[k as usize]).map(|p| (i, p)))
+            // the splitter: of CANDIDATES pieces with a plane, spread evenly over the
+            // list (neighbours in a mesh share nearly one plane, and one of them splits
+            // the rest no better than another), the one of the least cost: a split costs
+            // SPLIT_WEIGHT, an unbalanced piece 1 (then the first)
+            let stride = (list.len() / CANDIDATES).max(1);
+            let candidates: Vec<(usize, Plane)> = (0..list.len())
+                .step_by(stride)
+                .filter_map(|i| Plane::of(&tree.pieces[list[i] as usize]).map(|p| (i, p)))
                 .take(CANDIDATES)
+                .chain(
+                    // a list whose evenly spread pieces have no plane: the first that has
+                    list.iter()
+                        .enumerate()
+                        .find_map(|(i, &k)| Plane::of(&tree.pieces[k as usize]).map(|p| (i, p))),
+                )
                 .collect();
             let best = candidates.iter().min_by_key(|(_, plane)| {
                 let (mut splits, mut front, mut back) = (0u64, 0i64, 0i64);
@@ -212,7 +226,7 @@ impl Tree {
                         Side::Both => splits += 1,
                     }
                 }
-                (splits, (front - back).unsigned_abs())
+                splits * SPLIT_WEIGHT + (front - back).unsigned_abs()
             });
             let Some(&(at, plane)) = best else {
                 // no plane among them: they cover nothing; keep them in a leaf
