@@ -100,3 +100,25 @@ fn threads_are_capped() {
     let out = cwisim_env(&dir, &[], &["render", "fig25", "--threads", "1000000"]);
     refused(&out, "--threads 1000000: at most");
 }
+
+#[test]
+fn nishita_pieces_past_the_budget_are_refused_band_by_band() {
+    let dir = scratch("budget-nishita");
+    let out = cwisim_env(
+        &dir,
+        &[("CWISIM_MAX_MEMORY", "8M")],
+        &[
+            "render",
+            "teapot",
+            "--renderer",
+            "nishita",
+            "--subscan",
+            "64",
+            "-o",
+            "t.png",
+        ],
+    );
+    let stderr = refused(&out, "pieces (so far, at row");
+    assert!(stderr.contains("--subscan 64"), "{stderr}");
+    assert!(!dir.join("t.png").exists());
+}
