@@ -3,7 +3,7 @@
 
 use crate::error::{describe, json_kind, locate_error, read_kind, SceneError, SceneErrorKind};
 use crate::predicates::simplicity_fault;
-use crate::{MAX_CHANNELS, MAX_COORDINATE, MAX_SIDE, MAX_VALUES, SCENE_KINDS};
+use crate::{MAX_CHANNELS, MAX_COORDINATE, MAX_INTENSITY, MAX_SIDE, MAX_VALUES, SCENE_KINDS};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -385,7 +385,8 @@ impl ScreenScene {
     /// * `width`, `height` in `1..=MAX_SIDE`; `channels` in `1..=MAX_CHANNELS`;
     ///   `width × height × channels ≤ MAX_VALUES`.
     /// * Every polygon: at least 3 vertices, finite, `|x|, |y| ≤ MAX_COORDINATE`; one
-    ///   intensity vector per vertex, each of `channels` finite values.
+    ///   intensity vector per vertex, each of `channels` finite values of magnitude at
+    ///   most `MAX_INTENSITY`.
     /// * `depth`, when given: one finite value per vertex, on every polygon or on none.
     /// * Every polygon is simple: no two non-adjacent edges cross or touch, and no two
     ///   adjacent edges overlap (a vertex that doubles back). Zero-length edges (repeated
@@ -476,6 +477,16 @@ impl ScreenScene {
                         K::NonFinite,
                         field(),
                         format!("expected a finite intensity, found {bad}"),
+                    ));
+                }
+                if let Some((c, big)) = i.iter().enumerate().find(|(_, c)| c.abs() > MAX_INTENSITY)
+                {
+                    return Err(SceneError::at_field(
+                        K::Limit,
+                        format!("polygons[{k}].intensity[{v}][{c}]"),
+                        format!(
+                            "intensity {big:e} is beyond ±{MAX_INTENSITY:e}, the limit that keeps the renderers' arithmetic finite (intensities are nominally 0 to 1)"
+                        ),
                     ));
                 }
             }
