@@ -147,6 +147,11 @@ pub fn project(
                         )
                     }),
                 };
+                for i in &intensity {
+                    crate::lighting::check_lit(i, channels, || {
+                        (format!("meshes[{k}]"), format!("face {f}"))
+                    })?;
+                }
                 out.push(ScreenTriangle {
                     points,
                     inv_depth: p.map(|q| 1.0 / camera.depth(q)),

@@ -33,7 +33,8 @@
 
 use crate::mesh::{self, Mesh};
 use cwisim_scene::{
-    json_error, locate_error, SceneError, SceneErrorKind, MAX_CHANNELS, MAX_SIDE, MAX_VALUES,
+    json_error, locate_error, SceneError, SceneErrorKind, MAX_CHANNELS, MAX_INTENSITY, MAX_SIDE,
+    MAX_VALUES,
 };
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -62,6 +63,9 @@ impl PerChannel {
         }
     }
 
+    /// Checks the shape (one number, or `channels`), that every value is finite, at least
+    /// `min` and at most [`MAX_INTENSITY`] in magnitude (a value beyond it is named by its
+    /// own path, `field[c]`, when given per channel).
     fn check(&self, field: &str, channels: usize, min: f64) -> Result<(), SceneError> {
         let values: Vec<f64> = match self {
             PerChannel::All(v) => vec![*v],
@@ -79,13 +83,23 @@ impl PerChannel {
                 v.clone()
             }
         };
-        for v in values {
+        let each = matches!(self, PerChannel::Each(_));
+        for (c, v) in values.into_iter().enumerate() {
             finite(field, v)?;
             if v < min {
                 return Err(SceneError::at_field(
                     SceneErrorKind::Limit,
                     field,
                     format!("expected a value ≥ {min}, found {v}"),
+                ));
+            }
+            if v.abs() > MAX_INTENSITY {
+                return Err(SceneError::at_field(
+                    SceneErrorKind::Limit,
+                    if each { format!("{field}[{c}]") } else { field.to_string() },
+                    format!(
+                        "{v:e} is beyond {MAX_INTENSITY:e}, the limit of every intensity and lighting term (it keeps the lighting and the renderers' arithmetic finite; terms are nominally 0 to 1)"
+                    ),
                 ));
             }
         }
