@@ -44,7 +44,9 @@ pub mod screen;
 pub mod settings;
 
 pub use error::{describe_json, json_error, locate_error, read_kind, SceneError, SceneErrorKind};
-pub use screen::{load_scene, parse_scene, read_scene_text, Polygon, Scene, ScreenScene};
+pub use screen::{
+    check_intensity, load_scene, parse_scene, read_scene_text, Polygon, Scene, ScreenScene,
+};
 pub use settings::{Antialias, Shading};
 
 /// The scene kinds this crate reads, as the `kind` key names them.
