@@ -189,6 +189,16 @@ fn lighting_terms_beyond_the_intensity_limit_are_refused_at_their_path() {
     ] {
         parse_any(&GOOD.replacen(from, to, 1), None).expect("within the limits");
     }
+    // a scene built in code is never validated: projection checks its lighting terms
+    let cwisim_world::AnyScene::World(mut w) = parse_any(GOOD, None).expect("good") else {
+        panic!("a world scene")
+    };
+    w.spec.meshes[0].material.k_d = cwisim_world::scene::PerChannel::All(f64::MAX);
+    let e = cwisim_world::project::project(&w, cwisim_scene::Shading::Gouraud).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        format!("meshes[0].material.k_d: 1.7976931348623157e308 {BEYOND}")
+    );
 }
 
 #[test]
