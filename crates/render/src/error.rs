@@ -1,8 +1,11 @@
-//! How rendering fails: bad input (the scene, the settings, the machine), or a fault of
-//! the renderer or the array, which is not the user's doing.
+//! How rendering fails: bad input (the scene, the settings, the machine, or scene values
+//! that overflow a renderer's arithmetic), or a fault of the renderer or the array, which
+//! is not the user's doing.
 
+use cwisim_isa::Instruction;
 use cwisim_scene::SceneError;
 use cwisim_xproc::{ImageLimit, MachineError};
+use std::io;
 
 /// Why a render failed.
 #[derive(Debug, thiserror::Error)]
@@ -40,9 +43,115 @@ pub enum RenderError {
     /// or failed, or a tap beside it (a cost map) did.
     #[error("the array failed: {0}")]
     Array(std::io::Error),
+    /// A value the renderer made for the array is not finite: the scene's values, each
+    /// within its limit, still overflow `f64` in the renderer's arithmetic. Bad input, like
+    /// a scene over a limit (the CLI's exit 2), found where the value was made (per-pixel
+    /// shading) or, at the latest, where the array checks every operand — before the array
+    /// runs it. Located by the renderer, the frame (renderers of several frames), the
+    /// pixel row and the pixel or instruction.
+    #[error(
+        "{renderer}: {}{source}: a value computed from the scene overflows f64 (its intensities or lighting terms are too large for this renderer's arithmetic; docs/LIMITS.md, \"Intensities\")",
+        place(*.frame, .source.row)
+    )]
+    Overflow {
+        /// The renderer.
+        renderer: &'static str,
+        /// The frame, for a renderer that draws several (`None`: it draws one).
+        frame: Option<u32>,
+        /// What was made, and where: the row (`source.row`), the pixel or instruction.
+        source: NonFinite,
+    },
+}
+
+/// A value made for the array that is not finite, as found where it was made: the stage
+/// and what (a pixel's shade; an instruction's operand). It travels in an [`io::Error`]
+/// (what emitters return, [`NonFinite::into_io`]) to the pipeline, which reports it as
+/// [`RenderError::Overflow`], naming the renderer and the row.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{stage}: {detail}")]
+pub struct NonFinite {
+    /// The pixel row it was made for, when known where it was found (else the pipeline
+    /// gives it, from the scanlines it has had: [`NonFinite::at_row`]).
+    pub row: Option<u32>,
+    /// What made it: `"per-pixel shading"`, `"emitted instruction"`.
+    pub stage: &'static str,
+    /// Where in the row and what: `"pixel 4, channel 0: the shade is inf"`.
+    pub detail: String,
+}
+
+impl NonFinite {
+    /// The value of an instruction's operand that is not finite, if one is: its slot
+    /// named (`I`, `dI`, `ddI`) with the instruction.
+    pub fn in_instruction(instr: &Instruction) -> Option<NonFinite> {
+        const SLOTS: [&str; 3] = [
+            "the intensity I",
+            "the first forward difference dI",
+            "the second forward difference ddI",
+        ];
+        let values = instr.values();
+        let (slot, bad) = values.iter().enumerate().find_map(|(s, v)| {
+            v.as_slice()
+                .iter()
+                .find(|f| !f.is_finite())
+                .map(|bad| (s, *bad))
+        })?;
+        Some(NonFinite {
+            row: None,
+            stage: "emitted instruction",
+            detail: format!("`{instr}`: {} is {bad}", SLOTS[slot]),
+        })
+    }
+
+    /// As an [`io::Error`] (kind `InvalidData`), for an emitter to return.
+    pub fn into_io(self) -> io::Error {
+        io::Error::new(io::ErrorKind::InvalidData, self)
+    }
+
+    /// The `NonFinite` an [`io::Error`] carries, if any.
+    pub fn carried_by(e: &io::Error) -> Option<&NonFinite> {
+        e.get_ref()?.downcast_ref()
+    }
+
+    /// `e`, its [`NonFinite`] (if it carries one without a row) given the row `row`: for a
+    /// renderer that makes its rows' values in a loop of its own.
+    pub fn at_row(e: io::Error, row: u32) -> io::Error {
+        match NonFinite::carried_by(&e) {
+            Some(nf) if nf.row.is_none() => NonFinite {
+                row: Some(row),
+                ..nf.clone()
+            }
+            .into_io(),
+            _ => e,
+        }
+    }
+}
+
+/// `frame F, row R: `, as much of it as is known.
+fn place(frame: Option<u32>, row: Option<u32>) -> String {
+    match (frame, row) {
+        (Some(f), Some(r)) => format!("frame {f}, row {r}: "),
+        (Some(f), None) => format!("frame {f}: "),
+        (None, Some(r)) => format!("row {r}: "),
+        (None, None) => String::new(),
+    }
 }
 
 impl RenderError {
+    /// What an error of `renderer`'s own making is: a value that is not finite
+    /// ([`RenderError::Overflow`], bad input) if `source` carries a [`NonFinite`];
+    /// otherwise the renderer's fault ([`RenderError::Renderer`]). For renderers that
+    /// make a frame's values before it is emitted (their `frame`), and the pipeline.
+    pub fn of_renderer(renderer: &'static str, source: io::Error) -> RenderError {
+        match NonFinite::carried_by(&source) {
+            Some(nf) => RenderError::Overflow {
+                renderer,
+                frame: None,
+                source: nf.clone(),
+            },
+            None => RenderError::Renderer { renderer, source },
+        }
+    }
+
     /// Whether the fault is cwisim's own (a renderer or the array misbehaving), not the
     /// input's.
     pub fn is_internal(&self) -> bool {

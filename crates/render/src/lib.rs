@@ -66,7 +66,7 @@ pub mod subsample;
 pub mod vanrij;
 pub mod woochall;
 
-pub use error::RenderError;
+pub use error::{NonFinite, RenderError};
 pub use pipeline::{emit, render, ArrayConfig, Rendered, Taps};
 pub use prepare::PolygonScene;
 pub use registry::{find, Entry, DEFAULT_RENDERER, REGISTRY};

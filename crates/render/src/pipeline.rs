@@ -16,9 +16,11 @@
 //! call). Either way the array's output, statistics and cycles are those of the serial
 //! stream: byte-identical at any thread count.
 
-use crate::error::RenderError;
+use crate::error::{NonFinite, RenderError};
 use crate::renderer::{Counters, FramePlan, Renderer};
-use cwisim_isa::{CheckedStream, Instruction, Opcode, PackedStream, TraceHeader, TraceWrite};
+use cwisim_isa::{
+    CheckedStream, Instruction, Opcode, OperandError, PackedStream, TraceHeader, TraceWrite,
+};
 use cwisim_xproc::{
     Band, BandArray, EngineWriter, Image, LineOut, LineSink, Machine, Numeric, RunStats, Timing,
 };
@@ -105,7 +107,12 @@ pub fn render(
         }
         None => lines,
     };
-    let mut feed = ScanlineFeed::open(&header, array, sink, taps)?;
+    let rows = Rows {
+        renderer: renderer.name(),
+        per_frame: header.lines,
+        frames: renderer.frames(),
+    };
+    let mut feed = ScanlineFeed::open(&header, array, sink, taps, rows)?;
     let start = Instant::now();
     let mut counters = Counters::default();
     let mut previous: Option<Image> = None;
@@ -114,10 +121,7 @@ pub fn render(
         let plan = renderer.frame(index, previous.as_ref())?;
         counters.merge(&plan.counters());
         row_figures.push(plan.row_figures().unwrap_or(serde_json::Value::Null));
-        let fault = |source| RenderError::Renderer {
-            renderer: renderer.name(),
-            source,
-        };
+        let fault = |source| RenderError::of_renderer(renderer.name(), source);
         let band = if threads > 1 {
             feed_parallel(&*plan, header.lines, threads, &mut feed, fault)?
         } else {
@@ -126,7 +130,9 @@ pub fn render(
         counters.merge(&band);
         // the frame's last scanlines reach the array (and the kept frame) before the
         // next frame is planned
-        feed.flush().map_err(RenderError::Array)?;
+        if let Err(e) = feed.flush() {
+            return Err(feed.array_fault(e));
+        }
         drop(plan);
         if let Some(frame) = &frame_image {
             previous = Some(frame.replace(empty_image(&header)));
@@ -137,7 +143,8 @@ pub fn render(
 
 /// Emits the whole stream of `renderer`, every frame, into `sink` (a trace file, a
 /// collector), serially; its counters. Frames that need the previous frame's output
-/// cannot be emitted without the array: they are refused.
+/// cannot be emitted without the array: they are refused. A value that is not finite is
+/// refused before it reaches `sink` ([`RenderError::Overflow`]), as the array would.
 pub fn emit(renderer: &dyn Renderer, sink: &mut dyn TraceWrite) -> Result<Counters, RenderError> {
     if renderer.needs_previous_frame() && renderer.frames() > 1 {
         return Err(RenderError::Usage(format!(
@@ -150,14 +157,102 @@ pub fn emit(renderer: &dyn Renderer, sink: &mut dyn TraceWrite) -> Result<Counte
         renderer: renderer.name(),
         source,
     };
+    let mut guard = Finite {
+        inner: sink,
+        header,
+        rows: Rows {
+            renderer: renderer.name(),
+            per_frame: header.lines,
+            frames: renderer.frames(),
+        },
+        line: 0,
+        overflow: None,
+    };
     let mut counters = Counters::default();
     for index in 0..renderer.frames() {
         let plan = renderer.frame(index, None)?;
         counters.merge(&plan.counters());
-        counters.merge(&plan.emit_rows(0..header.lines, sink).map_err(fault)?);
+        let emitted = plan.emit_rows(0..header.lines, &mut guard);
+        counters.merge(&emitted.map_err(|e| guard.fault(e, &fault))?);
     }
-    sink.finish().map_err(fault)?;
+    guard.inner.finish().map_err(fault)?;
     Ok(counters)
+}
+
+/// Whose rows a stream carries: what locates a value that is not finite.
+#[derive(Clone, Copy, Debug)]
+struct Rows {
+    renderer: &'static str,
+    per_frame: u32,
+    frames: u32,
+}
+
+impl Rows {
+    /// The refusal of `source`, made while the stream's `line`-th scanline (from 0, over
+    /// every frame) was.
+    fn overflow(&self, line: u64, mut source: NonFinite) -> RenderError {
+        let per_frame = u64::from(self.per_frame.max(1));
+        source.row = source.row.or(Some((line % per_frame) as u32));
+        RenderError::Overflow {
+            renderer: self.renderer,
+            frame: (self.frames > 1).then_some((line / per_frame) as u32),
+            source,
+        }
+    }
+}
+
+/// Passes a stream on to `inner`, refusing an instruction whose values are not finite
+/// (`emit`'s sink is a trace, which must not hold one) and counting the scanlines, so that
+/// the refusal names its row.
+struct Finite<'a> {
+    inner: &'a mut dyn TraceWrite,
+    header: TraceHeader,
+    rows: Rows,
+    line: u64,
+    overflow: Option<RenderError>,
+}
+
+impl Finite<'_> {
+    /// What an emission's error is: a value that is not finite (refused here, or found by
+    /// the renderer where it made it), or the renderer's fault.
+    fn fault(&mut self, e: io::Error, fault: &dyn Fn(io::Error) -> RenderError) -> RenderError {
+        if let Some(o) = self.overflow.take() {
+            return o;
+        }
+        match NonFinite::carried_by(&e) {
+            Some(nf) => self.rows.overflow(self.line, nf.clone()),
+            None => fault(e),
+        }
+    }
+}
+
+impl TraceWrite for Finite<'_> {
+    fn write(&mut self, instr: &Instruction) -> io::Result<()> {
+        if instr.op == Opcode::Refresh {
+            self.line += 1;
+        } else if let Err(OperandError::NonFinite(m)) = instr.check(&self.header) {
+            let nf = NonFinite::in_instruction(instr).unwrap_or(NonFinite {
+                row: None,
+                stage: "emitted instruction",
+                detail: m,
+            });
+            self.overflow = Some(self.rows.overflow(self.line, nf.clone()));
+            return Err(nf.into_io());
+        }
+        self.inner.write(instr)
+    }
+
+    fn comment(&mut self, text: &str) -> io::Result<()> {
+        self.inner.comment(text)
+    }
+
+    fn wants_comments(&self) -> bool {
+        self.inner.wants_comments()
+    }
+
+    fn finish(&mut self) -> io::Result<()> {
+        self.inner.finish()
+    }
 }
 
 fn empty_image(header: &TraceHeader) -> Image {
@@ -211,6 +306,10 @@ struct ScanlineFeed<'a, 's> {
     lines: u64,
     /// The array's (or a tap's) own failure, told apart from the renderer's.
     fault: Option<io::Error>,
+    /// Whose rows these are.
+    rows: Rows,
+    /// An instruction refused for a value that is not finite: bad input, not a fault.
+    overflow: Option<RenderError>,
 }
 
 impl<'a, 's> ScanlineFeed<'a, 's> {
@@ -223,6 +322,7 @@ impl<'a, 's> ScanlineFeed<'a, 's> {
         array: &ArrayConfig,
         sink: &'s mut dyn LineSink<f64>,
         taps: Taps<'a>,
+        rows: Rows,
     ) -> Result<Self, RenderError> {
         Ok(ScanlineFeed {
             array: EngineWriter::with_numeric(
@@ -240,6 +340,8 @@ impl<'a, 's> ScanlineFeed<'a, 's> {
             bands_taken: false,
             lines: 0,
             fault: None,
+            rows,
+            overflow: None,
         })
     }
 
@@ -252,7 +354,9 @@ impl<'a, 's> ScanlineFeed<'a, 's> {
         row_figures: Vec<serde_json::Value>,
         total: Duration,
     ) -> Result<Rendered, RenderError> {
-        self.finish().map_err(RenderError::Array)?;
+        if let Err(e) = self.finish() {
+            return Err(self.array_fault(e));
+        }
         let array_time = self.array_time;
         let stats = self.array.into_stats().expect("finished");
         Ok(Rendered {
@@ -286,7 +390,21 @@ impl<'a, 's> ScanlineFeed<'a, 's> {
     /// through the array; the buffer emptied for reuse.
     fn run_buffer(&mut self) -> io::Result<()> {
         let raw = std::mem::take(&mut self.buffer);
-        let stream = CheckedStream::from_vec(&self.header, raw).map_err(|u| u.refusal())?;
+        let stream = CheckedStream::from_vec(&self.header, raw).map_err(|u| {
+            if let OperandError::NonFinite(m) = &u.error {
+                let instr = &u.instructions[u.index];
+                let before = &u.instructions[..u.index];
+                let line =
+                    self.lines + before.iter().filter(|i| i.op == Opcode::Refresh).count() as u64;
+                let nf = NonFinite::in_instruction(instr).unwrap_or(NonFinite {
+                    row: None,
+                    stage: "emitted instruction",
+                    detail: m.clone(),
+                });
+                self.overflow = Some(self.rows.overflow(line, nf));
+            }
+            u.refusal()
+        })?;
         let r = self.array.write_checked(&stream);
         self.buffer = stream.into_vec();
         self.buffer.clear();
@@ -323,6 +441,44 @@ impl<'a, 's> ScanlineFeed<'a, 's> {
         Ok(true)
     }
 
+    /// The scanline being made: every `Refresh` the feed has had.
+    fn line_now(&self) -> u64 {
+        self.lines + self.buffered_lines
+    }
+
+    /// What an error of the array's (or a tap's) is: the refusal of a value that is not
+    /// finite (bad input), or the array's own fault.
+    fn array_fault(&mut self, e: io::Error) -> RenderError {
+        match self.overflow.take() {
+            Some(o) => {
+                self.fault = None;
+                o
+            }
+            None => RenderError::Array(e),
+        }
+    }
+
+    /// What an error of the renderer's emission into the feed is: a value that is not
+    /// finite (refused by the array, or found by the renderer where it made it), the
+    /// array's or a tap's own fault, or else the renderer's (`fault`).
+    fn renderer_fault(
+        &mut self,
+        e: io::Error,
+        fault: &dyn Fn(io::Error) -> RenderError,
+    ) -> RenderError {
+        if let Some(o) = self.overflow.take() {
+            self.fault = None;
+            return o;
+        }
+        if let Some(nf) = NonFinite::carried_by(&e) {
+            return self.rows.overflow(self.line_now(), nf.clone());
+        }
+        match self.fault.take() {
+            Some(own) => RenderError::Array(own),
+            None => fault(e),
+        }
+    }
+
     /// Notes an error of the array's or a tap's own, so that it is not blamed on the
     /// renderer.
     fn own(&mut self, r: io::Result<()>) -> io::Result<()> {
@@ -337,6 +493,17 @@ impl<'a, 's> ScanlineFeed<'a, 's> {
 impl TraceWrite for ScanlineFeed<'_, '_> {
     fn write(&mut self, instr: &Instruction) -> io::Result<()> {
         if let Some(also) = self.taps.also.as_deref_mut() {
+            // a tap (a trace, a cost map) gets no value the array would refuse as not
+            // finite: that is the input's doing, refused here first
+            if let Err(OperandError::NonFinite(m)) = instr.check(&self.header) {
+                let nf = NonFinite::in_instruction(instr).unwrap_or(NonFinite {
+                    row: None,
+                    stage: "emitted instruction",
+                    detail: m,
+                });
+                self.overflow = Some(self.rows.overflow(self.line_now(), nf.clone()));
+                return Err(nf.into_io());
+            }
             let r = also.write(instr);
             self.own(r)?;
         }
@@ -413,7 +580,10 @@ fn feed_serial_bands(
             .and_then(|c| Ok((array.take().map_err(io::Error::other)?, c)));
         let taken = match executed {
             Ok((band, band_counters)) => {
-                let taken = feed.take_in(&band).map_err(RenderError::Array)?;
+                let taken = match feed.take_in(&band) {
+                    Ok(t) => t,
+                    Err(e) => return Err(feed.array_fault(e)),
+                };
                 spare = std::mem::replace(&mut previous, band);
                 taken.then_some(band_counters)
             }
@@ -440,11 +610,8 @@ fn emit_into_feed(
     feed: &mut ScanlineFeed<'_, '_>,
     fault: &dyn Fn(io::Error) -> RenderError,
 ) -> Result<Counters, RenderError> {
-    plan.emit_rows(rows, feed).map_err(|e| {
-        feed.fault
-            .take()
-            .map_or_else(|| fault(e), RenderError::Array)
-    })
+    plan.emit_rows(rows, feed)
+        .map_err(|e| feed.renderer_fault(e, fault))
 }
 
 /// A band of rows as a thread emitted it: either its instructions, for the feeding thread
@@ -548,7 +715,9 @@ fn feed_parallel(
                 let emitted = match band {
                     Ok((Emitted::Instructions(instructions), band_counters)) => {
                         for instr in instructions.iter() {
-                            feed.write(&instr).map_err(RenderError::Array)?;
+                            if let Err(e) = feed.write(&instr) {
+                                return Err(feed.array_fault(e));
+                            }
                         }
                         if let Ok(mut s) = spare.lock() {
                             s.push(instructions);
@@ -556,7 +725,10 @@ fn feed_parallel(
                         Ok(band_counters)
                     }
                     Ok((Emitted::Executed(band), band_counters)) => {
-                        let taken = feed.take_in(&band).map_err(RenderError::Array)?;
+                        let taken = match feed.take_in(&band) {
+                            Ok(t) => t,
+                            Err(e) => return Err(feed.array_fault(e)),
+                        };
                         if let Ok(mut s) = spare_bands.lock() {
                             s.push(band);
                         }
@@ -566,7 +738,8 @@ fn feed_parallel(
                             Err(())
                         }
                     }
-                    Err(e) if band_arrays.is_none() => return Err(fault(e)),
+                    // failed on its thread: emitted again here, into the feed, which
+                    // tells a value that is not finite (and its row) from a fault
                     Err(_) => Err(()),
                 };
                 let band_counters = match emitted {

@@ -60,12 +60,17 @@ pub fn phong_needs_world() -> RenderError {
     )
 }
 
-/// Refuses a screen scene with a negative intensity, naming the value's JSON path: the
-/// array adds light and drops negative contributions (`Acc_mode` off), so a negative
-/// polygon would be drawn as 0 — silently wrong. Every renderer of screen scenes calls it.
-pub fn no_negative_intensity(s: &ScreenScene) -> Result<(), RenderError> {
+/// Checks a screen scene's intensities as every renderer of screen scenes draws them,
+/// naming the value's JSON path: each finite and at most `cwisim_scene::MAX_INTENSITY` in
+/// magnitude ([`RenderError::Scene`], as `ScreenScene::validate` refuses a file's — a
+/// scene built in code is never validated, and its values must not overflow a renderer's
+/// arithmetic either), and none negative ([`RenderError::Usage`]: the array adds light and
+/// drops negative contributions while `Acc_mode` is off, so a negative polygon would be
+/// drawn as 0 — silently wrong). Every renderer of screen scenes calls it.
+pub fn check_intensities(s: &ScreenScene) -> Result<(), RenderError> {
     for (k, p) in s.polygons.iter().enumerate() {
         for (v, i) in p.intensity.iter().enumerate() {
+            cwisim_scene::check_intensity(k, v, i)?;
             if let Some(bad) = i.iter().find(|c| **c < 0.0) {
                 return Err(RenderError::Usage(format!(
                     "polygons[{k}].intensity[{v}]: intensity {bad:e} is negative; renderers draw light, intensities ≥ 0 (the array drops negative contributions)"
@@ -123,7 +128,7 @@ impl PolygonScene {
         match loaded.scene {
             AnyScene::Screen(_) if phong => return Err(phong_needs_world()),
             AnyScene::Screen(s) => {
-                no_negative_intensity(&s)?;
+                check_intensities(&s)?;
                 prepared.screen = s
             }
             AnyScene::World(_) if phong && settings.visibility != Visibility::Exact => {

@@ -37,6 +37,7 @@
 //!
 //! Tolerance 0 means exactly the targets: one `Eval1` per pixel, no search.
 
+use crate::error::NonFinite;
 use cwisim_isa::{Instruction, Intensity, TraceWrite, MAX_CHANNELS};
 use std::io;
 
@@ -101,7 +102,9 @@ pub enum SpanError {
 
 /// Fits the run of pixels `x, x+1, …` whose targets are `targets` (pixel-major,
 /// `channels` values per pixel) within `tolerance` per value, and writes the pieces to
-/// `sink` in order.
+/// `sink` in order. A target that is not finite (a shade that overflowed) is refused as
+/// [`NonFinite`] (the pipeline's [`RenderError::Overflow`](crate::RenderError::Overflow),
+/// bad input), naming its pixel; any other fault as [`SpanError`].
 pub fn fit_span(
     x: u32,
     targets: &[f64],
@@ -109,8 +112,23 @@ pub fn fit_span(
     tolerance: f64,
     sink: &mut dyn TraceWrite,
 ) -> io::Result<SpanStats> {
-    let fitter = Fitter::new(targets, channels, tolerance)
-        .map_err(|e| io::Error::new(io::ErrorKind::InvalidInput, e))?;
+    let fitter = Fitter::new(targets, channels, tolerance).map_err(|e| match e {
+        // a shade that overflowed where it was made: the scene's doing, located
+        SpanError::Target {
+            pixel,
+            channel,
+            value,
+        } if !value.is_finite() => NonFinite {
+            row: None,
+            stage: "per-pixel shading",
+            detail: format!(
+                "pixel {}, channel {channel}: the shade is {value}",
+                u64::from(x) + pixel as u64
+            ),
+        }
+        .into_io(),
+        e => io::Error::new(io::ErrorKind::InvalidInput, e),
+    })?;
     fitter.send(x, sink)
 }
 

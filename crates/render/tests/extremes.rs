@@ -292,27 +292,41 @@ fn cases() -> Vec<Case> {
             screen(16, 16, vec![uniform(2047.0)]),
         ),
         draw(
+            "intensity 1e12 (the limit, MAX_INTENSITY)",
+            screen(16, 16, vec![uniform(1e12)]),
+        ),
+        refuse(
+            "intensity 1.000000000001e12 (just beyond the limit)",
+            screen(16, 16, vec![uniform(1.000000000001e12)]),
+            "polygons[0].intensity[0][0]",
+        ),
+        refuse(
             "intensity 3e38 (near f32's largest)",
             screen(16, 16, vec![uniform(3e38)]),
+            "polygons[0].intensity[0][0]",
         ),
-        draw("intensity 1e300", screen(16, 16, vec![uniform(1e300)])),
+        refuse(
+            "intensity 1e308",
+            screen(16, 16, vec![uniform(1e308)]),
+            "polygons[0].intensity[0][0]",
+        ),
         refuse_to_draw(
             "intensity -1",
             screen(16, 16, vec![uniform(-1.0)]),
             "polygons[0].intensity[0]",
         ),
         draw(
-            "sliver 1e-12 px wide, intensity 0 → 1e300 across its width",
-            sliver(1e300),
+            "sliver 1e-12 px wide, intensity 0 → 1e12 (the limit) across its width",
+            sliver(1e12),
         ),
         draw(
-            "triangle of 1e-9 px², intensities 0, 1e300, 5e299",
+            "triangle of 1e-9 px², intensities 0, 1e12, 5e11",
             screen(
                 16,
                 16,
                 vec![Polygon::new(
                     vec![[5.3, 5.3], [5.3 + 1e-4, 5.3], [5.3, 5.3 + 2e-5]],
-                    vec![vec![0.0], vec![1e300], vec![5e299]],
+                    vec![vec![0.0], vec![1e12], vec![5e11]],
                 )],
             ),
         ),

@@ -47,7 +47,9 @@ pub mod screen;
 pub mod settings;
 
 pub use error::{describe_json, json_error, locate_error, read_kind, SceneError, SceneErrorKind};
-pub use screen::{load_scene, parse_scene, read_scene_text, Polygon, Scene, ScreenScene};
+pub use screen::{
+    check_intensity, load_scene, parse_scene, read_scene_text, Polygon, Scene, ScreenScene,
+};
 pub use settings::{Antialias, Shading};
 
 /// The scene kinds this crate reads, as the `kind` key names them.
@@ -62,6 +64,13 @@ pub const MAX_VALUES: u64 = 1 << 28;
 /// The largest coordinate magnitude accepted. At 1e15 the spacing of `f64` is 0.125
 /// pixel; beyond it a coordinate can no longer resolve a pixel.
 pub const MAX_COORDINATE: f64 = 1e15;
+/// The largest intensity magnitude accepted (per vertex, per channel; world scenes hold
+/// their ambient, light and material terms to it too). Intensities are nominally in
+/// `[0, 1]`; the limit leaves room for high dynamic range while every renderer's
+/// arithmetic on intensities — flat means, coverage × intensity, forward differences over
+/// a 65 536-pixel row, lighting sums — stays far inside `f64` (the bound argument:
+/// `docs/LIMITS.md`, "Intensities").
+pub const MAX_INTENSITY: f64 = 1e12;
 
 /// A channel vector: up to [`MAX_CHANNELS`] values, the unused ones 0.
 pub type Vector = [f64; cwisim_isa::MAX_CHANNELS];

@@ -3,7 +3,7 @@
 
 use crate::error::{describe, json_kind, locate_error, read_kind, SceneError, SceneErrorKind};
 use crate::predicates::simplicity_fault;
-use crate::{MAX_CHANNELS, MAX_COORDINATE, MAX_SIDE, MAX_VALUES, SCENE_KINDS};
+use crate::{MAX_CHANNELS, MAX_COORDINATE, MAX_INTENSITY, MAX_SIDE, MAX_VALUES, SCENE_KINDS};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -343,6 +343,35 @@ fn channels_error(channels: u64) -> SceneError {
     )
 }
 
+/// Checks the intensity of polygon `k`'s vertex `v`: every value finite and at most
+/// [`MAX_INTENSITY`] in magnitude; a fault names its JSON path
+/// (`polygons[k].intensity[v]`, or `…[v][c]` for a value beyond the limit). What
+/// [`ScreenScene::validate`] asks of every intensity, for code that draws scenes it did not
+/// read (`cwisim-render` checks scenes built in code with it).
+pub fn check_intensity(k: usize, v: usize, values: &[f64]) -> Result<(), SceneError> {
+    if let Some(bad) = values.iter().find(|c| !c.is_finite()) {
+        return Err(SceneError::at_field(
+            SceneErrorKind::NonFinite,
+            format!("polygons[{k}].intensity[{v}]"),
+            format!("expected a finite intensity, found {bad}"),
+        ));
+    }
+    if let Some((c, big)) = values
+        .iter()
+        .enumerate()
+        .find(|(_, c)| c.abs() > MAX_INTENSITY)
+    {
+        return Err(SceneError::at_field(
+            SceneErrorKind::Limit,
+            format!("polygons[{k}].intensity[{v}][{c}]"),
+            format!(
+                "intensity {big:e} is beyond ±{MAX_INTENSITY:e}, the limit that keeps the renderers' arithmetic finite (intensities are nominally 0 to 1)"
+            ),
+        ));
+    }
+    Ok(())
+}
+
 impl ScreenScene {
     /// The channel count as a `usize`.
     pub fn channel_count(&self) -> usize {
@@ -398,7 +427,8 @@ impl ScreenScene {
     /// * `width`, `height` in `1..=MAX_SIDE`; `channels` in `1..=MAX_CHANNELS`;
     ///   `width × height × channels ≤ MAX_VALUES`.
     /// * Every polygon: at least 3 vertices, finite, `|x|, |y| ≤ MAX_COORDINATE`; one
-    ///   intensity vector per vertex, each of `channels` finite values.
+    ///   intensity vector per vertex, each of `channels` finite values of magnitude at
+    ///   most `MAX_INTENSITY`.
     /// * `depth`, when given: one finite value per vertex, on every polygon or on none.
     /// * Every polygon is simple: no two non-adjacent edges cross or touch, and no two
     ///   adjacent edges overlap (a vertex that doubles back). Zero-length edges (repeated
@@ -484,13 +514,7 @@ impl ScreenScene {
                         ),
                     ));
                 }
-                if let Some(bad) = i.iter().find(|c| !c.is_finite()) {
-                    return Err(SceneError::at_field(
-                        K::NonFinite,
-                        field(),
-                        format!("expected a finite intensity, found {bad}"),
-                    ));
-                }
+                check_intensity(k, v, i)?;
             }
             if p.depth.is_some() != self.polygons[0].depth.is_some() {
                 return Err(SceneError::at_field(

@@ -149,8 +149,10 @@ fn numbers_that_overflow_are_refused_not_infinite() {
     let e = err(&variant("[0.5]", "[-1e400]"));
     assert_eq!(e.kind, SceneErrorKind::Syntax);
     assert_eq!((e.line, e.column), (Some(6), Some(34)));
-    // the largest finite number is fine as an intensity
-    screen(&variant("[0.5]", "[1.7976931348623157e308]"));
+    // the largest finite number reads, and is then refused as an intensity beyond the
+    // limit (`limits`)
+    let e = err(&variant("[0.5]", "[1.7976931348623157e308]"));
+    assert_eq!(e.kind, SceneErrorKind::Limit, "{e}");
 }
 
 #[test]
@@ -247,6 +249,16 @@ fn limits() {
             "[40.0, 2e15]",
             "5:34: polygons[0].vertices[1]: coordinate 2e15 is beyond ±1e15, where f64 can no longer resolve a pixel",
         ),
+        (
+            "[0.5]",
+            "[1e308]",
+            "6:29: polygons[0].intensity[1][0]: intensity 1e308 is beyond ±1e12, the limit that keeps the renderers' arithmetic finite (intensities are nominally 0 to 1)",
+        ),
+        (
+            "[0.5]",
+            "[-1.000000000001e12]",
+            "6:29: polygons[0].intensity[1][0]: intensity -1.000000000001e12 is beyond ±1e12, the limit that keeps the renderers' arithmetic finite (intensities are nominally 0 to 1)",
+        ),
     ] {
         refused(&variant(from, to), Limit, shown);
     }
@@ -256,6 +268,24 @@ fn limits() {
         "\"width\": 65536, \"height\": 4096",
     ));
     screen(&variant("[40.0, 3.25]", "[-1e15, 1e15]"));
+    // the intensity limit itself is fine (a negative intensity is the renderers' to refuse)
+    screen(&variant(
+        "[[1.0], [0.5], [0.25]]",
+        "[[1e12], [-1e12], [5e-324]]",
+    ));
+    // the limit per channel, named by its index
+    let e = err(&one(
+        "[[0, 0], [1, 0], [0, 1]]",
+        "[[1, 1, 1], [1, 1, 1], [1, 1, 1.7976931348623157e308]]",
+        3,
+    ));
+    assert_eq!(e.kind, Limit, "{e}");
+    assert!(
+        e.to_string().starts_with(
+            "3:44: polygons[0].intensity[2][2]: intensity 1.7976931348623157e308 is beyond ±1e12"
+        ),
+        "{e}"
+    );
     let e = err(&variant("\"width\": 64", "\"width\": 99999999999999999999"));
     assert_eq!(e.kind, SceneErrorKind::Schema, "{e}");
 }

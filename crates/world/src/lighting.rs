@@ -10,9 +10,13 @@
 //! specular, and a highlight facing away (`R·V ≤ 0`) contributes no specular term — the
 //! formula as printed would subtract light there. Several lights add up. Intensities
 //! are not clamped: a PNG clamps to `[0, 1]` on output, `.npy` keeps the values.
+//!
+//! Every term is at most `cwisim_scene::MAX_INTENSITY` (`M`, checked when a scene is read)
+//! and `N·L`, `(R·V)^n` are in `[0, 1]`, so `I ≤ M² (1 + 2 · lights)`: finite for any scene
+//! a file can hold (`docs/LIMITS.md`, "Intensities").
 
 use crate::scene::{LightSpec, Material, PerChannel};
-use cwisim_scene::{vector, Vector};
+use cwisim_scene::{vector, SceneError, SceneErrorKind, Vector, MAX_INTENSITY};
 use glam::DVec3;
 
 /// The lights of a scene.
@@ -38,7 +42,9 @@ impl Lighting {
                 continue;
             }
             let r = 2.0 * n_dot_l * normal - l;
-            let r_dot_v = r.dot(v);
+            // at most 1 (rounding can give 1 + 2^-52, which a large exponent `n` would
+            // raise to infinity): `(R·V)^n` is then in [0, 1] for every `n ≥ 0`
+            let r_dot_v = r.dot(v).min(1.0);
             for (c, value) in out.iter_mut().enumerate().take(self.channels) {
                 let specular = if r_dot_v > 0.0 && m.k_s.get(c) != 0.0 {
                     m.k_s.get(c) * r_dot_v.powf(m.n)
@@ -49,6 +55,30 @@ impl Lighting {
             }
         }
         out
+    }
+}
+
+/// Refuses a lit intensity that is not finite: what lighting makes is checked where it is
+/// made (the scene's limits keep it finite; this is the defence behind them), so that no
+/// renderer gets a value the array would refuse. `place` names, only when needed, the
+/// JSON path of the mesh (or patch) and the part lit (`("meshes[2]", "face 7")`).
+pub fn check_lit(
+    i: &Vector,
+    channels: usize,
+    place: impl FnOnce() -> (String, String),
+) -> Result<(), SceneError> {
+    match i[..channels].iter().find(|v| !v.is_finite()) {
+        None => Ok(()),
+        Some(bad) => {
+            let (field, part) = place();
+            Err(SceneError::at_field(
+                SceneErrorKind::NonFinite,
+                field,
+                format!(
+                    "lighting: {part} is lit to {bad}: ambient × k_a + Σ lights × (k_d + k_s) overflows f64 (each term is limited to ±{MAX_INTENSITY:e})"
+                ),
+            ))
+        }
     }
 }
 
@@ -104,5 +134,31 @@ mod tests {
             DVec3::new(0.0, -5.0, 0.0),
         );
         assert_eq!(&i[..3], &[0.1, 0.1, 0.1]);
+    }
+
+    #[test]
+    fn a_huge_exponent_gives_a_highlight_of_at_most_one_and_overflow_is_refused() {
+        let mut m = material();
+        m.n = f64::MAX;
+        // a light and an eye placed so that R·V rounds to 1 + 2^-52 (found by search):
+        // the highlight is clamped to (R·V)^n = 1, not raised to infinity
+        let l = Lighting {
+            lights: vec![LightSpec {
+                position: [0.9095578363365777, 8.098510160219618, -2.4368424793545906],
+                intensity: PerChannel::All(1.0),
+            }],
+            ..lighting()
+        };
+        let eye = DVec3::new(-0.5346591013375908, 4.7604912974814875, 1.432432285296553);
+        let n_dot_l = DVec3::Y.dot(DVec3::from_array(l.lights[0].position).normalize());
+        let i = l.intensity(&m, DVec3::ZERO, DVec3::Y, eye);
+        assert_eq!(i[0], 0.1 + (0.8 * n_dot_l + 0.4), "{i:?}");
+        let place = || ("meshes[2]".to_string(), "face 7".to_string());
+        assert_eq!(check_lit(&[0.5, 1.0, 0.0, f64::NAN], 3, place), Ok(()));
+        let e = check_lit(&[0.5, f64::INFINITY, 0.0, 0.0], 3, place).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "meshes[2]: lighting: face 7 is lit to inf: ambient × k_a + Σ lights × (k_d + k_s) overflows f64 (each term is limited to ±1e12)"
+        );
     }
 }

@@ -58,12 +58,17 @@ pub fn check_in_front(camera: &Camera, mesh: &Mesh, k: usize) -> Result<(), Scen
     Ok(())
 }
 
-/// The lit screen triangles of a scene, in mesh and face order.
+/// The lit screen triangles of a scene, in mesh and face order. The lighting terms are
+/// checked first ([`WorldSpec::check_lighting`](crate::scene::WorldSpec::check_lighting):
+/// a scene built in code is refused as a file would be), and every lit intensity where it
+/// is made ([`check_lit`](crate::lighting::check_lit)).
 pub fn project(
     scene: &WorldScene,
     shading: Shading,
 ) -> Result<(Vec<ScreenTriangle>, ProjectStats), SceneError> {
     let spec = &scene.spec;
+    // a scene built in code was never validated: its lighting terms are checked here
+    spec.check_lighting()?;
     let channels = scene.channels();
     let camera = Camera::new(&spec.camera, scene.width(), scene.height());
     let lighting = Lighting {
@@ -147,6 +152,11 @@ pub fn project(
                         )
                     }),
                 };
+                for i in &intensity {
+                    crate::lighting::check_lit(i, channels, || {
+                        (format!("meshes[{k}]"), format!("face {f}"))
+                    })?;
+                }
                 out.push(ScreenTriangle {
                     points,
                     inv_depth: p.map(|q| 1.0 / camera.depth(q)),

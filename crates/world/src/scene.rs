@@ -33,7 +33,8 @@
 
 use crate::mesh::{self, Mesh};
 use cwisim_scene::{
-    json_error, locate_error, SceneError, SceneErrorKind, MAX_CHANNELS, MAX_SIDE, MAX_VALUES,
+    json_error, locate_error, SceneError, SceneErrorKind, MAX_CHANNELS, MAX_INTENSITY, MAX_SIDE,
+    MAX_VALUES,
 };
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -62,6 +63,9 @@ impl PerChannel {
         }
     }
 
+    /// Checks the shape (one number, or `channels`), that every value is finite, at least
+    /// `min` and at most [`MAX_INTENSITY`] in magnitude (a value beyond it is named by its
+    /// own path, `field[c]`, when given per channel).
     fn check(&self, field: &str, channels: usize, min: f64) -> Result<(), SceneError> {
         let values: Vec<f64> = match self {
             PerChannel::All(v) => vec![*v],
@@ -79,13 +83,23 @@ impl PerChannel {
                 v.clone()
             }
         };
-        for v in values {
+        let each = matches!(self, PerChannel::Each(_));
+        for (c, v) in values.into_iter().enumerate() {
             finite(field, v)?;
             if v < min {
                 return Err(SceneError::at_field(
                     SceneErrorKind::Limit,
                     field,
                     format!("expected a value ≥ {min}, found {v}"),
+                ));
+            }
+            if v.abs() > MAX_INTENSITY {
+                return Err(SceneError::at_field(
+                    SceneErrorKind::Limit,
+                    if each { format!("{field}[{c}]") } else { field.to_string() },
+                    format!(
+                        "{v:e} is beyond {MAX_INTENSITY:e}, the limit of every intensity and lighting term (it keeps the lighting and the renderers' arithmetic finite; terms are nominally 0 to 1)"
+                    ),
                 ));
             }
         }
@@ -468,7 +482,46 @@ fn check_image(s: &WorldSpec) -> Result<(), SceneError> {
     Ok(())
 }
 
+impl Material {
+    /// Checks the lighting coefficients of mesh `k`'s material: `k_a`, `k_d`, `k_s`
+    /// finite, ≥ 0 and at most [`MAX_INTENSITY`]; `n` finite and ≥ 0 (any size: `(R·V)^n`
+    /// is at most 1).
+    fn check(&self, k: usize, channels: usize) -> Result<(), SceneError> {
+        let f = |key: &str| format!("meshes[{k}].material.{key}");
+        self.k_a.check(&f("k_a"), channels, 0.0)?;
+        self.k_d.check(&f("k_d"), channels, 0.0)?;
+        self.k_s.check(&f("k_s"), channels, 0.0)?;
+        finite(&f("n"), self.n)?;
+        if self.n < 0.0 {
+            return Err(SceneError::at_field(
+                SceneErrorKind::Limit,
+                f("n"),
+                format!("expected a specular exponent ≥ 0, found {}", self.n),
+            ));
+        }
+        Ok(())
+    }
+}
+
 impl WorldSpec {
+    /// Checks the lighting terms alone, as [`WorldSpec::validate`] does: the ambient
+    /// term and every light's intensity (finite, ≥ 0, at most [`MAX_INTENSITY`]), and
+    /// every material's coefficients. What lighting needs to stay finite, for code that
+    /// lights a scene it did not read (a scene built in code is never validated):
+    /// [`crate::project::project`] and `cwisim-render`'s `nishita` start with it.
+    pub fn check_lighting(&self) -> Result<(), SceneError> {
+        let channels = self.channels as usize;
+        self.ambient.check("ambient", channels, 0.0)?;
+        for (k, l) in self.lights.iter().enumerate() {
+            l.intensity
+                .check(&format!("lights[{k}].intensity"), channels, 0.0)?;
+        }
+        for (k, m) in self.meshes.iter().enumerate() {
+            m.material.check(k, channels)?;
+        }
+        Ok(())
+    }
+
     /// Checks every rule that does not need the meshes built: sizes, channels, camera,
     /// lights, materials, transforms, and that each mesh names exactly one source.
     pub fn validate(&self) -> Result<(), SceneError> {
@@ -529,17 +582,7 @@ impl WorldSpec {
         for (k, m) in self.meshes.iter().enumerate() {
             let f = |key: &str| format!("meshes[{k}].{key}");
             let mat = &m.material;
-            mat.k_a.check(&f("material.k_a"), channels, 0.0)?;
-            mat.k_d.check(&f("material.k_d"), channels, 0.0)?;
-            mat.k_s.check(&f("material.k_s"), channels, 0.0)?;
-            finite(&f("material.n"), mat.n)?;
-            if mat.n < 0.0 {
-                return Err(SceneError::at_field(
-                    K::Limit,
-                    f("material.n"),
-                    format!("expected a specular exponent ≥ 0, found {}", mat.n),
-                ));
-            }
+            mat.check(k, channels)?;
             finite(&f("material.transmittance"), mat.transmittance)?;
             if !(0.0..=1.0).contains(&mat.transmittance) {
                 return Err(SceneError::at_field(

@@ -141,6 +141,67 @@ fn camera_and_material_limits() {
 }
 
 #[test]
+fn lighting_terms_beyond_the_intensity_limit_are_refused_at_their_path() {
+    const BEYOND: &str = "is beyond 1e12, the limit of every intensity and lighting term (it keeps the lighting and the renderers' arithmetic finite; terms are nominally 0 to 1)";
+    for (from, to, shown) in [
+        (
+            r#""ambient": 0.2"#,
+            r#""ambient": 1.7976931348623157e308"#,
+            "4:14: ambient: 1.7976931348623157e308",
+        ),
+        (
+            r#""intensity": 0.8"#,
+            r#""intensity": 1e308"#,
+            "5:53: lights[0].intensity: 1e308",
+        ),
+        (
+            r#""k_a": 0.3"#,
+            r#""k_a": 1.000000000001e12"#,
+            "7:28: meshes[0].material.k_a: 1.000000000001e12",
+        ),
+        (
+            r#""k_d": 0.6"#,
+            r#""k_d": 1e13"#,
+            "7:40: meshes[0].material.k_d: 1e13",
+        ),
+        (
+            r#""k_s": 0.2"#,
+            r#""k_s": 1e300"#,
+            "7:52: meshes[0].material.k_s: 1e300",
+        ),
+    ] {
+        let (m, k, _) = fault(from, to);
+        assert_eq!(k, SceneErrorKind::Limit, "{m}");
+        assert_eq!(m, format!("{shown} {BEYOND}"));
+    }
+    // per channel: the channel's own path
+    let text = GOOD
+        .replacen(r#""channels": 1"#, r#""channels": 3"#, 1)
+        .replacen(r#""intensity": 0.8"#, r#""intensity": [0.8, 0.8, 2e12]"#, 1);
+    let m = parse_any(&text, None).expect_err("a fault").to_string();
+    assert_eq!(m, format!("5:64: lights[0].intensity[2]: 2e12 {BEYOND}"));
+    // the limit itself is fine, as is any finite shininess
+    for (from, to) in [
+        (r#""ambient": 0.2"#, r#""ambient": 1e12"#),
+        (r#""intensity": 0.8"#, r#""intensity": 1e12"#),
+        (r#""k_a": 0.3"#, r#""k_a": 1e12"#),
+        (r#""n": 8"#, r#""n": 1.7976931348623157e308"#),
+    ] {
+        parse_any(&GOOD.replacen(from, to, 1), None).expect("within the limits");
+    }
+    // a scene built in code is never validated: projection checks its lighting terms
+    let cwisim_world::AnyScene::World(mut w) = parse_any(GOOD, None).expect("good") else {
+        panic!("a world scene")
+    };
+    w.spec.meshes[0].material.k_d = cwisim_world::scene::PerChannel::All(f64::MAX);
+    let e = cwisim_world::project::project(&w, cwisim_scene::Shading::Gouraud).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        format!("meshes[0].material.k_d: 1.7976931348623157e308 {BEYOND}")
+    );
+}
+
+#[test]
 fn obj_errors_name_the_obj_file_and_line() {
     let dir = std::env::temp_dir().join(format!("cwisim-world-bad-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();

@@ -231,10 +231,10 @@ impl Renderer for Bsp {
         _index: u32,
         _previous: Option<&'a Image>,
     ) -> Result<Box<dyn FramePlan + 'a>, RenderError> {
-        let mut frame = self.scan().run().map_err(|source| RenderError::Renderer {
-            renderer: "bsp",
-            source,
-        })?;
+        let mut frame = self
+            .scan()
+            .run()
+            .map_err(|source| RenderError::of_renderer("bsp", source))?;
         frame.frame = std::mem::take(&mut frame.frame)
             .with("bsp_triangles", self.polys.polys.len() as u64)
             .with("bsp_splits", self.splits)

@@ -99,6 +99,8 @@ pub struct Pieces {
 
 /// The pieces of every Bézier mesh of `w`, band by band (rows `0..height`).
 pub fn pieces(w: &WorldScene, settings: &Settings) -> Result<Pieces, RenderError> {
+    // a scene built in code was never validated: its lighting terms are checked here
+    w.spec.check_lighting()?;
     let camera = Camera::new(&w.spec.camera, w.width(), w.height());
     let view = View { camera };
     let params = Params {
@@ -171,6 +173,14 @@ pub fn pieces(w: &WorldScene, settings: &Settings) -> Result<Pieces, RenderError
             );
             for p in &raw {
                 if let Some(t) = triangle(p, *k as u32, m, &camera, &lighting) {
+                    for i in &t.intensity {
+                        cwisim_world::lighting::check_lit(i, w.channels(), || {
+                            (
+                                format!("meshes[{k}].bezier.patches[{}]", p.patch),
+                                "a piece of the patch".to_string(),
+                            )
+                        })?;
+                    }
                     out.triangles.push(t);
                     out.facing.push(p.facing);
                     out.origin.push((*k as u32, p.patch, p.uv));

@@ -19,6 +19,7 @@
 use super::polys::{Poly, Polys};
 use super::sweep::{edge_value, span_gradient, LineCounts, Sweep};
 use crate::cp::{columns_in, Increment};
+use crate::error::NonFinite;
 use crate::renderer::Counters;
 use crate::span::{fit_span, SpanStats};
 use crate::subsample::{Grid, Sampler};
@@ -598,7 +599,8 @@ impl Scan<'_> {
                             list: &mut list,
                             counts: &mut visible,
                         },
-                    )?;
+                    )
+                    .map_err(|e| NonFinite::at_row(e, row))?;
                     counts.add(&visible);
                 }
                 list.push(Instruction::refresh());
@@ -625,7 +627,8 @@ impl Scan<'_> {
                     tolerance: (self.shading == Shading::Phong).then_some(self.shade_tolerance),
                     channels: ch,
                 };
-                let c = emit_row(s, &refs, &rule, &mut list)?;
+                let c =
+                    emit_row(s, &refs, &rule, &mut list).map_err(|e| NonFinite::at_row(e, row))?;
                 counts.eval1 += c.edge_pixels + c.runs.eval1;
                 counts.eval2 += c.runs.eval2;
                 counts.eval3 += c.runs.eval3;

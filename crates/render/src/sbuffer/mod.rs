@@ -127,10 +127,10 @@ impl Renderer for SBuffer {
         _index: u32,
         _previous: Option<&'a Image>,
     ) -> Result<Box<dyn FramePlan + 'a>, RenderError> {
-        let frame = self.scan().run().map_err(|source| RenderError::Renderer {
-            renderer: "sbuffer",
-            source,
-        })?;
+        let frame = self
+            .scan()
+            .run()
+            .map_err(|source| RenderError::of_renderer("sbuffer", source))?;
         Ok(Box::new(frame))
     }
 

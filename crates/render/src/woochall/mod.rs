@@ -19,7 +19,7 @@ pub mod prepare;
 pub mod shade;
 pub mod triangle;
 
-use crate::error::RenderError;
+use crate::error::{NonFinite, RenderError};
 use crate::renderer::{Counters, FramePlan, Renderer};
 use crate::settings::Settings;
 use crate::source::LoadedScene;
@@ -146,7 +146,8 @@ impl WooChall {
             carried = s.grid == crate::subsample::Grid::Corner;
             let refs: Vec<&Subline> = sublines.iter().collect();
             let mut out = Vec::new();
-            let counts = emit_row(s, &refs, &rule, &mut out)?;
+            let counts =
+                emit_row(s, &refs, &rule, &mut out).map_err(|e| NonFinite::at_row(e, row))?;
             list_stats.merge(&row_lists);
             let shaded = &shader.stats;
             figures.push(serde_json::json!({
@@ -247,10 +248,9 @@ impl Renderer for WooChall {
         _index: u32,
         _previous: Option<&'a Image>,
     ) -> Result<Box<dyn FramePlan + 'a>, RenderError> {
-        let frame = self.run().map_err(|source| RenderError::Renderer {
-            renderer: "woo-chall",
-            source,
-        })?;
+        let frame = self
+            .run()
+            .map_err(|source| RenderError::of_renderer("woo-chall", source))?;
         Ok(Box::new(frame))
     }
 
