@@ -87,9 +87,9 @@ impl From<RenderError> for CliError {
             e @ (RenderError::Renderer { .. } | RenderError::Array(_)) => {
                 CliError::Internal(e.to_string())
             }
-            e @ (RenderError::Usage(_) | RenderError::UnknownRenderer { .. }) => {
-                CliError::Usage(e.to_string())
-            }
+            e @ (RenderError::Usage(_)
+            | RenderError::UnknownRenderer { .. }
+            | RenderError::Overflow { .. }) => CliError::Usage(e.to_string()),
         }
     }
 }
