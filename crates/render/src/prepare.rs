@@ -67,13 +67,20 @@ pub fn phong_needs_world() -> RenderError {
 /// arithmetic either), and none negative ([`RenderError::Usage`]: the array adds light and
 /// drops negative contributions while `Acc_mode` is off, so a negative polygon would be
 /// drawn as 0 — silently wrong). Every renderer of screen scenes calls it.
-pub fn check_intensities(s: &ScreenScene) -> Result<(), RenderError> {
+///
+/// `source` names the file in the message, when the scene is one.
+pub fn check_intensities(s: &ScreenScene, source: &Source) -> Result<(), RenderError> {
+    let file = source.path();
     for (k, p) in s.polygons.iter().enumerate() {
         for (v, i) in p.intensity.iter().enumerate() {
-            cwisim_scene::check_intensity(k, v, i)?;
+            cwisim_scene::check_intensity(k, v, i).map_err(|e| match file {
+                Some(f) => e.in_file(f),
+                None => e,
+            })?;
             if let Some(bad) = i.iter().find(|c| **c < 0.0) {
+                let at = file.map_or_else(String::new, |f| format!("{}: ", f.display()));
                 return Err(RenderError::Usage(format!(
-                    "polygons[{k}].intensity[{v}]: intensity {bad:e} is negative; renderers draw light, intensities ≥ 0 (the array drops negative contributions)"
+                    "{at}polygons[{k}].intensity[{v}]: intensity {bad} is negative; renderers draw light, intensities ≥ 0 (the array drops negative contributions)"
                 )));
             }
         }
@@ -128,7 +135,7 @@ impl PolygonScene {
         match loaded.scene {
             AnyScene::Screen(_) if phong => return Err(phong_needs_world()),
             AnyScene::Screen(s) => {
-                check_intensities(&s)?;
+                check_intensities(&s, &prepared.source)?;
                 prepared.screen = s
             }
             AnyScene::World(_) if phong && settings.visibility != Visibility::Exact => {

@@ -39,6 +39,11 @@ use cwisim_scene::{
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
+/// The narrowest field of view (degrees): at it the tallest image's focal length is about
+/// 4e9 pixels, so that the projection of any scene within the world coordinate limit
+/// stays finite; narrower is a telescope no scene here needs.
+pub const MIN_FOV_Y: f64 = 1e-3;
+
 /// The largest coordinate magnitude accepted in world space.
 pub const MAX_WORLD_COORDINATE: f64 = 1e9;
 /// The most triangles a scene may hold after its meshes are built.
@@ -533,12 +538,12 @@ impl WorldSpec {
         check_point("camera.target", c.target)?;
         check_point("camera.up", c.up)?;
         finite("camera.fov_y", c.fov_y)?;
-        if !(c.fov_y > 0.0 && c.fov_y < 180.0) {
+        if !(c.fov_y >= MIN_FOV_Y && c.fov_y < 180.0) {
             return Err(SceneError::at_field(
                 K::Limit,
                 "camera.fov_y",
                 format!(
-                    "expected a field of view in (0, 180) degrees, found {}",
+                    "expected a field of view from {MIN_FOV_Y} to under 180 degrees, found {}",
                     c.fov_y
                 ),
             ));

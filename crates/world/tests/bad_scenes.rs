@@ -129,6 +129,13 @@ fn a_camera_inside_or_behind_an_object_is_refused() {
 fn camera_and_material_limits() {
     let (m, _, _) = fault(r#""fov_y": 40"#, r#""fov_y": 180"#);
     assert!(m.contains("camera.fov_y"), "{m}");
+    // a field of view so narrow that projection would overflow: refused at its path, in
+    // its file, before anything is projected
+    let (m, _, _) = fault(r#""fov_y": 40"#, r#""fov_y": 1e-300"#);
+    assert!(
+        m.contains("camera.fov_y: expected a field of view from 0.001 to under 180 degrees, found 1e-300"),
+        "{m}"
+    );
     let (m, _, _) = fault(r#""target": [0, 0, 0]"#, r#""target": [0, 0, 5]"#);
     assert!(m.contains("looks at its own position"), "{m}");
     let (m, _, _) = fault(r#""k_d": 0.6"#, r#""k_d": [0.6, 0.2]"#);

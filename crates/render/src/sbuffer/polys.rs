@@ -120,7 +120,7 @@ impl Polys {
                     Shading::Hidden => return Err(hidden()),
                     _ => {}
                 }
-                crate::prepare::check_intensities(&s)?;
+                crate::prepare::check_intensities(&s, &loaded.source)?;
                 let ch = s.channel_count();
                 for (k, p) in s.polygons.iter().enumerate() {
                     let cp = CpPolygon::new(&p.vertices);

@@ -54,7 +54,7 @@ impl Triangles {
                 if shading == Shading::Phong {
                     return Err(crate::prepare::phong_needs_world());
                 }
-                crate::prepare::check_intensities(&s)?;
+                crate::prepare::check_intensities(&s, &loaded.source)?;
                 polygons = s.polygons.len() as u64;
                 (s.width, s.height, s.channels, screen_triangles(&s))
             }
