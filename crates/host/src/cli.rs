@@ -12,7 +12,7 @@ use crate::commands::{
     stats, tradeoff, vcd,
 };
 use crate::error::CliError;
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use std::ffi::OsString;
 use std::io::Write;
 use std::process::ExitCode;
@@ -328,7 +328,7 @@ pub fn run_cli_with(
     stderr: &mut dyn Write,
     progress: bool,
 ) -> u8 {
-    let cli = match Cli::try_parse_from(args) {
+    let cli = match parse(args) {
         Ok(cli) => cli,
         Err(e) => {
             let text = e.render().to_string();
@@ -371,6 +371,41 @@ pub fn run_cli_with(
             e.exit_code()
         }
     }
+}
+
+impl Command {
+    /// Its drawing flags, if it draws a scene.
+    fn draw_mut(&mut self) -> Option<&mut crate::draw::DrawArgs> {
+        match self {
+            Command::Run(a) => Some(&mut a.draw),
+            Command::Render(a) => Some(&mut a.draw),
+            Command::Emit(a) => Some(&mut a.draw),
+            Command::Fit(a) => Some(&mut a.draw),
+            Command::Stats(a) => Some(&mut a.draw),
+            Command::History(a) => Some(&mut a.draw),
+            Command::Inspect(a) => Some(&mut a.draw),
+            Command::Vcd(a) => Some(&mut a.draw),
+            Command::Diff(a) => Some(&mut a.draw),
+            Command::Dump(a) => Some(&mut a.draw),
+            Command::Scenes(_)
+            | Command::Renderers(_)
+            | Command::Tradeoff(_)
+            | Command::Refine(_)
+            | Command::Convert(_)
+            | Command::Machine(_) => None,
+        }
+    }
+}
+
+/// Parses the command line, noting which drawing flags it gave
+/// ([`crate::draw::DrawArgs::note_given`]): clap's derive keeps only the values.
+pub fn parse(args: impl IntoIterator<Item = OsString>) -> Result<Cli, clap::Error> {
+    let matches = Cli::command().try_get_matches_from(args)?;
+    let mut cli = Cli::from_arg_matches(&matches).map_err(|e| e.format(&mut Cli::command()))?;
+    if let (Some(draw), Some((_, sub))) = (cli.command.draw_mut(), matches.subcommand()) {
+        draw.note_given(sub);
+    }
+    Ok(cli)
 }
 
 /// Standard output for a command whose exit code is its answer (`diff`): when the reader
@@ -463,7 +498,6 @@ pub fn main() -> ExitCode {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use clap::CommandFactory;
 
     fn cli(args: &[&str]) -> (u8, String, String) {
         let (mut out, mut err) = (Vec::new(), Vec::new());

@@ -2,15 +2,21 @@
 //! `--visibility`, `--eval0-tolerance`, `--size`, the supersampling renderers' `--samples`,
 //! `--grid`, `--merge-subscanlines`, `--shade-p`, `--shade-contrast`, `--seed`, and Barkan &
 //! Gordon's `--cp-increment`, `--sbuffer`, `--order`, `--unset`, and refinement's thresholds and `--phong-angle` — one flattened group shared by
-//! `render`, `emit`, `stats` and `fit`, converted into `cwisim-render`'s plain
-//! [`Settings`].
+//! `render`, `emit`, `fit` and the commands that read a trace or a scene, converted into
+//! `cwisim-render`'s plain [`Settings`].
+//!
+//! A flag given on the command line ([`DrawArgs::given`]) must do something: one the
+//! renderer does not read (its registry entry's `uses`), one the other flags leave idle,
+//! or one the scene has nothing for is refused, naming what would use it; so is any
+//! drawing flag when the input is a trace ([`crate::input::drawing_applies`]).
 
 use crate::error::CliError;
-use clap::{Args, ValueEnum};
+use clap::parser::ValueSource;
+use clap::{ArgMatches, Args, ValueEnum};
 use cwisim_render::cp::Increment;
 use cwisim_render::settings::{
-    BspOrder, SbufferMode, Threshold, Unset, DEFAULT_AA_THRESHOLD, DEFAULT_GOURAUD_THRESHOLD,
-    DEFAULT_PHONG_ANGLE,
+    BspOrder, SbufferMode, Setting, Threshold, Unset, DEFAULT_AA_THRESHOLD,
+    DEFAULT_GOURAUD_THRESHOLD, DEFAULT_PHONG_ANGLE,
 };
 use cwisim_render::subsample::Grid;
 use cwisim_render::{registry, LoadedScene, Renderer, Settings, Size, Source};
@@ -195,9 +201,13 @@ impl From<VisibilityArg> for Visibility {
     }
 }
 
-/// How a scene is drawn: shared by `render`, `emit`, `stats` and `fit`.
+/// How a scene is drawn: shared by every command that draws one.
 #[derive(Args, Clone, Debug, PartialEq)]
 pub struct DrawArgs {
+    /// The drawing flags given on the command line (`--samples`), in the order declared
+    /// here: [`DrawArgs::note_given`] fills it after parsing (empty: nothing is checked).
+    #[arg(skip)]
+    pub given: Vec<&'static str>,
     /// The renderer: the Y-processor program that turns the scene into instructions
     /// (`cwisim renderers` lists them).
     #[arg(long, value_name = "NAME", default_value = registry::DEFAULT_RENDERER)]
@@ -206,16 +216,16 @@ pub struct DrawArgs {
     #[arg(long, value_enum, default_value_t = ShadingArg::Gouraud)]
     pub shading: ShadingArg,
     /// Anti-aliasing.
-    #[arg(long, value_enum, default_value_t = AaArg::Box)]
+    #[arg(long, value_enum, default_value_t = AaArg::Box, help_heading = TRAPEZIA)]
     pub aa: AaArg,
-    /// Hidden-surface removal for world scenes (screen scenes are drawn as they are:
-    /// their polygons add up).
-    #[arg(long, value_enum, default_value_t = VisibilityArg::Exact)]
+    /// Hidden-surface removal for world scenes, by vanrij (nishita's pieces are always
+    /// resolved exactly; screen scenes are drawn as they are: their polygons add up).
+    #[arg(long, value_enum, default_value_t = VisibilityArg::Exact, help_heading = TRAPEZIA)]
     pub visibility: VisibilityArg,
     /// With --visibility eval0 and Gouraud shading: how far (in intensity) the staircase
     /// of Eval0s that claims a shaded interior may stray from the Gouraud value at a pixel
     /// centre. Smaller is more exact and costs more Eval0s; 0 is one Eval0 per pixel.
-    #[arg(long, value_name = "TOL", default_value_t = 1.0 / 512.0)]
+    #[arg(long, value_name = "TOL", default_value_t = 1.0 / 512.0, help_heading = TRAPEZIA)]
     pub eval0_tolerance: f64,
     /// Draw at another size, WIDTHxHEIGHT (a world scene's camera keeps its vertical field
     /// of view; a screen scene is scaled).
@@ -229,26 +239,25 @@ pub struct DrawArgs {
     /// the scene says.
     #[arg(long, value_name = "N")]
     pub tessellate: Option<u32>,
-    /// Supersampling renderers (woo-chall): samples per pixel side, an L×L grid per pixel
-    /// (1 to 64).
+    /// Supersampling renderers: samples per pixel side, an L×L grid per pixel (1 to 64).
     #[arg(
         long,
         value_name = "L",
         default_value_t = 3,
-        help_heading = "Supersampling (woo-chall)"
+        help_heading = SUPERSAMPLING
     )]
     pub samples: u32,
     /// Where a pixel's samples lie.
-    #[arg(long, value_enum, default_value_t = GridArg::Centre, help_heading = "Supersampling (woo-chall)")]
+    #[arg(long, value_enum, default_value_t = GridArg::Centre, help_heading = SUPERSAMPLING)]
     pub grid: GridArg,
     /// Sum a row's L sub-scanlines on the host and send one pass per row, instead of one
     /// pass per sub-scanline that the array accumulates (the hardware way: its cost grows
     /// with L).
-    #[arg(long, help_heading = "Supersampling (woo-chall)")]
+    #[arg(long, help_heading = SUPERSAMPLING)]
     pub merge_subscanlines: bool,
     /// Probability of a stochastic shading call at a sample whose surface the pixel has
     /// shaded already [default: the paper's (L−1)/(L²−1)].
-    #[arg(long, value_name = "P", help_heading = "Supersampling (woo-chall)")]
+    #[arg(long, value_name = "P", help_heading = STOCHASTIC)]
     pub shade_p: Option<f64>,
     /// Colour difference (any channel) between a shading call and the pixel's previous
     /// sample, its left or right neighbour or the row above, beyond which the pixel and
@@ -257,12 +266,12 @@ pub struct DrawArgs {
         long,
         value_name = "T",
         default_value_t = 0.1,
-        help_heading = "Supersampling (woo-chall)"
+        help_heading = STOCHASTIC
     )]
     pub shade_contrast: f64,
     /// Seed of every random choice (woo-chall's stochastic shading calls): the same seed
     /// gives the same stream.
-    #[arg(long, value_name = "S", default_value_t = 0)]
+    #[arg(long, value_name = "S", default_value_t = 0, help_heading = STOCHASTIC)]
     pub seed: u64,
     /// Barkan & Gordon's renderers (sbuffer, bsp): how critical-points scan conversion
     /// updates an edge's intersection from one scanline to the next.
@@ -343,9 +352,21 @@ pub struct DrawArgs {
     pub phong_angle: Threshold,
 }
 
+/// The help heading of van Rij's trapezia's flags: the pixel filter and the visibility.
+const TRAPEZIA: &str = "Trapezia (vanrij, nishita)";
+/// The help heading of the supersampling renderers' flags.
+const SUPERSAMPLING: &str = "Supersampling (woo-chall, sbuffer, bsp)";
+/// The help heading of Woo & Chall's shading calls' flags.
+const STOCHASTIC: &str = "Stochastic shading calls (woo-chall)";
+
+/// The help heading of the drawing flags in a command that reads a trace or a scene.
+pub const SCENE_ONLY: &str =
+    "Drawing a scene (only when the input is a scene; refused with a trace)";
+
 impl Default for DrawArgs {
     fn default() -> Self {
         DrawArgs {
+            given: Vec::new(),
             renderer: registry::DEFAULT_RENDERER.into(),
             shading: ShadingArg::Gouraud,
             aa: AaArg::Box,
@@ -387,7 +408,38 @@ pub struct Drawn {
     pub renderer: Box<dyn Renderer>,
 }
 
+/// `--renderer`, or the flag of a [`Setting`], from its long name (`samples`).
+fn flag_of(long: &str) -> Option<&'static str> {
+    match long {
+        "renderer" => Some("--renderer"),
+        _ => Setting::ALL
+            .into_iter()
+            .map(Setting::flag)
+            .find(|f| f.strip_prefix("--") == Some(long)),
+    }
+}
+
 impl DrawArgs {
+    /// Records in [`DrawArgs::given`] the drawing flags `matches` (the subcommand's) took
+    /// from the command line, not from their defaults.
+    pub fn note_given(&mut self, matches: &ArgMatches) {
+        let group = DrawArgs::augment_args(clap::Command::new("draw"));
+        self.given = group
+            .get_arguments()
+            .filter(|a| matches.value_source(a.get_id().as_str()) == Some(ValueSource::CommandLine))
+            .filter_map(|a| a.get_long().and_then(flag_of))
+            .collect();
+    }
+
+    /// The settings given on the command line (all of [`DrawArgs::given`] but
+    /// `--renderer`).
+    pub fn given_settings(&self) -> Vec<Setting> {
+        self.given
+            .iter()
+            .filter_map(|f| Setting::of_flag(f))
+            .collect()
+    }
+
     /// The library's settings.
     pub fn settings(&self) -> Settings {
         Settings {
@@ -433,8 +485,19 @@ impl DrawArgs {
             threads,
             ..self.settings()
         };
+        let given = self.given_settings();
+        entry
+            .check_given(&given, &settings)
+            .map_err(CliError::Usage)?;
         settings.check().map_err(CliError::Usage)?;
         let loaded = Source::resolve(scene)?.load_for(&settings)?;
+        let name = scene.map_or_else(
+            || cwisim_render::DEFAULT_SCENE.to_string(),
+            |p| p.display().to_string(),
+        );
+        entry
+            .check_scene(&given, &loaded.scene, &name)
+            .map_err(CliError::Usage)?;
         Ok(build(entry, loaded, &settings)?)
     }
 }
@@ -452,4 +515,67 @@ pub fn build(
         load_time,
         renderer: (entry.build)(loaded, settings)?,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use cwisim_render::REGISTRY;
+
+    #[test]
+    fn every_drawing_flag_is_the_renderer_or_a_setting() {
+        let group = DrawArgs::augment_args(clap::Command::new("draw"));
+        let longs: Vec<&str> = group.get_arguments().filter_map(|a| a.get_long()).collect();
+        for long in &longs {
+            assert!(flag_of(long).is_some(), "--{long} is no setting");
+        }
+        for s in Setting::ALL {
+            assert!(longs.contains(&&s.flag()[2..]), "{} is no flag", s.flag());
+        }
+        assert_eq!(longs.len(), Setting::ALL.len() + 1);
+    }
+
+    #[test]
+    fn a_heading_naming_renderers_names_every_one_that_reads_its_flags() {
+        let group = DrawArgs::augment_args(clap::Command::new("draw"));
+        for arg in group.get_arguments() {
+            let Some(heading) = arg.get_help_heading() else {
+                continue;
+            };
+            let named = heading
+                .rsplit_once('(')
+                .and_then(|(_, r)| r.strip_suffix(')'))
+                .unwrap_or_default();
+            let named: Vec<&str> = named.split(", ").collect();
+            let flag = arg.get_long().and_then(flag_of).unwrap_or_default();
+            let setting = Setting::of_flag(flag).expect("a setting");
+            for e in REGISTRY.iter().filter(|e| e.uses.contains(&setting)) {
+                assert!(
+                    named.contains(&e.name),
+                    "{flag} under `{heading}`, read by {}",
+                    e.name
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn the_flags_given_are_noted_in_declaration_order() {
+        let args = [
+            "cwisim",
+            "render",
+            "--samples",
+            "2",
+            "--renderer",
+            "bsp",
+            "--seed=0",
+        ];
+        let cli = crate::cli::parse(args.map(Into::into)).expect("parses");
+        let crate::cli::Command::Render(r) = cli.command else {
+            panic!("render");
+        };
+        // a flag given with its default value counts: it was given
+        assert_eq!(r.draw.given, ["--renderer", "--samples", "--seed"]);
+        assert_eq!(r.draw.given_settings(), [Setting::Samples, Setting::Seed]);
+    }
 }

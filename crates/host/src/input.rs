@@ -42,6 +42,37 @@ impl InputKind {
     }
 }
 
+/// Refuses drawing flags given on the command line when none of `inputs` is a scene:
+/// they would change nothing. `None` is the embedded demo trace (`run` without TRACE);
+/// a `.npy` file (`diff`) is an output image.
+pub fn drawing_applies(draw: &DrawArgs, inputs: &[Option<&Path>]) -> Result<(), CliError> {
+    let Some(first) = draw.given.first() else {
+        return Ok(());
+    };
+    let mut replayed = None;
+    for input in inputs {
+        let what = match input {
+            None => "without one, the embedded demo trace is replayed as it is".to_string(),
+            Some(p) if p.extension().is_some_and(|e| e.eq_ignore_ascii_case("npy")) => {
+                format!("{} is an output image, compared as it is", p.display())
+            }
+            Some(p) => match InputKind::of(p)? {
+                InputKind::Scene => return Ok(()),
+                InputKind::Trace => format!("{} is a trace, replayed as it is", p.display()),
+            },
+        };
+        replayed.get_or_insert(what);
+    }
+    let what = replayed.unwrap_or_default();
+    Err(CliError::Usage(match draw.given.split_last() {
+        Some((last, rest)) if !rest.is_empty() => format!(
+            "{} and {last} apply when the input is a scene; {what}",
+            rest.join(", ")
+        ),
+        _ => format!("{first} applies when the input is a scene; {what}"),
+    }))
+}
+
 /// A reader on the input's instructions: the trace file, or the scene's stream as
 /// `draw` renders it.
 pub fn open(input: &Path, draw: &DrawArgs) -> Result<Box<dyn TraceRead>, CliError> {

@@ -37,10 +37,11 @@ fn study_commands_read_a_scene_as_its_emitted_trace() {
             &["history", "{}", "--line", "60", "--x", "50"],
             &["dump", "{}", "--lines", "60"],
         ] {
+            // the trace is replayed as it is: the drawing flags are for the scene
+            let trace = with(&dir, command, "pot.cwt");
             let mut args = command.to_vec();
             args.extend_from_slice(draw);
             let scene = with(&dir, &args, "pot");
-            let trace = with(&dir, &args, "pot.cwt");
             assert_eq!(scene, trace.replace("pot.cwt", "pot"), "{args:?}");
             assert!(!scene.is_empty());
         }
@@ -48,10 +49,11 @@ fn study_commands_read_a_scene_as_its_emitted_trace() {
         for window in [&[][..], &["--x", "40..=60"]] {
             let mut vcd = vec!["vcd", "pot", "--line", "60", "-o", "a.vcd"];
             vcd.extend_from_slice(window);
+            let mut trace = vcd.clone();
+            trace[1] = "pot.cwt";
+            trace[5] = "b.vcd";
+            cwisim_ok(&dir, &trace);
             vcd.extend_from_slice(draw);
-            cwisim_ok(&dir, &vcd);
-            vcd[1] = "pot.cwt";
-            vcd[5] = "b.vcd";
             cwisim_ok(&dir, &vcd);
             assert_eq!(
                 read(dir.join("a.vcd")),

@@ -225,7 +225,7 @@ fn refine_prints_its_phases_and_refuses_bad_thresholds() {
             "inf",
             "expected `all`, `none` or a finite number",
         ),
-        ("--shading", "phong", "--shading phong does not apply"),
+        ("--shading", "phong", "--shading is not used by refine"),
         (
             "--phong-angle",
             "200",

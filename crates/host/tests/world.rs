@@ -260,18 +260,14 @@ fn scenes_generate_cp_bench_writes_a_scene_the_scanline_renderers_draw() {
     // the same seed, the same scene
     assert_eq!(text(&cwisim(&dir, &args)).0, stdout);
     std::fs::write(dir.join("bench.json"), &stdout).unwrap();
-    for renderer in ["sbuffer", "bsp", "vanrij"] {
-        let summary = cwisim_ok(
-            &dir,
-            &[
-                "render",
-                "bench.json",
-                "--renderer",
-                renderer,
-                "--samples",
-                "1",
-            ],
-        );
+    for (renderer, samples) in [
+        ("sbuffer", &["--samples", "1"][..]),
+        ("bsp", &["--samples", "1"]),
+        ("vanrij", &[]),
+    ] {
+        let mut args = vec!["render", "bench.json", "--renderer", renderer];
+        args.extend_from_slice(samples);
+        let summary = cwisim_ok(&dir, &args);
         assert!(summary.contains("scene"), "{summary}");
     }
     // bad input: exit 2, one line

@@ -3,8 +3,9 @@
 
 use crate::error::RenderError;
 use crate::renderer::Renderer;
-use crate::settings::Settings;
+use crate::settings::{Setting, Settings};
 use crate::source::LoadedScene;
+use cwisim_world::AnyScene;
 
 /// How a renderer is built: from a scene read from its source, under settings.
 pub type Build = fn(LoadedScene, &Settings) -> Result<Box<dyn Renderer>, RenderError>;
@@ -27,6 +28,74 @@ pub struct Entry {
     /// It draws several frames, each refining the previous one's output (`refine`):
     /// `tradeoff`, which measures one frame against the exact image, leaves it out.
     pub progressive: bool,
+    /// The settings it reads (its module reads them in `build`); the command line
+    /// refuses a flag given for any other.
+    pub uses: &'static [Setting],
+    /// How it draws, in a few words, for the refusal of a flag it does not use: "it draws
+    /// trapezia with the box filter or point sampling".
+    pub draws: &'static str,
+}
+
+impl Entry {
+    /// Refuses settings given on the command line (`given`) that it would not use under
+    /// `settings`: one it does not read, naming the renderers that do; or one the other
+    /// settings leave nothing to do ([`Setting::idle_under`], when it reads the setting
+    /// that decides).
+    pub fn check_given(&self, given: &[Setting], settings: &Settings) -> Result<(), String> {
+        for &s in given {
+            if !self.uses.contains(&s) {
+                let users: Vec<&str> = REGISTRY
+                    .iter()
+                    .filter(|e| e.uses.contains(&s))
+                    .map(|e| e.name)
+                    .collect();
+                return Err(format!(
+                    "{flag} is not used by {} ({}; {flag} is for {})",
+                    self.name,
+                    self.draws,
+                    users.join(", "),
+                    flag = s.flag()
+                ));
+            }
+            match s.idle_under(settings) {
+                Some((by, why)) if self.uses.contains(&by) => return Err(why),
+                _ => {}
+            }
+        }
+        Ok(())
+    }
+
+    /// Refuses what the scene (called `name`) leaves nothing to do: a renderer of Bézier
+    /// patches on a scene without any (it would draw exactly as the default renderer); a
+    /// setting given for world scenes ([`Setting::world_only`]) on a screen scene; a
+    /// tessellation given for a scene without Bézier meshes.
+    pub fn check_scene(
+        &self,
+        given: &[Setting],
+        scene: &AnyScene,
+        name: &str,
+    ) -> Result<(), String> {
+        if self.patches && !scene.has_patches() {
+            return Err(format!(
+                "--renderer {} draws Bézier patches, and {name} has none: it would draw exactly as {DEFAULT_RENDERER}; use --renderer {DEFAULT_RENDERER}",
+                self.name
+            ));
+        }
+        for &s in given {
+            if s.world_only() && matches!(scene, AnyScene::Screen(_)) {
+                return Err(format!(
+                    "{} applies to world scenes; {name} is a screen scene, its polygons drawn as they are",
+                    s.flag()
+                ));
+            }
+            if s == Setting::Tessellate && !scene.has_patches() {
+                return Err(format!(
+                    "--tessellate applies to Bézier meshes; {name} has none"
+                ));
+            }
+        }
+        Ok(())
+    }
 }
 
 /// The renderer used when none is named.
@@ -41,6 +110,16 @@ pub const REGISTRY: &[Entry] = &[
         supersampled: false,
         patches: false,
         progressive: false,
+        uses: &[
+            Setting::Shading,
+            Setting::Aa,
+            Setting::Visibility,
+            Setting::Eval0Tolerance,
+            Setting::Size,
+            Setting::ShadeTolerance,
+            Setting::Tessellate,
+        ],
+        draws: "it draws trapezia with the box filter or point sampling",
     },
     Entry {
         name: "woo-chall",
@@ -49,6 +128,19 @@ pub const REGISTRY: &[Entry] = &[
         supersampled: true,
         patches: false,
         progressive: false,
+        uses: &[
+            Setting::Shading,
+            Setting::Size,
+            Setting::ShadeTolerance,
+            Setting::Tessellate,
+            Setting::Samples,
+            Setting::Grid,
+            Setting::MergeSubscanlines,
+            Setting::ShadeP,
+            Setting::ShadeContrast,
+            Setting::Seed,
+        ],
+        draws: "it point-samples each pixel on an l×l grid and resolves visibility per sample",
     },
     Entry {
         name: "sbuffer",
@@ -57,6 +149,18 @@ pub const REGISTRY: &[Entry] = &[
         supersampled: true,
         patches: false,
         progressive: false,
+        uses: &[
+            Setting::Shading,
+            Setting::Size,
+            Setting::ShadeTolerance,
+            Setting::Tessellate,
+            Setting::Samples,
+            Setting::Grid,
+            Setting::MergeSubscanlines,
+            Setting::CpIncrement,
+            Setting::Sbuffer,
+        ],
+        draws: "it samples each pixel on an l×l grid into a host depth line",
     },
     Entry {
         name: "bsp",
@@ -65,6 +169,19 @@ pub const REGISTRY: &[Entry] = &[
         supersampled: true,
         patches: false,
         progressive: false,
+        uses: &[
+            Setting::Shading,
+            Setting::Size,
+            Setting::ShadeTolerance,
+            Setting::Tessellate,
+            Setting::Samples,
+            Setting::Grid,
+            Setting::MergeSubscanlines,
+            Setting::CpIncrement,
+            Setting::Order,
+            Setting::Unset,
+        ],
+        draws: "it samples each pixel on an l×l grid in the BSP tree's order",
     },
     Entry {
         name: "nishita",
@@ -73,6 +190,17 @@ pub const REGISTRY: &[Entry] = &[
         supersampled: false,
         patches: true,
         progressive: false,
+        uses: &[
+            Setting::Shading,
+            Setting::Aa,
+            Setting::Size,
+            Setting::ShadeTolerance,
+            Setting::RootTolerance,
+            Setting::Flatness,
+            Setting::Band,
+            Setting::Subscan,
+        ],
+        draws: "it cuts Bézier patches into pieces at most a row high, which no Eval0 claim could cover, and box-filters the exact visible ones as vanrij does",
     },
     Entry {
         name: "refine",
@@ -81,6 +209,15 @@ pub const REGISTRY: &[Entry] = &[
         supersampled: false,
         patches: false,
         progressive: true,
+        uses: &[
+            Setting::Size,
+            Setting::ShadeTolerance,
+            Setting::Tessellate,
+            Setting::GouraudThreshold,
+            Setting::AaThreshold,
+            Setting::PhongAngle,
+        ],
+        draws: "its phases choose the shading, the filter and the visibility themselves",
     },
 ];
 
@@ -129,5 +266,39 @@ mod tests {
                 super::names().join(", ")
             )
         );
+    }
+
+    #[test]
+    fn every_setting_is_read_by_some_renderer_and_refused_by_the_others() {
+        for s in Setting::ALL {
+            assert!(REGISTRY.iter().any(|e| e.uses.contains(&s)), "{s:?}");
+        }
+        let vanrij = find("vanrij").unwrap();
+        let settings = Settings::default();
+        assert_eq!(
+            vanrij.check_given(&[Setting::Shading, Setting::Samples], &settings),
+            Err("--samples is not used by vanrij (it draws trapezia with the box filter or point sampling; --samples is for woo-chall, sbuffer, bsp)".into())
+        );
+        // idle only where the renderer reads the setting that decides
+        let gouraud = [Setting::ShadeTolerance];
+        assert!(vanrij.check_given(&gouraud, &settings).is_err());
+        assert_eq!(
+            find("refine").unwrap().check_given(&gouraud, &settings),
+            Ok(())
+        );
+        let pot = crate::Source::resolve(None)
+            .unwrap()
+            .load(None)
+            .unwrap()
+            .scene;
+        assert_eq!(vanrij.check_scene(&[], &pot, "pot"), Ok(()));
+        assert!(find("nishita")
+            .unwrap()
+            .check_scene(&[], &pot, "pot")
+            .unwrap_err()
+            .contains("it would draw exactly as vanrij"));
+        assert!(vanrij
+            .check_scene(&[Setting::Tessellate], &pot, "pot")
+            .is_err());
     }
 }

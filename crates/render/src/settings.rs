@@ -108,6 +108,185 @@ pub struct Settings {
     pub threads: usize,
 }
 
+/// One of the [`Settings`] a renderer may read, named by its command-line flag. A
+/// renderer declares the ones it reads ([`crate::registry::Entry::uses`]); the command
+/// line refuses a flag given for one that is not read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Setting {
+    /// [`Settings::shading`].
+    Shading,
+    /// [`Settings::aa`].
+    Aa,
+    /// [`Settings::visibility`].
+    Visibility,
+    /// [`Settings::eval0_tolerance`].
+    Eval0Tolerance,
+    /// [`Settings::size`].
+    Size,
+    /// [`Settings::shade_tolerance`].
+    ShadeTolerance,
+    /// [`Settings::tessellate`].
+    Tessellate,
+    /// [`Settings::samples`].
+    Samples,
+    /// [`Settings::grid`].
+    Grid,
+    /// [`Settings::merge_subscanlines`].
+    MergeSubscanlines,
+    /// [`Settings::shade_p`].
+    ShadeP,
+    /// [`Settings::shade_contrast`].
+    ShadeContrast,
+    /// [`Settings::seed`].
+    Seed,
+    /// [`Settings::cp_increment`].
+    CpIncrement,
+    /// [`Settings::sbuffer`].
+    Sbuffer,
+    /// [`Settings::bsp_order`].
+    Order,
+    /// [`Settings::unset`].
+    Unset,
+    /// [`Settings::root_tolerance`].
+    RootTolerance,
+    /// [`Settings::flatness`].
+    Flatness,
+    /// [`Settings::band`].
+    Band,
+    /// [`Settings::subscan`].
+    Subscan,
+    /// [`Settings::gouraud_threshold`].
+    GouraudThreshold,
+    /// [`Settings::aa_threshold`].
+    AaThreshold,
+    /// [`Settings::phong_angle`].
+    PhongAngle,
+}
+
+impl Setting {
+    /// Every setting, in the order of the command line's drawing flags.
+    pub const ALL: [Setting; 24] = [
+        Setting::Shading,
+        Setting::Aa,
+        Setting::Visibility,
+        Setting::Eval0Tolerance,
+        Setting::Size,
+        Setting::ShadeTolerance,
+        Setting::Tessellate,
+        Setting::Samples,
+        Setting::Grid,
+        Setting::MergeSubscanlines,
+        Setting::ShadeP,
+        Setting::ShadeContrast,
+        Setting::Seed,
+        Setting::CpIncrement,
+        Setting::Sbuffer,
+        Setting::Order,
+        Setting::Unset,
+        Setting::RootTolerance,
+        Setting::Flatness,
+        Setting::Band,
+        Setting::Subscan,
+        Setting::GouraudThreshold,
+        Setting::AaThreshold,
+        Setting::PhongAngle,
+    ];
+
+    /// Its flag: `--samples`.
+    pub fn flag(self) -> &'static str {
+        match self {
+            Setting::Shading => "--shading",
+            Setting::Aa => "--aa",
+            Setting::Visibility => "--visibility",
+            Setting::Eval0Tolerance => "--eval0-tolerance",
+            Setting::Size => "--size",
+            Setting::ShadeTolerance => "--shade-tolerance",
+            Setting::Tessellate => "--tessellate",
+            Setting::Samples => "--samples",
+            Setting::Grid => "--grid",
+            Setting::MergeSubscanlines => "--merge-subscanlines",
+            Setting::ShadeP => "--shade-p",
+            Setting::ShadeContrast => "--shade-contrast",
+            Setting::Seed => "--seed",
+            Setting::CpIncrement => "--cp-increment",
+            Setting::Sbuffer => "--sbuffer",
+            Setting::Order => "--order",
+            Setting::Unset => "--unset",
+            Setting::RootTolerance => "--root-tolerance",
+            Setting::Flatness => "--flatness",
+            Setting::Band => "--band",
+            Setting::Subscan => "--subscan",
+            Setting::GouraudThreshold => "--gouraud-threshold",
+            Setting::AaThreshold => "--aa-threshold",
+            Setting::PhongAngle => "--phong-angle",
+        }
+    }
+
+    /// The setting of a flag (`--samples`).
+    pub fn of_flag(flag: &str) -> Option<Setting> {
+        Setting::ALL.into_iter().find(|s| s.flag() == flag)
+    }
+
+    /// It concerns world scenes only: a screen scene has no depth to resolve, nothing to
+    /// light per pixel and nothing to refine.
+    pub fn world_only(self) -> bool {
+        matches!(
+            self,
+            Setting::Visibility
+                | Setting::Eval0Tolerance
+                | Setting::ShadeTolerance
+                | Setting::GouraudThreshold
+                | Setting::AaThreshold
+                | Setting::PhongAngle
+        )
+    }
+
+    /// When the other settings of `s` leave this one nothing to do in a renderer that
+    /// reads both: the setting that decides, and why. `--aa box` with Phong shading is
+    /// here too: Phong's box filter is the report's, coverage × the centre's shade.
+    pub fn idle_under(self, s: &Settings) -> Option<(Setting, String)> {
+        let why = |by, text: &str| Some((by, text.to_string()));
+        match self {
+            Setting::ShadeTolerance if s.shading != Shading::Phong => why(
+                Setting::Shading,
+                "--shade-tolerance is the span fitter's, used with --shading phong only",
+            ),
+            Setting::Eval0Tolerance
+                if !(s.visibility == Visibility::Eval0 && s.shading == Shading::Gouraud) =>
+            {
+                why(
+                    Setting::Visibility,
+                    "--eval0-tolerance is used with --visibility eval0 and --shading gouraud only (a flat claim is one value)",
+                )
+            }
+            Setting::Unset if s.bsp_order != BspOrder::FrontToBack => why(
+                Setting::Order,
+                "--unset is used with --order front-to-back only (back to front paints into a host colour line)",
+            ),
+            Setting::MergeSubscanlines if s.samples < 2 => why(
+                Setting::Samples,
+                "--merge-subscanlines is used with --samples 2 or more (one sub-scanline per row has nothing to merge)",
+            ),
+            Setting::ShadeP | Setting::ShadeContrast | Setting::Seed
+                if s.shading == Shading::Hidden =>
+            {
+                Some((
+                    Setting::Shading,
+                    format!(
+                        "{} is for shading calls, and --shading hidden makes none",
+                        self.flag()
+                    ),
+                ))
+            }
+            Setting::Aa if s.shading == Shading::Phong && s.aa == Antialias::Box => why(
+                Setting::Shading,
+                "--aa box (exact) is not drawn with --shading phong: no instruction carries the exact integral of a Phong shade over a pixel; use --aa box-centre (coverage × the shade at the pixel centre, what Phong's box filter is) or --aa none",
+            ),
+            _ => None,
+        }
+    }
+}
+
 /// A refinement threshold: `all` (everything passes), `none` (nothing does), or a
 /// number `T ≥ 0` (a measure passes when it exceeds `T`).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -426,6 +605,24 @@ mod tests {
             ..Settings::default()
         };
         assert!(wide.check().unwrap_err().contains("--phong-angle"));
+    }
+
+    #[test]
+    fn settings_are_named_by_their_flags() {
+        for s in Setting::ALL {
+            assert_eq!(Setting::of_flag(s.flag()), Some(s));
+        }
+        assert_eq!(Setting::of_flag("--renderer"), None);
+        let phong = Settings {
+            shading: Shading::Phong,
+            ..Settings::default()
+        };
+        assert_eq!(Setting::ShadeTolerance.idle_under(&phong), None);
+        assert_eq!(
+            Setting::Aa.idle_under(&phong).map(|(by, _)| by),
+            Some(Setting::Shading)
+        );
+        assert!(Setting::Aa.idle_under(&Settings::default()).is_none());
     }
 
     #[test]

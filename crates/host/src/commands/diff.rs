@@ -40,8 +40,8 @@ pub struct DiffArgs {
     /// The machine model (for replaying traces).
     #[command(flatten)]
     pub machine: MachineArgs,
-    /// How to draw a scene (ignored for traces and outputs).
-    #[command(flatten, next_help_heading = "Drawing a scene")]
+    /// How to draw a scene (refused when neither input is one).
+    #[command(flatten, next_help_heading = crate::draw::SCENE_ONLY)]
     pub draw: crate::draw::DrawArgs,
 }
 
@@ -51,6 +51,7 @@ fn is_npy(p: &Path) -> bool {
 
 /// Runs `cwisim diff`; `Ok(true)` when equal.
 pub fn run(args: &DiffArgs, stdout: &mut dyn Write) -> Result<bool, CliError> {
+    crate::input::drawing_applies(&args.draw, &[Some(&args.a), Some(&args.b)])?;
     if !(args.tolerance >= 0.0 && args.tolerance.is_finite()) {
         return Err(CliError::Usage(format!(
             "--tolerance {} must be a finite number ≥ 0",

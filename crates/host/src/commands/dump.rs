@@ -34,8 +34,8 @@ pub struct DumpArgs {
     /// The machine model (for the cycles).
     #[command(flatten)]
     pub machine: MachineArgs,
-    /// How to draw a scene (ignored for a trace).
-    #[command(flatten, next_help_heading = "Drawing a scene")]
+    /// How to draw a scene (refused with a trace).
+    #[command(flatten, next_help_heading = crate::draw::SCENE_ONLY)]
     pub draw: crate::draw::DrawArgs,
 }
 
@@ -77,6 +77,7 @@ impl Probe for Printer<'_> {
 
 /// Runs `cwisim dump`.
 pub fn run(args: &DumpArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
+    crate::input::drawing_applies(&args.draw, &[Some(&args.trace)])?;
     let machine = args.machine.load()?;
     let mut file = crate::input::open(&args.trace, &args.draw)?;
     let header = *file.header();

@@ -31,13 +31,14 @@ pub struct HistoryArgs {
     /// The machine model (for the cycles).
     #[command(flatten)]
     pub machine: MachineArgs,
-    /// How to draw a scene (ignored for a trace).
-    #[command(flatten, next_help_heading = "Drawing a scene")]
+    /// How to draw a scene (refused with a trace).
+    #[command(flatten, next_help_heading = crate::draw::SCENE_ONLY)]
     pub draw: crate::draw::DrawArgs,
 }
 
 /// Runs `cwisim history`.
 pub fn run(args: &HistoryArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
+    crate::input::drawing_applies(&args.draw, &[Some(&args.trace)])?;
     let machine = args.machine.load()?;
     let mut file = crate::input::open(&args.trace, &args.draw)?;
     let header = *file.header();

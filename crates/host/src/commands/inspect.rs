@@ -46,8 +46,8 @@ pub struct InspectArgs {
     /// The machine model (for the cycles).
     #[command(flatten)]
     pub machine: MachineArgs,
-    /// How to draw a scene (ignored for a trace).
-    #[command(flatten, next_help_heading = "Drawing a scene")]
+    /// How to draw a scene (refused with a trace).
+    #[command(flatten, next_help_heading = crate::draw::SCENE_ONLY)]
     pub draw: DrawArgs,
 }
 
@@ -104,6 +104,7 @@ fn window(
 /// Runs `cwisim inspect`.
 pub fn run(args: &InspectArgs, stdout: &mut dyn Write, progress: bool) -> Result<(), CliError> {
     let kind = InputKind::of(&args.input)?;
+    crate::input::drawing_applies(&args.draw, &[Some(&args.input)])?;
     check_extension("-o", &args.output, "html")?;
     let input_file = args
         .input

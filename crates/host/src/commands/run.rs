@@ -86,8 +86,8 @@ pub struct RunArgs {
     /// it. Statistics and cost outputs are not written for a bad trace.
     #[arg(long)]
     pub keep_partial: bool,
-    /// How to draw a scene (ignored for a trace).
-    #[command(flatten, next_help_heading = "Drawing a scene")]
+    /// How to draw a scene (refused with a trace).
+    #[command(flatten, next_help_heading = crate::draw::SCENE_ONLY)]
     pub draw: crate::draw::DrawArgs,
 }
 
@@ -101,6 +101,7 @@ pub fn run(
     stderr: &mut dyn Write,
     progress: bool,
 ) -> Result<(), CliError> {
+    crate::input::drawing_applies(&args.draw, &[args.trace.as_deref()])?;
     check_paths(args)?;
     let machine = args.machine.load()?;
     let timing = Timing::from(args.timing);

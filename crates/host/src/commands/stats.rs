@@ -62,8 +62,8 @@ pub struct StatsArgs {
     #[arg(long, value_enum, default_value_t = TimingArg::Fast)]
     pub timing: TimingArg,
 
-    /// How to draw a scene (ignored for a trace).
-    #[command(flatten)]
+    /// How to draw a scene (refused with a trace).
+    #[command(flatten, next_help_heading = crate::draw::SCENE_ONLY)]
     pub draw: DrawArgs,
 }
 
@@ -155,6 +155,7 @@ pub fn run(
     stderr: &mut dyn Write,
 ) -> Result<(), CliError> {
     let kind = Input::of(&args.input)?;
+    crate::input::drawing_applies(&args.draw, &[Some(&args.input)])?;
     check_outputs(args)?;
     let machine = args.machine.load()?;
     let timing = Timing::from(args.timing);

@@ -56,13 +56,14 @@ pub struct VcdArgs {
     /// The machine model (for the cycles).
     #[command(flatten)]
     pub machine: MachineArgs,
-    /// How to draw a scene (ignored for a trace).
-    #[command(flatten, next_help_heading = "Drawing a scene")]
+    /// How to draw a scene (refused with a trace).
+    #[command(flatten, next_help_heading = crate::draw::SCENE_ONLY)]
     pub draw: crate::draw::DrawArgs,
 }
 
 /// Runs `cwisim vcd`.
 pub fn run(args: &VcdArgs) -> Result<(), CliError> {
+    crate::input::drawing_applies(&args.draw, &[Some(&args.trace)])?;
     if same_file(&args.output, &args.trace) {
         return Err(CliError::Usage(format!(
             "-o {} would overwrite the trace being read",
