@@ -12,7 +12,7 @@ use crate::arith::Arith;
 use crate::clock::Clock;
 use crate::engine::{Engine, ReplayError};
 use crate::fast::FastEngine;
-use crate::machine::Timeline;
+use crate::machine::{MachineError, Timeline};
 use crate::output::LineSink;
 use crate::probe::Probe;
 use crate::stats::{IssueTally, Recorder, RunStats};
@@ -77,6 +77,13 @@ pub enum StepFrom {
     /// scanline or a few earlier.
     Issue(u64),
 }
+
+/// The latest cycle the stepped engine goes on from: its cycle arithmetic is plain (it
+/// steps one cycle at a time), and from here a few frames of the longest (2⁵⁷ cycles)
+/// stay below 2⁶⁴. Only a run at the edges of the machine's ranges gets here (a line
+/// period of 2⁴⁰ with 2¹⁶ blank lines: 128 frames), and a stepped run from the start never
+/// would.
+const LATEST_RESUME: u64 = 1 << 63;
 
 /// Instructions between progress reports.
 const PROGRESS_EVERY: u64 = 4096;
@@ -207,6 +214,17 @@ pub(crate) fn probed<A: Arith>(
     let Some(state) = fast.handover() else {
         unreachable!("the fast engine stops between scanlines, and takes no bands")
     };
+    if state.cycle() >= LATEST_RESUME {
+        return Err(ReplayError::Machine(MachineError::Invalid {
+            name: "line_period_cycles".into(),
+            message: format!(
+                "scanline {} starts at cycle {}, beyond what the cycle-stepped engine steps \
+                 to (2^63); shorten the line period or the blanking",
+                state.lines(),
+                state.cycle()
+            ),
+        }));
+    }
     let mut eng = Box::new(SteppedEngine::resume(state, probe));
     for instr in ahead.instrs.iter().chain(&start) {
         eng.execute(instr, sink);

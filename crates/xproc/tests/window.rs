@@ -526,6 +526,33 @@ fn a_window_beyond_the_end() {
     }
 }
 
+/// At the edges of the machine's ranges the fast engine reaches cycles the stepped engine
+/// cannot go on from: refused, not wrapped.
+#[test]
+fn a_window_beyond_2_pow_63_cycles_is_refused() {
+    let header = TraceHeader::new(8, 1, 1).unwrap();
+    let machine = Machine {
+        line_period_cycles: Some(1 << 40),
+        vblank_lines: 1 << 16,
+        ..Machine::default()
+    };
+    let trace = vec![Instruction::refresh(); 140];
+    let mut reader = VecReader::new(&header, &trace);
+    let err = replay_probed_from::<f64>(
+        &mut reader,
+        &machine,
+        StepFrom::Scanline(139),
+        &mut Log::default(),
+        &mut NullSink,
+        &mut |_| {},
+    )
+    .unwrap_err();
+    assert!(
+        err.to_string().contains("scanline 139 starts at cycle"),
+        "{err}"
+    );
+}
+
 /// `replay_probed_from` is `replay_probed_numeric` in `f64`.
 #[test]
 fn the_native_entry_point_is_the_numeric_one_in_f64() {
