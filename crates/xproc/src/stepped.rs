@@ -5,7 +5,8 @@
 //! bookkeeping: processors are plain structs with one flag per condition, and every
 //! token (an instruction with its running forward-differencing state) visits every
 //! processor, one hop at a time. Obviously right, and slow: the property tests hold the
-//! fast engine to it.
+//! fast engine to it. It can also go on from the fast engine's state between scanlines
+//! ([`SteppedEngine::resume`]), to step only the scanlines a study tool shows.
 
 use crate::arith::{vector, Arith, Native};
 use crate::engine::Engine;
@@ -166,11 +167,15 @@ impl<'p, A: Arith> SteppedEngine<'p, A> {
     /// reaches a processor finds it as they all left it: accumulator zero, preload flags,
     /// lock and mask clear, the `Acc_mode` flag as the earlier `Acc_mode`s left it, the
     /// preload registers' values as last written. Nor do they delay anything but one: a
-    /// token enters the chain a hop after the one before it (they all move a hop at a
-    /// time), so only the last one handed over, which entered at the hand-over cycle,
-    /// holds the first processor for a hop. Their work and readiness are already in the
+    /// token enters the chain at least a hop after the one before it and they all move a
+    /// hop at a time, so only the last one handed over, which entered at the hand-over
+    /// cycle, holds the first processor (for a hop). Their work and readiness are already in the
     /// statistics handed over; the chain starts empty, and the bus idle at the cycle that
     /// last token entered, where the stepped engine starts the next instruction.
+    ///
+    /// Its cycles are plain arithmetic, as they are stepped: a hand-over at cycle 2⁶³ or
+    /// later (only at the edges of the machine's ranges) is beyond it, and
+    /// [`crate::replay_probed_from`] refuses one.
     pub fn resume(state: Handover<A>, probe: &'p mut dyn Probe) -> Self {
         let Handover {
             header,
@@ -288,9 +293,8 @@ impl<'p, A: Arith> SteppedEngine<'p, A> {
         out
     }
 
-    /// The clock advances one cycle per step (from 0, or from a hand-over's cycle, which
-    /// a stepped run from the start would have reached step by step), so `t` stays far
-    /// below 2⁶⁴, and the plain additions to it (a cost below 2²⁰, a hop at most 2¹⁶:
+    /// The clock advances one cycle per step (from 0, or from a hand-over's cycle, below
+    /// 2⁶³: `crate::window`), so `t` stays far below 2⁶⁴, and the plain additions to it (a cost below 2²⁰, a hop at most 2¹⁶:
     /// `crate::machine`) cannot overflow.
     fn next_cycle(&mut self) {
         self.t += 1;
