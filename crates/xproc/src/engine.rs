@@ -194,8 +194,8 @@ fn drive<T: Sample>(
     Ok(eng.finish(sink))
 }
 
-/// Replays a trace on the cycle-stepped engine, reporting to `probe` as it steps
-/// (`cwisim history`, `cwisim vcd`).
+/// Replays a trace on the cycle-stepped engine, reporting to `probe` as it steps, from
+/// the start ([`replay_probed_from`] steps only the scanlines asked for).
 pub fn replay_probed<T: Sample>(
     reader: &mut dyn TraceRead,
     machine: &Machine,

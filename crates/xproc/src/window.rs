@@ -159,7 +159,6 @@ impl Ahead {
 /// Replays `reader` with registers of arithmetic `arith`: the fast engine up to the
 /// scanlines `from` asks for, then the stepped engine with `probe` from the fast
 /// engine's state (see [`crate::replay_probed_from`]).
-#[allow(clippy::too_many_arguments)]
 pub(crate) fn probed<A: Arith>(
     reader: &mut dyn TraceRead,
     timeline: Timeline,
