@@ -1,12 +1,14 @@
 //! One pixel's history: every instruction that reached processor `x` on scanline `y`,
 //! with the registers before and after it acted (`cwisim history`), computed by the
-//! cycle-stepped engine through a [`Probe`].
+//! cycle-stepped engine through a [`Probe`]. Only scanline `y` is stepped: the fast
+//! engine runs the scanlines before it and hands its state over
+//! ([`cwisim_xproc::replay_probed_from`]).
 
 use crate::error::StudyError;
 use crate::until::UntilLine;
 use cwisim_isa::text::format_value;
 use cwisim_isa::{Instruction, Opcode, TraceRead};
-use cwisim_xproc::{replay_probed, Machine, NullSink, Probe, ProcessorState};
+use cwisim_xproc::{replay_probed_from, Machine, NullSink, Probe, ProcessorState, StepFrom};
 
 /// Replays `trace` up to scanline `y` and returns every visit of a token to processor
 /// `x` on it. `Ok(Err(n))`: the trace outputs only `n` scanlines.
@@ -16,13 +18,32 @@ pub fn pixel_history(
     x: usize,
     y: u64,
 ) -> Result<Result<Vec<Visit>, u64>, StudyError> {
+    pixel_history_with_progress(trace, machine, x, y, &mut |_| {})
+}
+
+/// [`pixel_history`], calling `progress` with the bytes of `trace` read so far every few
+/// thousand instructions (and at the end): for a progress bar.
+pub fn pixel_history_with_progress(
+    trace: &mut dyn TraceRead,
+    machine: &Machine,
+    x: usize,
+    y: u64,
+    progress: &mut dyn FnMut(u64),
+) -> Result<Result<Vec<Visit>, u64>, StudyError> {
     let mut watch = Watch {
         x,
         y,
         visits: Vec::new(),
     };
     let mut reader = UntilLine::new(trace, Some(y));
-    replay_probed::<f64>(&mut reader, machine, &mut watch, &mut NullSink)?;
+    replay_probed_from::<f64>(
+        &mut reader,
+        machine,
+        StepFrom::Scanline(y),
+        &mut watch,
+        &mut NullSink,
+        progress,
+    )?;
     let lines = reader.lines_read();
     if lines <= y {
         return Ok(Err(lines));
@@ -203,4 +224,38 @@ pub fn state(s: &ProcessorState) -> String {
             flags.join(",")
         }
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::window_tests::{machines, reader, trace};
+    use cwisim_xproc::replay_probed;
+
+    /// Every pixel's history, with the scanlines before it on the fast engine, is the
+    /// history a stepped run from the start of the trace gives.
+    #[test]
+    fn every_history_is_that_of_a_stepped_run_from_the_start() {
+        let text = trace();
+        for machine in machines() {
+            for y in 0..13 {
+                for x in 0..16 {
+                    let windowed = pixel_history(&mut reader(&text), &machine, x, y).unwrap();
+                    let mut watch = Watch {
+                        x,
+                        y,
+                        visits: Vec::new(),
+                    };
+                    replay_probed::<f64>(&mut reader(&text), &machine, &mut watch, &mut NullSink)
+                        .unwrap();
+                    if y < 12 {
+                        assert!(!watch.visits.is_empty());
+                        assert_eq!(windowed, Ok(watch.visits), "({x}, {y})");
+                    } else {
+                        assert_eq!(windowed, Err(12));
+                    }
+                }
+            }
+        }
+    }
 }

@@ -3,10 +3,11 @@
 //! the late scanlines), the scanline timeline with each scanline's disassembly, and the
 //! pixel history of every pixel in a window.
 //!
-//! Everything the page shows is computed here, by one replay on the cycle-stepped engine
-//! (the reference model) with a [`Probe`]: the same figures as `cwisim stats`, the same
-//! lines as `cwisim dump` and `cwisim history`. The page's script only decodes, draws and
-//! looks up; it simulates nothing.
+//! Everything the page shows is computed here, by one replay with a [`Probe`] on the
+//! cycle-stepped engine (the reference model), which steps the frame from the state the
+//! fast engine hands it after the frames before: the same figures as `cwisim stats`, the
+//! same lines as `cwisim dump` and `cwisim history`. The page's script only decodes,
+//! draws and looks up; it simulates nothing.
 //!
 //! The data is embedded as JSON with the large arrays as base64 of zlib streams
 //! (little-endian `f64` values, `u32` counts and indices, text joined by newlines), which
@@ -20,7 +21,9 @@ use crate::plot::{group_cycles, issue_costs, GROUPS, OVERRUN};
 use crate::until::UntilLine;
 use cwisim_isa::text::format_instruction;
 use cwisim_isa::{Instruction, Opcode, TraceRead};
-use cwisim_xproc::{replay_probed, LineOut, LineSink, Machine, Probe, ProcessorState};
+use cwisim_xproc::{
+    replay_probed_from, LineOut, LineSink, Machine, Probe, ProcessorState, StepFrom,
+};
 use std::collections::{HashMap, VecDeque};
 use std::io::Write;
 
@@ -392,14 +395,27 @@ a browser could not open the page; study it with `cwisim stats`, `dump` and `his
     Ok(())
 }
 
-/// Replays `trace` up to the end of frame `opts.frame` on the cycle-stepped engine and
-/// builds the page. Refuses (as [`StudyError::Usage`]) a frame beyond the trace, a frame
-/// over [`MAX_FRAME_PIXELS`], a window outside the frame or over [`MAX_HISTORY_PIXELS`],
-/// and a page over [`MAX_PAGE_BYTES`].
+/// Replays `trace` up to the end of frame `opts.frame` and builds the page: the frames
+/// before on the fast engine, the frame on the cycle-stepped engine from the fast
+/// engine's state ([`cwisim_xproc::replay_probed_from`]). Refuses (as
+/// [`StudyError::Usage`]) a frame beyond the trace, a frame over [`MAX_FRAME_PIXELS`], a
+/// window outside the frame or over [`MAX_HISTORY_PIXELS`], and a page over
+/// [`MAX_PAGE_BYTES`].
 pub fn inspect(
     trace: &mut dyn TraceRead,
     machine: &Machine,
     opts: &Options<'_>,
+) -> Result<Page, StudyError> {
+    inspect_with_progress(trace, machine, opts, &mut |_| {})
+}
+
+/// [`inspect`], calling `progress` with the bytes of `trace` read so far every few
+/// thousand instructions (and at the end): for a progress bar.
+pub fn inspect_with_progress(
+    trace: &mut dyn TraceRead,
+    machine: &Machine,
+    opts: &Options<'_>,
+    progress: &mut dyn FnMut(u64),
 ) -> Result<Page, StudyError> {
     let header = *trace.header();
     let width = u64::from(header.width);
@@ -467,7 +483,14 @@ choose a smaller one with --x and --lines",
         let mut until = UntilLine::new(trace, Some(frame.1 - 1));
         let stats = {
             let mut reader = CostReader::new(&mut until, &mut cost);
-            replay_probed::<f64>(&mut reader, machine, &mut collector, &mut image)?
+            replay_probed_from::<f64>(
+                &mut reader,
+                machine,
+                StepFrom::Scanline(first),
+                &mut collector,
+                &mut image,
+                progress,
+            )?
         };
         (stats, until.lines_read())
     };

@@ -39,3 +39,62 @@ pub mod until;
 pub mod vcd;
 
 pub use error::StudyError;
+
+/// What the tests of the stepped window share: a trace that leaves state across its
+/// scanlines, and machines with and without scanlines in flight together.
+#[cfg(test)]
+pub(crate) mod window_tests {
+    use cwisim_isa::text::{format_header, format_instruction, TextReader};
+    use cwisim_isa::{Instruction, Intensity, TraceHeader};
+    use cwisim_xproc::Machine;
+
+    /// 12 scanlines of 16 pixels, 3 per frame: ramps, preloads left unconsumed across a
+    /// `Refresh` (their values stay), `Eval0` locks, `Dis` masks, `Acc_mode` on for some
+    /// scanlines, an empty scanline, and instructions after the last `Refresh`.
+    pub(crate) fn trace() -> String {
+        let header = TraceHeader::new(16, 3, 1).unwrap();
+        let g = Intensity::grey;
+        let mut out = vec![format_header(&header)];
+        let mut push = |i: Instruction| out.push(format_instruction(&i));
+        for line in 0..12u32 {
+            if line == 7 {
+                push(Instruction::refresh());
+                continue;
+            }
+            push(Instruction::set_pi(line % 4, 5, g(0.25 * f64::from(line))));
+            push(Instruction::set_di(line % 16, g(-0.125)));
+            push(Instruction::eval0(3, 2, g(0.75)));
+            push(Instruction::dis(9, 3));
+            push(Instruction::eval2(0, 16, g(0.5), g(-0.0625)));
+            push(Instruction::eval1(line % 8, 6, g(-0.25)));
+            if line % 3 == 1 {
+                push(Instruction::acc_mode());
+            }
+            push(Instruction::refresh());
+        }
+        push(Instruction::eval1(0, 4, g(1.0)));
+        out.join("\n") + "\n"
+    }
+
+    /// A reader of [`trace`].
+    pub(crate) fn reader(text: &str) -> TextReader<&[u8]> {
+        TextReader::new(text.as_bytes()).unwrap()
+    }
+
+    /// A machine whose `Refresh`es wait for the display (no two scanlines in the array
+    /// together), and one whose line period is shorter than a traversal.
+    pub(crate) fn machines() -> [Machine; 2] {
+        [
+            Machine {
+                line_period_cycles: Some(400),
+                ..Machine::default()
+            },
+            Machine {
+                hop_cycles: 3,
+                line_period_cycles: Some(25),
+                vblank_lines: 1,
+                ..Machine::default()
+            },
+        ]
+    }
+}

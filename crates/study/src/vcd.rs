@@ -4,7 +4,9 @@
 //! [`Probe`] that watches a window of processors. From the cycle the instruction bus
 //! starts issuing the first instruction of scanline `Y` to the cycle scanline `Y` leaves
 //! the array, every change of the bus and of the watched processors' registers and flags
-//! is written through the `vcd` crate.
+//! is written through the `vcd` crate. Only the scanlines whose tokens are in the array
+//! then are stepped (`Y`, and the few before it still crossing): the fast engine runs the
+//! ones before and hands its state over ([`StepFrom::Issue`]).
 //!
 //! The `vcd` crate's writer formats what it is given and checks nothing, so this module
 //! checks what makes a dump valid: the timescale (1, 10 or 100 of a unit), strictly
@@ -19,7 +21,9 @@
 
 use crate::error::StudyError;
 use cwisim_isa::{Instruction, Location, Opcode, OperandKind, TraceError, TraceHeader, TraceRead};
-use cwisim_xproc::{replay_probed, LineOut, LineSink, Machine, Probe, ProcessorState};
+use cwisim_xproc::{
+    replay_probed_from, LineOut, LineSink, Machine, Probe, ProcessorState, StepFrom,
+};
 use std::cell::Cell;
 use std::collections::BTreeSet;
 use std::io::{self, Write};
@@ -37,6 +41,19 @@ pub fn record_scanline(
     from: usize,
     to: usize,
 ) -> Result<Result<Wave, u64>, StudyError> {
+    record_scanline_with_progress(trace, machine, line, from, to, &mut |_| {})
+}
+
+/// [`record_scanline`], calling `progress` with the bytes of `trace` read so far every
+/// few thousand instructions (and at the end): for a progress bar.
+pub fn record_scanline_with_progress(
+    trace: &mut dyn TraceRead,
+    machine: &Machine,
+    line: u64,
+    from: usize,
+    to: usize,
+    progress: &mut dyn FnMut(u64),
+) -> Result<Result<Wave, u64>, StudyError> {
     let header = *trace.header();
     let timeline = machine.timeline(&header)?;
     let done = Rc::new(Cell::new(false));
@@ -49,10 +66,16 @@ pub fn record_scanline(
         values: None,
     };
     let mut reader = UntilReady { inner: trace, done };
-    replay_probed::<f64>(&mut reader, machine, &mut probe, &mut sink)?;
-    let lines = probe.lines_ready;
+    let stats = replay_probed_from::<f64>(
+        &mut reader,
+        machine,
+        StepFrom::Issue(line),
+        &mut probe,
+        &mut sink,
+        progress,
+    )?;
     let Some(wave) = probe.finish() else {
-        return Ok(Err(lines));
+        return Ok(Err(stats.totals.lines));
     };
     // The `out` registers must hold exactly what the replay output for the scanline.
     if !wave.out_matches(&sink.values.unwrap_or_default()) {
@@ -293,6 +316,24 @@ impl Layout {
         self.proc_base(p) + 5 * self.channels + 6
     }
 
+    /// The values of processor `p`'s registers and flags in `s`.
+    fn state(&self, p: usize, s: &ProcessorState) -> Vec<(usize, Val)> {
+        let mut sets = Vec::with_capacity(self.proc_len());
+        for k in 0..self.channels {
+            sets.push((self.acc(p, k), Val::Real(s.acc[k])));
+            for slot in 0..3 {
+                sets.push((self.reg(p, slot, k), Val::Real(s.reg[slot][k])));
+            }
+        }
+        for slot in 0..3 {
+            sets.push((self.has(p, slot), Val::Bit(s.has[slot])));
+        }
+        sets.push((self.locked(p), Val::Bit(s.locked)));
+        sets.push((self.masked(p), Val::Bit(s.masked)));
+        sets.push((self.neg(p), Val::Bit(s.negative_enabled)));
+        sets
+    }
+
     /// Every signal's value before anything happened: registers `+0.0`, flags clear,
     /// the bus idle, no token anywhere.
     fn reset_values(&self) -> Vec<Val> {
@@ -335,8 +376,6 @@ struct Recorder {
     initial: Vec<Val>,
     /// Changes inside the window: `(cycle, signal, value)`, in the order they happened.
     log: Vec<(u64, usize, Val)>,
-    /// Scanlines that left the array so far.
-    lines_ready: u64,
     done: Rc<Cell<bool>>,
 }
 
@@ -375,7 +414,6 @@ impl Recorder {
             end: None,
             initial: Vec::new(),
             log: Vec::new(),
-            lines_ready: 0,
             done,
             header: *header,
         }
@@ -525,19 +563,7 @@ impl Probe for Recorder {
         }
         let l = &self.layout;
         let c = l.channels;
-        let mut sets = Vec::with_capacity(l.proc_len());
-        for k in 0..c {
-            sets.push((l.acc(p, k), Val::Real(after.acc[k])));
-            for slot in 0..3 {
-                sets.push((l.reg(p, slot, k), Val::Real(after.reg[slot][k])));
-            }
-        }
-        for slot in 0..3 {
-            sets.push((l.has(p, slot), Val::Bit(after.has[slot])));
-        }
-        sets.push((l.locked(p), Val::Bit(after.locked)));
-        sets.push((l.masked(p), Val::Bit(after.masked)));
-        sets.push((l.neg(p), Val::Bit(after.negative_enabled)));
+        let mut sets = l.state(p, after);
         if instr.op == Opcode::Refresh && line == self.line {
             for k in 0..c {
                 sets.push((l.out(p, k), Val::Real(before.acc[k])));
@@ -550,11 +576,20 @@ impl Probe for Recorder {
         self.token_until[p - self.layout.from] = Some(cycle + self.hop);
     }
 
+    /// The replay starts from the fast engine's state: the watched processors hold what
+    /// it says (the bus is idle, no token in the window).
+    fn resume(&mut self, cycle: u64, _line: u64, watched: &[(usize, ProcessorState)]) {
+        for (p, state) in watched {
+            for (sig, val) in self.layout.state(*p, state) {
+                self.set(cycle, sig, val);
+            }
+        }
+    }
+
     fn line_ready(&mut self, cycle: u64, line: u64) {
         if self.past(cycle) {
             return;
         }
-        self.lines_ready += 1;
         if line == self.line {
             self.end = Some(cycle);
             self.done.set(true);
@@ -772,6 +807,66 @@ the array. Tokens stay {} cycle(s) in each processor.",
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::window_tests::{machines, reader, trace};
+    use cwisim_xproc::replay_probed;
+
+    /// [`record_scanline`]'s steps, on the stepped engine from the start of the trace.
+    fn record_from_the_start(
+        text: &str,
+        machine: &Machine,
+        line: u64,
+        from: usize,
+        to: usize,
+    ) -> Option<Wave> {
+        let mut trace = reader(text);
+        let header = *trace.header();
+        let hop = machine.timeline(&header).unwrap().hop;
+        let done = Rc::new(Cell::new(false));
+        let mut probe = Recorder::new(&header, line, from, to, hop, Rc::clone(&done));
+        let mut sink = LineCapture {
+            line,
+            from,
+            to,
+            channels: header.channel_count(),
+            values: None,
+        };
+        let mut reader = UntilReady {
+            inner: &mut trace,
+            done,
+        };
+        replay_probed::<f64>(&mut reader, machine, &mut probe, &mut sink).unwrap();
+        probe.finish()
+    }
+
+    fn vcd_text(wave: &Wave) -> String {
+        let mut out = Vec::new();
+        write_vcd(&mut out, wave).unwrap();
+        String::from_utf8(out).unwrap()
+    }
+
+    /// Every scanline's waveform, with the scanlines before it on the fast engine, is
+    /// byte for byte the one a stepped run from the start of the trace gives — also when
+    /// the tokens of earlier scanlines are still crossing the window.
+    #[test]
+    fn every_waveform_is_that_of_a_stepped_run_from_the_start() {
+        let text = trace();
+        for machine in machines() {
+            for line in 0..13 {
+                for (from, to) in [(0, 15), (2, 4), (14, 15)] {
+                    let windowed =
+                        record_scanline(&mut reader(&text), &machine, line, from, to).unwrap();
+                    let full = record_from_the_start(&text, &machine, line, from, to);
+                    match (windowed, full) {
+                        (Ok(w), Some(f)) => {
+                            assert_eq!(vcd_text(&w), vcd_text(&f), "{line} {from}..={to}")
+                        }
+                        (Err(n), None) => assert_eq!((line, n), (12, 12)),
+                        _ => panic!("scanline {line}: one replay found it, the other not"),
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn timescales_other_than_1_10_100_are_refused() {

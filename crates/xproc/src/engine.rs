@@ -4,12 +4,13 @@ use crate::arith::{Arith, F32Arith, FixedArith, Native};
 use crate::band::{Band, BandArray};
 use crate::fast::FastEngine;
 use crate::machine::{Machine, MachineError, Timeline};
-use crate::numeric::Numeric;
+use crate::numeric::{FixedFormat, Numeric};
 use crate::output::{Image, ImageSink, LineSink};
 use crate::probe::Probe;
 use crate::sample::Sample;
 use crate::stats::{LineRecords, RunStats};
 use crate::stepped::SteppedEngine;
+use crate::window::{self, StepFrom};
 use cwisim_isa::{Instruction, TraceError, TraceHeader, TraceRead};
 
 /// An X-processor array that executes instructions in order and shifts out scanlines.
@@ -107,13 +108,7 @@ pub fn numeric_engine(
     Ok(match numeric {
         Numeric::F64 => boxed(header, timeline, timing, Native::<f64>::new()),
         Numeric::F32 => boxed(header, timeline, timing, F32Arith),
-        Numeric::Fixed(f) => {
-            let arith = FixedArith::new(f).map_err(|e| MachineError::Invalid {
-                name: "numeric".into(),
-                message: e.message().to_string(),
-            })?;
-            boxed(header, timeline, timing, arith)
-        }
+        Numeric::Fixed(f) => boxed(header, timeline, timing, fixed_arith(f)?),
     })
 }
 
@@ -199,8 +194,8 @@ fn drive<T: Sample>(
     Ok(eng.finish(sink))
 }
 
-/// Replays a trace on the cycle-stepped engine, reporting to `probe` as it steps
-/// (`cwisim history`, `cwisim vcd`).
+/// Replays a trace on the cycle-stepped engine, reporting to `probe` as it steps, from
+/// the start ([`replay_probed_from`] steps only the scanlines asked for).
 pub fn replay_probed<T: Sample>(
     reader: &mut dyn TraceRead,
     machine: &Machine,
@@ -216,6 +211,69 @@ pub fn replay_probed<T: Sample>(
         eng.execute(&instr, sink);
     }
     Ok(eng.finish(sink))
+}
+
+/// Replays a trace reporting to `probe` every event of the scanlines `from` asks for (and
+/// later ones), as [`replay_probed`] reports them, without stepping the scanlines before:
+/// the fast engine runs those and hands its state over to the cycle-stepped engine
+/// ([`crate::window`]). The scanlines to `sink` and the statistics of the whole run are
+/// those of [`replay_probed`], bit for bit; the probe is first told where the stepped
+/// engine starts ([`Probe::resume`]). `progress` is called with the bytes read every few
+/// thousand instructions, and at the end.
+///
+/// The replay stops at the end of `reader`: to step no further than the scanlines asked
+/// for, end the reader after them.
+pub fn replay_probed_from<T: Sample>(
+    reader: &mut dyn TraceRead,
+    machine: &Machine,
+    from: StepFrom,
+    probe: &mut dyn Probe,
+    sink: &mut dyn LineSink<T>,
+    progress: &mut dyn FnMut(u64),
+) -> Result<RunStats, ReplayError> {
+    let timeline = machine.timeline(reader.header())?;
+    window::probed(
+        reader,
+        timeline,
+        Native::<T>::new(),
+        from,
+        probe,
+        sink,
+        progress,
+    )
+}
+
+/// [`replay_probed_from`] with registers of the format `numeric` (see
+/// [`numeric_engine`]); the sink receives the accumulators' values as `f64`.
+pub fn replay_probed_numeric(
+    reader: &mut dyn TraceRead,
+    machine: &Machine,
+    numeric: &Numeric,
+    from: StepFrom,
+    probe: &mut dyn Probe,
+    sink: &mut dyn LineSink<f64>,
+    progress: &mut dyn FnMut(u64),
+) -> Result<RunStats, ReplayError> {
+    let t = machine.timeline(reader.header())?;
+    match numeric {
+        Numeric::F64 => {
+            window::probed(reader, t, Native::<f64>::new(), from, probe, sink, progress)
+        }
+        Numeric::F32 => window::probed(reader, t, F32Arith, from, probe, sink, progress),
+        Numeric::Fixed(f) => {
+            let arith = fixed_arith(f)?;
+            window::probed(reader, t, arith, from, probe, sink, progress)
+        }
+    }
+}
+
+/// The arithmetic of a fixed format; one outside the limits is a
+/// [`MachineError::Invalid`] of the parameter `numeric`.
+fn fixed_arith(f: &FixedFormat) -> Result<FixedArith, MachineError> {
+    FixedArith::new(f).map_err(|e| MachineError::Invalid {
+        name: "numeric".into(),
+        message: e.message().to_string(),
+    })
 }
 
 /// Runs instructions held in memory and collects the image (in `f64`).

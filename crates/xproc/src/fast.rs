@@ -19,6 +19,7 @@ use crate::output::{LineOut, LineSink};
 use crate::processors::{LineEnd, Processors};
 use crate::sample::Sample;
 use crate::stats::{IssueTally, LineRecords, Recorder, RunStats, Work};
+use crate::window::Handover;
 use cwisim_isa::{Instruction, TraceHeader};
 
 /// The fast engine (see the module documentation), with registers of arithmetic `A`.
@@ -26,6 +27,8 @@ pub struct FastEngine<A: Arith> {
     header: TraceHeader,
     processors: Processors<A>,
     scanlines: Scanlines,
+    /// Bands were taken in: their preload registers never reached `processors`.
+    absorbed: bool,
 }
 
 /// What becomes of each scanline the processors hand out: timed, recorded and output in
@@ -98,7 +101,35 @@ impl<A: Arith> FastEngine<A> {
                 timeline,
                 line: 0,
             },
+            absorbed: false,
         }
+    }
+
+    /// The array's state for the cycle-stepped engine to go on from
+    /// ([`crate::stepped::SteppedEngine::resume`]): taken between scanlines (before the
+    /// first instruction, or right after a `Refresh`), it is exactly the state the
+    /// stepped engine has there for every later instruction — its registers and flags,
+    /// its clock, its counts and its statistics so far ([`Handover`]). `None` in the
+    /// middle of a scanline, or after bands were taken in ([`Self::absorb`]: their
+    /// preload registers are not here).
+    pub fn handover(self) -> Option<Handover<A>> {
+        if !self.processors.between_scanlines() || self.absorbed {
+            return None;
+        }
+        let negative_enabled = self.processors.negative_enabled();
+        let (arith, regs) = self.processors.into_registers();
+        let s = self.scanlines;
+        Some(Handover {
+            header: self.header,
+            instructions: s.recorder.instructions(),
+            last_entry: s.clock.last_entry(),
+            recorder: s.recorder,
+            timeline: s.timeline,
+            arith,
+            regs,
+            negative_enabled,
+            lines: s.line,
+        })
     }
 
     /// Takes in a band's scanlines, as if its instructions were executed here now: each
@@ -116,6 +147,7 @@ impl<A: Arith> FastEngine<A> {
                 .output(line.tally, line.work, line.span, line.values, sink);
         }
         self.processors.set_negative_enabled(band.negative_at_end());
+        self.absorbed = true;
         true
     }
 }

@@ -18,6 +18,9 @@
 //!   advances every processor every cycle; [`Timing::Fast`] computes the same scanlines
 //!   and the same cycle of every event in closed form, with cost proportional to the work
 //!   in the trace.
+//! * Stepping only a window ([`replay_probed_from`]): the fast engine runs the scanlines
+//!   before it and hands its state over to the stepped engine, which reports every event
+//!   of the window to a [`Probe`] as a stepped run from the start does.
 //! * Per-scanline statistics ([`RunStats`]): instructions by opcode, bus and stall
 //!   cycles, processor updates, readiness against the display deadline.
 //!
@@ -50,12 +53,13 @@ mod processors;
 pub mod sample;
 pub mod stats;
 pub mod stepped;
+pub mod window;
 
 pub use arith::{Arith, F32Arith, FixedArith, Native};
 pub use band::{Band, BandArray, OpenScanline};
 pub use engine::{
-    engine, numeric_engine, replay, replay_numeric, replay_probed, replay_streaming, run,
-    run_numeric, Engine, ReplayError, Timing,
+    engine, numeric_engine, replay, replay_numeric, replay_probed, replay_probed_from,
+    replay_probed_numeric, replay_streaming, run, run_numeric, Engine, ReplayError, Timing,
 };
 pub use feed::EngineWriter;
 pub use machine::{Machine, MachineError, OpcodeCycles, Timeline};
@@ -66,3 +70,4 @@ pub use output::{Image, ImageLimit, ImageSink, LineOut, LineSink, NullSink};
 pub use probe::{NoProbe, Probe, ProcessorState};
 pub use sample::Sample;
 pub use stats::{LineRecords, LineStats, OpcodeCounts, RunStats, Totals};
+pub use window::{Handover, StepFrom};

@@ -1,5 +1,7 @@
 //! Watching the array cycle by cycle: the cycle-stepped engine reports what happens on
-//! the bus and in chosen processors to a [`Probe`] (`cwisim history`, `cwisim vcd`).
+//! the bus and in chosen processors to a [`Probe`] (`cwisim history`, `cwisim vcd`),
+//! from the start of the trace or from a scanline the fast engine ran up to
+//! ([`Probe::resume`]).
 
 use cwisim_isa::Instruction;
 
@@ -51,6 +53,15 @@ pub trait Probe {
     }
     /// Scanline `line` left the last processor at `cycle`.
     fn line_ready(&mut self, _cycle: u64, _line: u64) {}
+    /// The engine resumes from the fast engine's state between scanlines
+    /// ([`crate::stepped::SteppedEngine::resume`], [`crate::replay_probed_from`]), before
+    /// any other event: from here on, every event of scanline `line` and later is
+    /// reported exactly as a stepped run from the start of the trace reports it, and none
+    /// of an earlier scanline. `cycle` is when the last instruction before `line` entered
+    /// the chain; `watched` holds each watched processor (in order) with the registers
+    /// and flags it has once every earlier token has passed it — what the first token of
+    /// scanline `line` finds there.
+    fn resume(&mut self, _cycle: u64, _line: u64, _watched: &[(usize, ProcessorState)]) {}
 }
 
 /// A probe that watches nothing.

@@ -130,6 +130,15 @@ impl<A: Arith> Processors<A> {
         self.negative_enabled = on;
     }
 
+    /// The arithmetic and the preload registers (`I`, `dI`, `ddI`, each `width ×
+    /// channels`), taken between scanlines: the rest of the state is then every
+    /// scanline's start, but a preload register keeps its value when a `Refresh` clears
+    /// its flag (a probe shows it).
+    pub(crate) fn into_registers(self) -> (A, [Vec<A::Reg>; 3]) {
+        debug_assert!(self.between_scanlines());
+        (self.arith, self.regs)
+    }
+
     /// The instructions since the last `Refresh` and their work, taken (at the end of a
     /// trace: a scanline never refreshed).
     pub(crate) fn take_open_scanline(&mut self) -> (IssueTally, Work) {

@@ -233,6 +233,11 @@ impl Recorder {
         }
     }
 
+    /// Instructions recorded so far (by [`Self::issue`] or [`Self::issued`]).
+    pub(crate) fn instructions(&self) -> u64 {
+        self.folded.instructions + self.open.iter().map(|l| l.instructions).sum::<u64>()
+    }
+
     /// Where every scanline's record goes ([`LineRecords`]). Set before the first event.
     pub(crate) fn line_records(&mut self, to: LineRecords) {
         self.records = to;

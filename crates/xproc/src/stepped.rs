@@ -5,7 +5,8 @@
 //! bookkeeping: processors are plain structs with one flag per condition, and every
 //! token (an instruction with its running forward-differencing state) visits every
 //! processor, one hop at a time. Obviously right, and slow: the property tests hold the
-//! fast engine to it.
+//! fast engine to it. It can also go on from the fast engine's state between scanlines
+//! ([`SteppedEngine::resume`]), to step only the scanlines a study tool shows.
 
 use crate::arith::{vector, Arith, Native};
 use crate::engine::Engine;
@@ -15,6 +16,7 @@ use crate::output::{LineOut, LineSink};
 use crate::probe::{NoProbe, Probe, ProcessorState};
 use crate::sample::Sample;
 use crate::stats::{LineRecords, Recorder, RunStats, Work};
+use crate::window::Handover;
 use cwisim_isa::{Instruction, Opcode, TraceHeader, MAX_CHANNELS};
 
 type Vector<T> = [T; MAX_CHANNELS];
@@ -90,6 +92,10 @@ pub struct SteppedEngine<'p, A: Arith> {
     last_exit: u64,
     /// Instructions issued so far.
     issued: u64,
+    /// The first cycle a token may enter the first processor besides its being free: 0,
+    /// except after a hand-over ([`Self::resume`]), where the last instruction handed
+    /// over holds the first processor for a hop without being in the chain.
+    free_at: u64,
     probe: &'p mut dyn Probe,
 }
 
@@ -146,8 +152,67 @@ impl<'p, A: Arith> SteppedEngine<'p, A> {
             lines_out: 0,
             last_exit: 0,
             issued: 0,
+            free_at: 0,
             probe,
         }
+    }
+
+    /// The engine that goes on from the fast engine's state between scanlines
+    /// ([`crate::fast::FastEngine::handover`]), reporting to `probe` (first
+    /// [`Probe::resume`] with the watched processors' states).
+    ///
+    /// It gives every later event, scanline and statistic exactly as a stepped run from
+    /// the start does. At the hand-over scanline `n`, the tokens of earlier scanlines
+    /// may still be crossing the chain, but tokens never overtake, so each one that
+    /// reaches a processor finds it as they all left it: accumulator zero, preload flags,
+    /// lock and mask clear, the `Acc_mode` flag as the earlier `Acc_mode`s left it, the
+    /// preload registers' values as last written. Nor do they delay anything but one: a
+    /// token enters the chain at least a hop after the one before it and they all move a
+    /// hop at a time, so only the last one handed over, which entered at the hand-over
+    /// cycle, holds the first processor (for a hop). Their work and readiness are already in the
+    /// statistics handed over; the chain starts empty, and the bus idle at the cycle that
+    /// last token entered, where the stepped engine starts the next instruction.
+    ///
+    /// Its cycles are plain arithmetic, as they are stepped: a hand-over at cycle 2⁶³ or
+    /// later (only at the edges of the machine's ranges) is beyond it, and
+    /// [`crate::replay_probed_from`] refuses one.
+    pub fn resume(state: Handover<A>, probe: &'p mut dyn Probe) -> Self {
+        let Handover {
+            header,
+            timeline,
+            arith,
+            regs,
+            negative_enabled,
+            lines,
+            instructions,
+            last_entry,
+            recorder,
+        } = state;
+        let mut eng = SteppedEngine::with_probe_arith(&header, timeline, arith, probe);
+        let c = eng.channels;
+        for (p, pr) in eng.procs.iter_mut().enumerate() {
+            for (slot, reg) in regs.iter().enumerate() {
+                pr.reg[slot][..c].copy_from_slice(&reg[p * c..p * c + c]);
+            }
+            pr.negative_enabled = negative_enabled;
+        }
+        eng.recorder = recorder;
+        eng.refreshes_issued = lines;
+        eng.lines_out = lines;
+        eng.issued = instructions;
+        if let Some(entry) = last_entry {
+            // the entry's cycle is done: tokens moved, and the bus took the entering one
+            eng.t = entry;
+            eng.moved = true;
+            eng.free_at = entry.saturating_add(eng.timeline.hop);
+            eng.last_exit = eng.timeline.exit(entry);
+        }
+        let watched: Vec<(usize, ProcessorState)> = (0..eng.procs.len())
+            .filter(|&p| eng.probe.watches(p))
+            .map(|p| (p, eng.state(p)))
+            .collect();
+        eng.probe.resume(eng.t, lines, &watched);
+        eng
     }
 
     /// Moves tokens whose time in a stage is up, then lets the bus hand its instruction
@@ -173,7 +238,10 @@ impl<'p, A: Arith> SteppedEngine<'p, A> {
                 self.stages[p + 1] = Some(tok);
             }
         }
-        if self.stages[0].is_none() && self.bus.as_ref().is_some_and(|b| b.issued_at <= t) {
+        if self.stages[0].is_none()
+            && t >= self.free_at
+            && self.bus.as_ref().is_some_and(|b| b.issued_at <= t)
+        {
             let bus = self.bus.take().expect("checked");
             self.probe.enter(t, bus.index);
             let cost = bus.issued_at - bus.begin;
@@ -225,9 +293,9 @@ impl<'p, A: Arith> SteppedEngine<'p, A> {
         out
     }
 
-    /// The clock advances one cycle per step, so `t` stays far below 2⁶⁴, and the plain
-    /// additions to it (a cost below 2²⁰, a hop at most 2¹⁶: `crate::machine`) cannot
-    /// overflow.
+    /// The clock advances one cycle per step (from 0, or from a hand-over's cycle, below
+    /// 2⁶³: `crate::window`), so `t` stays far below 2⁶⁴, and the plain additions to it (a cost below 2²⁰, a hop at most 2¹⁶:
+    /// `crate::machine`) cannot overflow.
     fn next_cycle(&mut self) {
         self.t += 1;
         self.moved = false;
