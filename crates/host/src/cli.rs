@@ -469,9 +469,9 @@ fn dispatch(
         Command::Fit(args) => fit::run(args, stdout, progress).map(|()| 0),
         Command::Emit(args) => scene::run_emit(args).map(|()| 0),
         Command::Stats(args) => stats::run(args, stdout, stderr).map(|()| 0),
-        Command::History(args) => history::run(args, stdout).map(|()| 0),
+        Command::History(args) => history::run(args, stdout, progress).map(|()| 0),
         Command::Inspect(args) => inspect::run(args, stdout, progress).map(|()| 0),
-        Command::Vcd(args) => vcd::run(args).map(|()| 0),
+        Command::Vcd(args) => vcd::run(args, progress).map(|()| 0),
         // equal: 0, different: 1, even when the reader of the report went away
         Command::Diff(args) => diff::run(args, &mut ReaderMayLeave::new(stdout)).map(|equal| {
             if equal {
@@ -480,7 +480,7 @@ fn dispatch(
                 crate::error::EXIT_DIFFERENT
             }
         }),
-        Command::Dump(args) => dump::run(args, stdout).map(|()| 0),
+        Command::Dump(args) => dump::run(args, stdout, progress).map(|()| 0),
     }
 }
 

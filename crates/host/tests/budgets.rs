@@ -122,3 +122,31 @@ fn nishita_pieces_past_the_budget_are_refused_band_by_band() {
     assert!(stderr.contains("--subscan 64"), "{stderr}");
     assert!(!dir.join("t.png").exists());
 }
+
+#[test]
+fn a_waveform_past_the_budget_is_refused() {
+    let dir = scratch("budget-vcd");
+    std::fs::write(
+        dir.join("wide.cwt"),
+        "cwisim-trace version=1 width=4096 lines=1 channels=1\nEval2 0 4096 0.25 0.0001\nRefresh\n",
+    )
+    .unwrap();
+    let out = cwisim_env(
+        &dir,
+        &[("CWISIM_MAX_MEMORY", "64K")],
+        &[
+            "vcd", "wide.cwt", "--line", "0", "--x", "0..4096", "-o", "w.vcd",
+        ],
+    );
+    refused(&out, "the waveform of scanline 0 over processors 0..=4095");
+    assert!(!dir.join("w.vcd").exists());
+    // within the default budget it is written
+    let out = cwisim_env(
+        &dir,
+        &[],
+        &[
+            "vcd", "wide.cwt", "--line", "0", "--x", "0..4096", "-o", "w.vcd",
+        ],
+    );
+    assert!(out.status.success(), "{:?}", text(&out));
+}

@@ -74,6 +74,21 @@ pub fn record_scanline_with_progress(
         &mut sink,
         progress,
     )?;
+    if probe.over_budget {
+        let budget = cwisim_scene::budget::Budget::current();
+        return Err(StudyError::Usage(
+            budget
+                .check_memory(
+                    &format!(
+                        "the waveform of scanline {line} over processors {from}..={to} (more than {} value changes; a narrower --x holds fewer)",
+                        probe.max_log
+                    ),
+                    (probe.max_log as u64 + 1) * LOG_ENTRY_BYTES,
+                )
+                .expect_err("past the budget")
+                .to_string(),
+        ));
+    }
     let Some(wave) = probe.finish() else {
         return Ok(Err(stats.totals.lines));
     };
@@ -357,6 +372,9 @@ impl Layout {
 
 /// The probe: follows every signal's value through the replay and, inside the window of
 /// time, logs each change with its cycle.
+/// The memory of one logged value change.
+const LOG_ENTRY_BYTES: u64 = std::mem::size_of::<(u64, usize, Val)>() as u64;
+
 struct Recorder {
     /// The trace's dimensions (for the dump's comment).
     header: TraceHeader,
@@ -374,6 +392,9 @@ struct Recorder {
     end: Option<u64>,
     /// Values at the start (after the start cycle's events up to the first issue).
     initial: Vec<Val>,
+    /// The most changes the log may hold (the memory budget), and whether it ran past.
+    max_log: usize,
+    over_budget: bool,
     /// Changes inside the window: `(cycle, signal, value)`, in the order they happened.
     log: Vec<(u64, usize, Val)>,
     done: Rc<Cell<bool>>,
@@ -414,6 +435,11 @@ impl Recorder {
             end: None,
             initial: Vec::new(),
             log: Vec::new(),
+            max_log: usize::try_from(
+                cwisim_scene::budget::Budget::current().memory_bytes / LOG_ENTRY_BYTES,
+            )
+            .unwrap_or(usize::MAX),
+            over_budget: false,
             done,
             header: *header,
         }
@@ -426,6 +452,12 @@ impl Recorder {
         }
         self.cur[sig] = val;
         if self.start.is_some() {
+            if self.log.len() >= self.max_log {
+                // past the memory budget: stop here, refused when the replay ends
+                self.over_budget = true;
+                self.done.set(true);
+                return;
+            }
             self.log.push((cycle, sig, val));
         }
     }

@@ -133,7 +133,9 @@ fn camera_and_material_limits() {
     // its file, before anything is projected
     let (m, _, _) = fault(r#""fov_y": 40"#, r#""fov_y": 1e-300"#);
     assert!(
-        m.contains("camera.fov_y: expected a field of view from 0.001 to under 180 degrees, found 1e-300"),
+        m.contains(
+            "camera.fov_y: expected a field of view from 0.001 to under 180 degrees, found 1e-300"
+        ),
         "{m}"
     );
     let (m, _, _) = fault(r#""target": [0, 0, 0]"#, r#""target": [0, 0, 5]"#);

@@ -6,13 +6,14 @@
 
 use super::MachineArgs;
 use crate::error::CliError;
+use crate::progress::Progress;
 use crate::range::{parse_range, Range};
 use clap::Args;
 use cwisim_isa::text::format_header;
 use cwisim_isa::Instruction;
 use cwisim_study::inspect::dump_line;
 use cwisim_study::until::UntilLine;
-use cwisim_xproc::{replay_probed, NullSink, Probe};
+use cwisim_xproc::{replay_probed_from, NullSink, Probe, StepFrom};
 use std::collections::VecDeque;
 use std::io::Write;
 use std::path::PathBuf;
@@ -76,10 +77,10 @@ impl Probe for Printer<'_> {
 }
 
 /// Runs `cwisim dump`.
-pub fn run(args: &DumpArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
+pub fn run(args: &DumpArgs, stdout: &mut dyn Write, progress: bool) -> Result<(), CliError> {
     crate::input::drawing_applies(&args.draw, &[Some(&args.trace)])?;
     let machine = args.machine.load()?;
-    let mut file = crate::input::open(&args.trace, &args.draw)?;
+    let (mut file, size) = crate::input::open_sized(&args.trace, &args.draw, false)?;
     let header = *file.header();
     let lines =
         Range::selection(args.lines, args.frames, u64::from(header.lines)).unwrap_or(Range::ALL);
@@ -96,8 +97,19 @@ pub fn run(args: &DumpArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
         current_line: None,
         error: None,
     };
+    // the scanlines before the first asked for run on the fast engine; only those shown
+    // are stepped
     let mut reader = UntilLine::new(&mut *file, lines.last);
-    replay_probed::<f64>(&mut reader, &machine, &mut printer, &mut NullSink)?;
+    let mut bar = Progress::new(size, progress);
+    replay_probed_from::<f64>(
+        &mut reader,
+        &machine,
+        StepFrom::Scanline(lines.first),
+        &mut printer,
+        &mut NullSink,
+        &mut |bytes| bar.update(bytes),
+    )?;
+    drop(bar);
     let output = reader.lines_read();
     if let Some(e) = printer.error {
         return Err(CliError::Stdout(e));

@@ -7,8 +7,9 @@
 
 use super::MachineArgs;
 use crate::error::CliError;
+use crate::progress::Progress;
 use clap::Args;
-use cwisim_study::history::{history_lines, pixel_history};
+use cwisim_study::history::{history_lines, pixel_history_with_progress};
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -37,10 +38,10 @@ pub struct HistoryArgs {
 }
 
 /// Runs `cwisim history`.
-pub fn run(args: &HistoryArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
+pub fn run(args: &HistoryArgs, stdout: &mut dyn Write, progress: bool) -> Result<(), CliError> {
     crate::input::drawing_applies(&args.draw, &[Some(&args.trace)])?;
     let machine = args.machine.load()?;
-    let mut file = crate::input::open(&args.trace, &args.draw)?;
+    let (mut file, size) = crate::input::open_sized(&args.trace, &args.draw, false)?;
     let header = *file.header();
     if args.x >= header.width {
         return Err(CliError::Usage(format!(
@@ -50,7 +51,15 @@ pub fn run(args: &HistoryArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
             header.width - 1
         )));
     }
-    let visits = pixel_history(&mut *file, &machine, args.x as usize, args.y)?;
+    let mut bar = Progress::new(size, progress);
+    let visits = pixel_history_with_progress(
+        &mut *file,
+        &machine,
+        args.x as usize,
+        args.y,
+        &mut |bytes| bar.update(bytes),
+    )?;
+    drop(bar);
     // the rest of the file, checked though not replayed: no success on a damaged trace
     file.check_to_end()?;
     let visits = match visits {

@@ -12,9 +12,10 @@
 use super::MachineArgs;
 use crate::error::CliError;
 use crate::files::{same_file, write_atomic};
+use crate::progress::Progress;
 use crate::range::{parse_range, Range};
 use clap::Args;
-use cwisim_study::vcd::{record_scanline, write_vcd};
+use cwisim_study::vcd::{record_scanline_with_progress, write_vcd};
 use std::path::PathBuf;
 
 /// The widest array dumped whole when neither `--from` nor `--to` is given.
@@ -62,7 +63,7 @@ pub struct VcdArgs {
 }
 
 /// Runs `cwisim vcd`.
-pub fn run(args: &VcdArgs) -> Result<(), CliError> {
+pub fn run(args: &VcdArgs, progress: bool) -> Result<(), CliError> {
     crate::input::drawing_applies(&args.draw, &[Some(&args.trace)])?;
     if same_file(&args.output, &args.trace) {
         return Err(CliError::Usage(format!(
@@ -71,10 +72,19 @@ pub fn run(args: &VcdArgs) -> Result<(), CliError> {
         )));
     }
     let machine = args.machine.load()?;
-    let mut file = crate::input::open(&args.trace, &args.draw)?;
+    let (mut file, size) = crate::input::open_sized(&args.trace, &args.draw, false)?;
     let header = *file.header();
     let (from, to) = window(args, header.width)?;
-    let recorded = record_scanline(&mut *file, &machine, args.line, from as usize, to as usize)?;
+    let mut bar = Progress::new(size, progress);
+    let recorded = record_scanline_with_progress(
+        &mut *file,
+        &machine,
+        args.line,
+        from as usize,
+        to as usize,
+        &mut |bytes| bar.update(bytes),
+    )?;
+    drop(bar);
     // the rest of the file, checked though not replayed: no success on a damaged trace
     file.check_to_end()?;
     let wave = match recorded {
