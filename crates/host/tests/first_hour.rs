@@ -91,3 +91,66 @@ fn a_hopeless_line_period_is_explained() {
     assert!(late.contains("2048 cycles to cross the array"), "{late}");
     assert!(late.contains("line period of 796 cycles"), "{late}");
 }
+
+#[test]
+fn the_study_tools_study_the_numeric_formats() {
+    let dir = scratch("first-hour-numeric");
+    let trace = repo().join("traces/gouraud.cwt");
+    let t = trace.to_str().unwrap();
+    let coarse = "fixed:I=2.3,dI=2.3,ddI=2.3";
+    let ok = |args: &[&str]| {
+        let out = cwisim(&dir, args);
+        let (stdout, stderr) = text(&out);
+        assert!(out.status.success(), "{args:?}: {stderr}");
+        stdout
+    };
+    // a pixel's history shows the registers' own (quantized) values
+    let exact = ok(&["history", t, "--x", "5", "--line", "2"]);
+    let narrow = ok(&["history", t, "--x", "5", "--line", "2", "--numeric", coarse]);
+    assert_ne!(exact, narrow);
+    // so does the waveform
+    ok(&["vcd", t, "--line", "2", "-o", "f64.vcd"]);
+    ok(&[
+        "vcd",
+        t,
+        "--line",
+        "2",
+        "-o",
+        "fixed.vcd",
+        "--numeric",
+        coarse,
+    ]);
+    assert_ne!(
+        std::fs::read(dir.join("f64.vcd")).unwrap(),
+        std::fs::read(dir.join("fixed.vcd")).unwrap()
+    );
+    // stats says what the registers overflowed, or that they held
+    let held = ok(&["stats", t, "--numeric", "fixed:I=4.20,dI=4.20,ddI=4.20"]);
+    assert!(held.contains("overflows: none in fixed:I=4.20"), "{held}");
+    std::fs::write(
+        dir.join("bright.cwt"),
+        "cwisim-trace version=1 width=8 lines=1 channels=1\nEval1 0 8 3.0\nRefresh\n",
+    )
+    .unwrap();
+    let tiny = ok(&[
+        "stats",
+        "bright.cwt",
+        "--numeric",
+        "fixed:I=2.4,dI=2.4,ddI=2.4",
+    ]);
+    assert!(
+        tiny.contains("overflows: ") && tiny.contains("overflow event(s)"),
+        "{tiny}"
+    );
+    // outputs compared in a format: the trace against itself is equal in any format
+    let out = cwisim(&dir, &["diff", t, t, "--outputs", "--numeric", coarse]);
+    assert_eq!(out.status.code(), Some(0), "{:?}", text(&out));
+    // the streams do not depend on the registers: refused there
+    let out = cwisim(&dir, &["diff", t, t, "--numeric", coarse]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out).1.contains("--numeric sets the registers"));
+    // the inspect page names its registers
+    ok(&["inspect", t, "-o", "p.html", "--numeric", coarse]);
+    let page = std::fs::read_to_string(dir.join("p.html")).unwrap();
+    assert!(page.contains("fixed:I=2.3"), "the page names the format");
+}

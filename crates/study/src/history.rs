@@ -2,13 +2,15 @@
 //! with the registers before and after it acted (`cwisim history`), computed by the
 //! cycle-stepped engine through a [`Probe`]. Only scanline `y` is stepped: the fast
 //! engine runs the scanlines before it and hands its state over
-//! ([`cwisim_xproc::replay_probed_from`]).
+//! ([`cwisim_xproc::replay_probed_numeric`]).
 
 use crate::error::StudyError;
 use crate::until::UntilLine;
 use cwisim_isa::text::format_value;
 use cwisim_isa::{Instruction, Opcode, TraceRead};
-use cwisim_xproc::{replay_probed_from, Machine, NullSink, Probe, ProcessorState, StepFrom};
+use cwisim_xproc::{
+    replay_probed_numeric, Machine, NullSink, Numeric, Probe, ProcessorState, StepFrom,
+};
 
 /// Replays `trace` up to scanline `y` and returns every visit of a token to processor
 /// `x` on it. `Ok(Err(n))`: the trace outputs only `n` scanlines.
@@ -18,14 +20,16 @@ pub fn pixel_history(
     x: usize,
     y: u64,
 ) -> Result<Result<Vec<Visit>, u64>, StudyError> {
-    pixel_history_with_progress(trace, machine, x, y, &mut |_| {})
+    pixel_history_with_progress(trace, machine, &Numeric::F64, x, y, &mut |_| {})
 }
 
-/// [`pixel_history`], calling `progress` with the bytes of `trace` read so far every few
-/// thousand instructions (and at the end): for a progress bar.
+/// [`pixel_history`] with registers of the format `numeric` (the values the history shows
+/// are the registers' own, as `f64`), calling `progress` with the bytes of `trace` read so
+/// far every few thousand instructions (and at the end): for a progress bar.
 pub fn pixel_history_with_progress(
     trace: &mut dyn TraceRead,
     machine: &Machine,
+    numeric: &Numeric,
     x: usize,
     y: u64,
     progress: &mut dyn FnMut(u64),
@@ -36,9 +40,10 @@ pub fn pixel_history_with_progress(
         visits: Vec::new(),
     };
     let mut reader = UntilLine::new(trace, Some(y));
-    replay_probed_from::<f64>(
+    replay_probed_numeric(
         &mut reader,
         machine,
+        numeric,
         StepFrom::Scanline(y),
         &mut watch,
         &mut NullSink,

@@ -22,7 +22,7 @@ use crate::until::UntilLine;
 use cwisim_isa::text::format_instruction;
 use cwisim_isa::{Instruction, Opcode, TraceRead};
 use cwisim_xproc::{
-    replay_probed_from, LineOut, LineSink, Machine, Probe, ProcessorState, StepFrom,
+    replay_probed_numeric, LineOut, LineSink, Machine, Numeric, Probe, ProcessorState, StepFrom,
 };
 use std::collections::{HashMap, VecDeque};
 use std::io::Write;
@@ -83,6 +83,8 @@ pub struct Options<'a> {
     /// The reference image of the frame (`lines × width × channels`) with what it is,
     /// for the error overlay.
     pub reference: Option<(&'a [f64], &'a str)>,
+    /// The array's registers (the histories show their values).
+    pub numeric: Numeric,
 }
 
 /// A written page and what it holds.
@@ -483,9 +485,10 @@ choose a smaller one with --x and --lines",
         let mut until = UntilLine::new(trace, Some(frame.1 - 1));
         let stats = {
             let mut reader = CostReader::new(&mut until, &mut cost);
-            replay_probed_from::<f64>(
+            replay_probed_numeric(
                 &mut reader,
                 machine,
+                &opts.numeric,
                 StepFrom::Scanline(first),
                 &mut collector,
                 &mut image,
@@ -560,6 +563,7 @@ choose a smaller one with --x and --lines",
     let data = serde_json::json!({
         "name": opts.name,
         "kind": opts.kind,
+        "numeric": opts.numeric.to_string(),
         "width": width,
         "lines": lines,
         "channels": channels,

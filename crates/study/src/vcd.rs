@@ -22,7 +22,7 @@
 use crate::error::StudyError;
 use cwisim_isa::{Instruction, Location, Opcode, OperandKind, TraceError, TraceHeader, TraceRead};
 use cwisim_xproc::{
-    replay_probed_from, LineOut, LineSink, Machine, Probe, ProcessorState, StepFrom,
+    replay_probed_numeric, LineOut, LineSink, Machine, Numeric, Probe, ProcessorState, StepFrom,
 };
 use std::cell::Cell;
 use std::collections::BTreeSet;
@@ -41,14 +41,16 @@ pub fn record_scanline(
     from: usize,
     to: usize,
 ) -> Result<Result<Wave, u64>, StudyError> {
-    record_scanline_with_progress(trace, machine, line, from, to, &mut |_| {})
+    record_scanline_with_progress(trace, machine, &Numeric::F64, line, from, to, &mut |_| {})
 }
 
-/// [`record_scanline`], calling `progress` with the bytes of `trace` read so far every
-/// few thousand instructions (and at the end): for a progress bar.
+/// [`record_scanline`] with registers of the format `numeric` (the waveform shows the
+/// registers' own values, as reals), calling `progress` with the bytes of `trace` read so
+/// far every few thousand instructions (and at the end): for a progress bar.
 pub fn record_scanline_with_progress(
     trace: &mut dyn TraceRead,
     machine: &Machine,
+    numeric: &Numeric,
     line: u64,
     from: usize,
     to: usize,
@@ -66,9 +68,10 @@ pub fn record_scanline_with_progress(
         values: None,
     };
     let mut reader = UntilReady { inner: trace, done };
-    let stats = replay_probed_from::<f64>(
+    let stats = replay_probed_numeric(
         &mut reader,
         machine,
+        numeric,
         StepFrom::Issue(line),
         &mut probe,
         &mut sink,

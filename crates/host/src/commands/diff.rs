@@ -12,7 +12,7 @@ use super::MachineArgs;
 use crate::error::CliError;
 use clap::Args;
 use cwisim_isa::Opcode;
-use cwisim_xproc::{replay, Image, ImageSink, OpcodeCounts, Timing};
+use cwisim_xproc::{Image, ImageSink, OpcodeCounts, Timing};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -40,6 +40,12 @@ pub struct DiffArgs {
     /// The machine model (for replaying traces).
     #[command(flatten)]
     pub machine: MachineArgs,
+
+    /// The array's registers: f64 (the reference), f32, or fixed point
+    /// fixed:I=M.N,dI=M.N,ddI=M.N[,acc=M.N][,overflow=wrap|saturate] (M integer bits with
+    /// the sign, N fraction bits; docs/ACCURACY.md).
+    #[arg(long, value_name = "FORMAT", default_value = "f64")]
+    pub numeric: cwisim_xproc::Numeric,
     /// How to draw a scene (refused when neither input is one).
     #[command(flatten, next_help_heading = crate::draw::SCENE_ONLY)]
     pub draw: crate::draw::DrawArgs,
@@ -59,6 +65,12 @@ pub fn run(args: &DiffArgs, stdout: &mut dyn Write) -> Result<bool, CliError> {
         )));
     }
     let outputs = args.output || is_npy(&args.a) || is_npy(&args.b);
+    let replays = outputs && !(is_npy(&args.a) && is_npy(&args.b));
+    if !replays && args.numeric != cwisim_xproc::Numeric::F64 {
+        return Err(CliError::Usage(
+            "--numeric sets the registers a trace is replayed on: it applies with --outputs, to a side that is a trace or a scene".into(),
+        ));
+    }
     if !outputs && args.image.is_some() {
         return Err(CliError::Usage(
             "--image compares outputs: add --outputs, or give .npy files".into(),
@@ -172,7 +184,14 @@ fn load_output(path: &Path, args: &DiffArgs) -> Result<Image, CliError> {
         h.channel_count(),
         cwisim_scene::budget::Budget::current().memory_bytes / 2,
     );
-    replay::<f64>(&mut *reader, &machine, Timing::Fast, &mut sink, &mut |_| {})?;
+    cwisim_xproc::replay_numeric(
+        &mut *reader,
+        &machine,
+        Timing::Fast,
+        &args.numeric,
+        &mut sink,
+        &mut |_| {},
+    )?;
     Ok(sink.finish()?)
 }
 

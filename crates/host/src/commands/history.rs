@@ -32,6 +32,12 @@ pub struct HistoryArgs {
     /// The machine model (for the cycles).
     #[command(flatten)]
     pub machine: MachineArgs,
+
+    /// The array's registers: f64 (the reference), f32, or fixed point
+    /// fixed:I=M.N,dI=M.N,ddI=M.N[,acc=M.N][,overflow=wrap|saturate] (M integer bits with
+    /// the sign, N fraction bits; docs/ACCURACY.md).
+    #[arg(long, value_name = "FORMAT", default_value = "f64")]
+    pub numeric: cwisim_xproc::Numeric,
     /// How to draw a scene (refused with a trace).
     #[command(flatten, next_help_heading = crate::draw::SCENE_ONLY)]
     pub draw: crate::draw::DrawArgs,
@@ -55,6 +61,7 @@ pub fn run(args: &HistoryArgs, stdout: &mut dyn Write, progress: bool) -> Result
     let visits = pixel_history_with_progress(
         &mut *file,
         &machine,
+        &args.numeric,
         args.x as usize,
         args.y,
         &mut |bytes| bar.update(bytes),

@@ -17,7 +17,7 @@ use cwisim_isa::{Encoding, TraceRead};
 use cwisim_render::{render, ArrayConfig, Taps};
 use cwisim_scene::Shading;
 use cwisim_study::inspect::{check_frame, inspect, Options, Window, MAX_HISTORY_PIXELS};
-use cwisim_xproc::{NullSink, Numeric, Timing};
+use cwisim_xproc::{NullSink, Timing};
 use std::io::{Cursor, Write};
 use std::path::PathBuf;
 
@@ -46,6 +46,12 @@ pub struct InspectArgs {
     /// The machine model (for the cycles).
     #[command(flatten)]
     pub machine: MachineArgs,
+
+    /// The array's registers: f64 (the reference), f32, or fixed point
+    /// fixed:I=M.N,dI=M.N,ddI=M.N[,acc=M.N][,overflow=wrap|saturate] (M integer bits with
+    /// the sign, N fraction bits; docs/ACCURACY.md).
+    #[arg(long, value_name = "FORMAT", default_value = "f64")]
+    pub numeric: cwisim_xproc::Numeric,
     /// How to draw a scene (refused with a trace).
     #[command(flatten, next_help_heading = crate::draw::SCENE_ONLY)]
     pub draw: DrawArgs,
@@ -144,7 +150,7 @@ pub fn run(args: &InspectArgs, stdout: &mut dyn Write, progress: bool) -> Result
             let renderer = &*drawn.renderer;
             let array = ArrayConfig {
                 machine: machine.clone(),
-                numeric: Numeric::F64,
+                numeric: args.numeric,
                 timing: Timing::Fast,
             };
             stage.message("inspect: rendering the scene for its summary");
@@ -154,7 +160,7 @@ pub fn run(args: &InspectArgs, stdout: &mut dyn Write, progress: bool) -> Result
                 &mut text,
                 &drawn,
                 &rendered,
-                &Numeric::F64,
+                &args.numeric,
                 &StageTimes::default(),
                 &[],
             )
@@ -197,6 +203,7 @@ pub fn run(args: &InspectArgs, stdout: &mut dyn Write, progress: bool) -> Result
             window,
             summary: summary.as_deref(),
             reference: reference.as_ref().map(|(r, n)| (r.as_slice(), *n)),
+            numeric: args.numeric,
         },
     )?;
     drop(stage);

@@ -58,6 +58,12 @@ pub struct StatsArgs {
     #[command(flatten)]
     pub machine: MachineArgs,
 
+    /// The array's registers: f64 (the reference), f32, or fixed point
+    /// fixed:I=M.N,dI=M.N,ddI=M.N[,acc=M.N][,overflow=wrap|saturate] (M integer bits with
+    /// the sign, N fraction bits; docs/ACCURACY.md).
+    #[arg(long, value_name = "FORMAT", default_value = "f64")]
+    pub numeric: cwisim_xproc::Numeric,
+
     /// Timing model. Both give identical cycle counts.
     #[arg(long, value_enum, default_value_t = TimingArg::Fast)]
     pub timing: TimingArg,
@@ -170,7 +176,7 @@ pub fn run(
                 &mut *reader,
                 &machine,
                 timing,
-                &cwisim_xproc::Numeric::F64,
+                &args.numeric,
                 keep,
                 &mut |_| {},
             )?;
@@ -180,7 +186,7 @@ pub fn run(
             let drawn = args.draw.draw(Some(&args.input))?;
             let array = cwisim_render::ArrayConfig {
                 machine: machine.clone(),
-                numeric: cwisim_xproc::Numeric::F64,
+                numeric: args.numeric,
                 timing,
             };
             let rendered = cwisim_render::render(
@@ -267,6 +273,12 @@ pub fn run(
     stdout
         .write_all(text.as_bytes())
         .map_err(CliError::Stdout)?;
+    // the registers the user is sizing: what they overflowed, or that they held
+    if args.numeric != cwisim_xproc::Numeric::F64 {
+        let note = crate::report::overflow_note(&stats)
+            .unwrap_or_else(|| format!("none in {}", args.numeric));
+        writeln!(stdout, "overflows: {note}").map_err(CliError::Stdout)?;
+    }
     stdout.flush().map_err(CliError::Stdout)
 }
 

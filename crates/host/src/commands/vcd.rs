@@ -57,6 +57,12 @@ pub struct VcdArgs {
     /// The machine model (for the cycles).
     #[command(flatten)]
     pub machine: MachineArgs,
+
+    /// The array's registers: f64 (the reference), f32, or fixed point
+    /// fixed:I=M.N,dI=M.N,ddI=M.N[,acc=M.N][,overflow=wrap|saturate] (M integer bits with
+    /// the sign, N fraction bits; docs/ACCURACY.md).
+    #[arg(long, value_name = "FORMAT", default_value = "f64")]
+    pub numeric: cwisim_xproc::Numeric,
     /// How to draw a scene (refused with a trace).
     #[command(flatten, next_help_heading = crate::draw::SCENE_ONLY)]
     pub draw: crate::draw::DrawArgs,
@@ -79,6 +85,7 @@ pub fn run(args: &VcdArgs, progress: bool) -> Result<(), CliError> {
     let recorded = record_scanline_with_progress(
         &mut *file,
         &machine,
+        &args.numeric,
         args.line,
         from as usize,
         to as usize,
