@@ -80,7 +80,7 @@ pub fn check_intensities(s: &ScreenScene, source: &Source) -> Result<(), RenderE
             if let Some(bad) = i.iter().find(|c| **c < 0.0) {
                 let at = file.map_or_else(String::new, |f| format!("{}: ", f.display()));
                 return Err(RenderError::Usage(format!(
-                    "{at}polygons[{k}].intensity[{v}]: intensity {bad} is negative; renderers draw light, intensities ≥ 0 (the array drops negative contributions)"
+                    "{at}polygons[{k}].intensity[{v}]: intensity {bad:?} is negative; renderers draw light, intensities ≥ 0 (the array drops negative contributions)"
                 )));
             }
         }

@@ -543,7 +543,7 @@ impl WorldSpec {
                 K::Limit,
                 "camera.fov_y",
                 format!(
-                    "expected a field of view from {MIN_FOV_Y} to under 180 degrees, found {}",
+                    "expected a field of view from {MIN_FOV_Y} to under 180 degrees, found {:?}",
                     c.fov_y
                 ),
             ));
