@@ -182,11 +182,16 @@ pub fn render_tradeoff_plot(rows: &[Row], name: &str) -> Result<Rgb, String> {
                 .align(Align::Start, Align::Center),
         );
         ly += 22;
-        for r in &front {
+        // as many as fit above the bottom edge; the rest said in one line
+        const ROW: i32 = 17;
+        let room = ((h as i32 - 20 - ly) / ROW).max(1) as usize;
+        let shown = if front.len() > room { room - 1 } else { front.len() };
+        for r in &front[..shown] {
             labels.push(
                 Label::new(
                     format!(
-                        "{}{} {} {} {}",
+                        "{} {}{} {} {} {}",
+                        r.renderer,
                         r.tessellate
                             .map_or_else(String::new, |n| format!("tessellated {n}, ")),
                         r.shading,
@@ -199,7 +204,20 @@ pub fn render_tradeoff_plot(rows: &[Row], name: &str) -> Result<Rgb, String> {
                 )
                 .align(Align::Start, Align::Center),
             );
-            ly += 17;
+            ly += ROW;
+        }
+        if shown < front.len() {
+            labels.push(
+                Label::new(
+                    format!(
+                        "… and {} more (the table's Pareto front, the CSV's pareto column)",
+                        front.len() - shown
+                    ),
+                    (lx, ly),
+                    11.0,
+                )
+                .align(Align::Start, Align::Center),
+            );
         }
         Ok(())
     })?;
