@@ -185,20 +185,33 @@ pub fn render_tradeoff_plot(rows: &[Row], name: &str) -> Result<Rgb, String> {
         // as many as fit above the bottom edge; the rest said in one line
         const ROW: i32 = 17;
         let room = ((h as i32 - 20 - ly) / ROW).max(1) as usize;
-        let shown = if front.len() > room { room - 1 } else { front.len() };
+        let shown = if front.len() > room {
+            room - 1
+        } else {
+            front.len()
+        };
         for r in &front[..shown] {
             labels.push(
                 Label::new(
-                    format!(
-                        "{} {}{} {} {} {}",
-                        r.renderer,
-                        r.tessellate
-                            .map_or_else(String::new, |n| format!("tessellated {n}, ")),
-                        r.shading,
-                        r.aa,
-                        r.visibility,
-                        short(&r.numeric)
-                    ),
+                    {
+                        // the row's own settings, what does not apply ("-") left out
+                        let mut words = vec![r.renderer.to_string()];
+                        if let Some(n) = r.tessellate {
+                            words.push(format!("tessellated {n},"));
+                        }
+                        words.push(r.shading.to_string());
+                        words.extend(
+                            [r.aa, r.visibility]
+                                .into_iter()
+                                .filter(|w| *w != "-")
+                                .map(str::to_string),
+                        );
+                        if let Some(l) = r.samples {
+                            words.push(format!("{l}×{l} samples"));
+                        }
+                        words.push(short(&r.numeric));
+                        words.join(" ")
+                    },
                     (lx, ly),
                     11.0,
                 )

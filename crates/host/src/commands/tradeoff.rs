@@ -36,8 +36,9 @@ pub struct TradeoffArgs {
     /// `cwisim renderers` lists them).
     #[arg(long, value_name = "LIST", value_delimiter = ',')]
     pub renderers: Vec<String>,
-    /// The numeric formats of the array to try, comma-separated or repeated (f64, f32,
-    /// fixed:I=M.N,dI=M.N,ddI=M.N[,acc=M.N][,overflow=wrap|saturate]).
+    /// The numeric formats of the array to try: repeat the flag, or separate them with
+    /// `;` (a fixed format has commas of its own): f64, f32,
+    /// fixed:I=M.N,dI=M.N,ddI=M.N[,acc=M.N][,overflow=wrap|saturate].
     #[arg(long = "numeric", value_name = "FORMAT", value_delimiter = ';')]
     pub numeric: Vec<Numeric>,
     /// Write the table as CSV.
