@@ -22,7 +22,8 @@ Exit status: 0 on success; 1 only from `diff`, when the two sides differ; 2 for 
 (a malformed trace, scene or machine file, bad arguments, a size over a budget); 3 when an \
 output could not be written; 4 for an internal error (a bug in cwisim); 130 when \
 interrupted (partial outputs removed). Errors are one line on standard error: \
-`error: FILE:LINE:COL: …` (text, JSON Lines) or `error: FILE: byte N: …` (binary).";
+`error: FILE:LINE:COL: …` (text, JSON Lines) or `error: FILE: byte N: …` (binary); a usage \
+error (an unknown option, a missing argument) is clap's message and the usage, several lines.";
 
 /// The `cwisim` command line.
 #[derive(Parser, Debug)]
@@ -121,7 +122,7 @@ scene's JSON file, to copy and edit.\n\n\
 `cwisim scenes generate cp-bench` generates Barkan & Gordon's benchmark (docs/REPRODUCTION.md): \
 --family convex|few|many, --polygons N, --vertices A..B, --seed S, --size WxH; what DETCR \
 counts goes to stderr.\n\n\
-Example:\n  cwisim scenes\n  cwisim scenes pot > my-pot.json\n  \
+Examples:\n  cwisim scenes\n  cwisim scenes pot > my-pot.json\n  \
 cwisim scenes generate cp-bench --family few --polygons 1000 --vertices 100..=1000 --seed 1 -o few.json",
         after_help = AFTER_HELP
     )]
@@ -133,7 +134,7 @@ cwisim scenes generate cp-bench --family few --polygons 1000 --vertices 100..=10
 scanline instructions for the X-processor array. Every command that draws a scene (render, \
 emit, stats, tradeoff, fit) takes one with --renderer NAME; each gets threads, traces, \
 statistics, cost images, tradeoff and fit through the same interface (docs/ARCHITECTURE.md).\n\n\
-Example:\n  cwisim renderers\n  cwisim render pot --renderer vanrij",
+Examples:\n  cwisim renderers\n  cwisim render pot --renderer vanrij",
         after_help = AFTER_HELP
     )]
     Renderers(renderers::RenderersArgs),
@@ -214,7 +215,7 @@ Example:\n  cwisim stats traces/overrun.cwt --machine traces/overrun.machine.jso
         long_about = "Pixel history: every instruction whose token reached processor X on scanline Y, \
 in order, with the cycle it arrived and the processor's registers and flags just before and \
 just after it acted (values as at that moment, from the cycle-stepped model).\n\n\
-Example:\n  cwisim history traces/visibility.cwt --x 9 --y 0",
+Example:\n  cwisim history traces/visibility.cwt --x 9 --line 0",
         after_help = AFTER_HELP
     )]
     History(history::HistoryArgs),
@@ -265,8 +266,9 @@ cwisim vcd pot --line 200 -o l.vcd",
         long_about = "Compare two traces (the first differing scanline and instruction, and the count \
 of each opcode on each side) or two outputs (.npy files, or traces replayed: per-scanline \
 max and RMS difference, and --image for an error image). Exit status 0 when equal, 1 when \
-different, 2 on bad input, so it serves in scripts.\n\n\
-Example:\n  cwisim diff a.cwt b.cwb --output\n  cwisim diff a.npy b.npy --image diff.png",
+different, 2 on bad input, 3 when the report or --image could not be written, so it serves in \
+scripts.\n\n\
+Examples:\n  cwisim diff a.cwt b.cwb --outputs\n  cwisim diff a.npy b.npy --image diff.png",
         after_help = AFTER_HELP
     )]
     Diff(diff::DiffArgs),
@@ -298,8 +300,8 @@ Examples:\n  cwisim convert scene.cwt -o scene.cwb\n  cwisim convert scene.cwt s
         long_about = "Print the effective machine model — the defaults, or --machine, then each --set — \
 as pretty JSON on standard output, ready to be saved and edited as a --machine file. One line \
 on standard error gives the line period and the traversal time it implies for a trace of \
-the given dimensions (--width, --lines, --channels).\n\n\
-Example:\n  cwisim machine --set clock_hz=2e8 --lines 768 > fast.json",
+the given dimensions (--width, --height, --channels).\n\n\
+Example:\n  cwisim machine --set clock_hz=2e8 --height 768 > fast.json",
         after_help = AFTER_HELP
     )]
     Machine(MachineCmdArgs),
