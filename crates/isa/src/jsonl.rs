@@ -69,8 +69,10 @@ struct HeaderRecord {
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
-struct Record {
-    op: String,
+struct Record<'a> {
+    /// Borrowed from the line unless it holds escapes: no allocation per record.
+    #[serde(borrow)]
+    op: std::borrow::Cow<'a, str>,
     x: Option<u64>,
     dx: Option<u64>,
     #[serde(rename = "I")]
@@ -203,12 +205,13 @@ impl<R: BufRead> JsonlReader<R> {
     }
 }
 
-/// One record: its instruction, and its note if it has one.
+/// One record's instruction; its note, if it has one, into `note`.
 fn parse_record(
     line: &str,
     line_no: u64,
     header: &TraceHeader,
-) -> Result<(Instruction, Option<String>), TraceError> {
+    note: &mut String,
+) -> Result<(Instruction, bool), TraceError> {
     let at = Location::Line {
         line: line_no,
         column: 1,
@@ -285,7 +288,11 @@ fn parse_record(
         ],
     );
     instr.check(header).map_err(|e| operand_error(e, at, op))?;
-    Ok((instr, rec.note))
+    let attached = rec.note.is_some();
+    if let Some(text) = rec.note {
+        *note = text;
+    }
+    Ok((instr, attached))
 }
 
 impl<R: BufRead> TraceRead for JsonlReader<R> {
@@ -307,15 +314,11 @@ impl<R: BufRead> TraceRead for JsonlReader<R> {
                 "empty line; JSON Lines holds one JSON object on every line",
             ));
         }
-        let (instr, note) = parse_record(line, line_no, &self.header)?;
+        let (instr, attached) = parse_record(line, line_no, &self.header, &mut self.note)?;
         self.location = Location::Line {
             line: line_no,
             column: 1,
         };
-        let attached = note.is_some();
-        if let Some(note) = note {
-            self.note = note;
-        }
         self.scope.step(instr.op, attached);
         Ok(Some(instr))
     }

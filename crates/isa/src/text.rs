@@ -160,20 +160,28 @@ fn tokens(content: &str) -> Vec<Token<'_>> {
     out
 }
 
-/// The text of a comment line (one whose first non-blank character is `#`): what follows
-/// the `#` and the one space after it; `None` for any other line.
-#[inline]
-fn comment_line(line: &str) -> Option<&str> {
-    let text = match line.as_bytes().first()? {
-        b'#' => &line[1..],
-        b if b.is_ascii_whitespace() => line
-            .trim_start_matches(|c: char| c.is_ascii_whitespace())
-            .strip_prefix('#')?,
-        _ => return None,
-    };
-    Some(text.strip_prefix(' ').unwrap_or(text))
+/// A line without an instruction, out of the reader's loop (which stays small enough to
+/// be inlined into the batch read): a comment line's text (`comment`, after the `#`) is a
+/// line of the note of the instruction directly below, if one is; a blank line (`None`)
+/// makes the comments above it a remark.
+#[inline(never)]
+fn take_remark(pending: &mut String, has_pending: &mut bool, comment: Option<&str>) {
+    match comment {
+        Some(text) => {
+            if *has_pending {
+                pending.push('\n');
+            }
+            pending.push_str(text.strip_prefix(' ').unwrap_or(text));
+            *has_pending = true;
+        }
+        None => {
+            pending.clear();
+            *has_pending = false;
+        }
+    }
 }
 
+#[inline]
 fn strip_comment(line: &str) -> &str {
     match line.find('#') {
         Some(i) => &line[..i],
@@ -182,6 +190,37 @@ fn strip_comment(line: &str) -> &str {
 }
 
 impl<R: BufRead> TextReader<R> {
+    /// The next instruction, with the comment lines directly above it as its note. Always
+    /// inlined: into the batch read, the instruction is built in place rather than
+    /// returned through memory.
+    #[inline(always)]
+    fn read_one(&mut self) -> Result<Option<Instruction>, TraceError> {
+        loop {
+            let Some((line_no, line)) = self.lines.next_line()? else {
+                return Ok(None);
+            };
+            let content = strip_comment(line);
+            let Some(instr) = parse_instruction(content, line_no, &self.header)? else {
+                // a comment line (`#` after blanks only), or a blank one
+                let comment = (content.len() < line.len()).then(|| &line[content.len() + 1..]);
+                take_remark(&mut self.pending, &mut self.has_pending, comment);
+                continue;
+            };
+            self.location = Location::Line {
+                line: line_no,
+                column: 1,
+            };
+            let attached = self.has_pending;
+            if attached {
+                std::mem::swap(&mut self.note, &mut self.pending);
+                self.pending.clear();
+                self.has_pending = false;
+            }
+            self.scope.step(instr.op, attached);
+            return Ok(Some(instr));
+        }
+    }
+
     /// Opens a trace: reads up to and including the header line.
     pub fn new(input: R) -> Result<Self, TraceError> {
         let mut lines = LineReader::new(input);
@@ -501,37 +540,20 @@ impl<R: BufRead> TraceRead for TextReader<R> {
     }
 
     fn next_instruction(&mut self) -> Result<Option<Instruction>, TraceError> {
-        loop {
-            let Some((line_no, line)) = self.lines.next_line()? else {
-                return Ok(None);
-            };
-            if let Some(text) = comment_line(line) {
-                if self.has_pending {
-                    self.pending.push('\n');
-                }
-                self.pending.push_str(text);
-                self.has_pending = true;
-                continue;
+        self.read_one()
+    }
+
+    /// The default's loop, over [`Self::read_one`] inlined.
+    fn read_batch(&mut self, out: &mut Vec<Instruction>, max: usize) -> Result<usize, TraceError> {
+        let mut n = 0;
+        while n < max.max(1) {
+            match self.read_one()? {
+                Some(i) => out.push(i),
+                None => break,
             }
-            let Some(instr) = parse_instruction(strip_comment(line), line_no, &self.header)? else {
-                // a blank line: the comments above it are a remark, not a note
-                self.pending.clear();
-                self.has_pending = false;
-                continue;
-            };
-            self.location = Location::Line {
-                line: line_no,
-                column: 1,
-            };
-            let attached = self.has_pending;
-            if attached {
-                std::mem::swap(&mut self.note, &mut self.pending);
-                self.pending.clear();
-                self.has_pending = false;
-            }
-            self.scope.step(instr.op, attached);
-            return Ok(Some(instr));
+            n += 1;
         }
+        Ok(n)
     }
 
     fn note(&self) -> Option<Note<'_>> {
