@@ -543,7 +543,7 @@ impl<R: BufRead> TraceRead for TextReader<R> {
         self.read_one()
     }
 
-    /// The default's loop, over [`Self::read_one`] inlined.
+    /// The default's loop, over `read_one` inlined.
     fn read_batch(&mut self, out: &mut Vec<Instruction>, max: usize) -> Result<usize, TraceError> {
         let mut n = 0;
         while n < max.max(1) {
