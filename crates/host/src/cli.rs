@@ -288,7 +288,9 @@ Example:\n  cwisim dump trace.cwb --lines 10..13",
         long_about = "Convert a trace between encodings, chosen by each file's extension: .cwt (text), \
 .jsonl (JSON Lines), .cwb (binary). Instructions are streamed one at a time and checked on the way; \
 values are copied bit-exactly, so any chain of conversions gives back the same trace. \
-Comments of a .cwt input are not kept (the output is the canonical form). IN and OUT must \
+The notes of the instructions (where each came from: the comment lines directly above an \
+instruction of a .cwt, \"note\" in a .jsonl) are kept when OUT is .cwt or .jsonl (.cwb has no place \
+for them); other comments are not (the output is the canonical form). IN and OUT must \
 be different files; OUT is replaced only once the whole input converted without error.\n\n\
 Examples:\n  cwisim convert scene.cwt -o scene.cwb\n  cwisim convert scene.cwt scene.cwb",
         after_help = AFTER_HELP
@@ -548,7 +550,8 @@ mod tests {
         assert!(out.contains("shape (scanlines, width, channels)"), "{out}");
         let out = flat(cli(&["convert", "--help"]).1);
         assert!(
-            out.contains("Comments of a .cwt input are not kept"),
+            out.contains("are kept when OUT is .cwt or .jsonl")
+                && out.contains("other comments are not"),
             "{out}"
         );
     }

@@ -1,12 +1,16 @@
 //! What the study commands read: a trace file, or a scene drawn through a renderer with
 //! the drawing options of the command line (`DrawArgs`, the same flags and defaults as
 //! `render`). A scene's stream is emitted into memory and read back as a `.cwb` trace, so
-//! every command replays it exactly as it would replay `cwisim emit`'s file.
+//! every command replays it exactly as it would replay `cwisim emit`'s file; for the
+//! tools that show where each instruction came from ([`open_noted`]), with the renderer's
+//! notes kept beside it (`.cwb` carries none).
 
 use crate::draw::DrawArgs;
 use crate::error::CliError;
+use cwisim_isa::binary::{BinaryReader, BinaryWriter};
+use cwisim_isa::note::{Annotated, NoteTaker};
 use cwisim_isa::{Encoding, FileReader, TraceRead};
-use std::io::Cursor;
+use std::io::{BufReader, Cursor};
 use std::path::Path;
 
 /// What an input argument names.
@@ -87,6 +91,24 @@ pub fn open_sized(
     draw: &DrawArgs,
     allow_incomplete: bool,
 ) -> Result<(Box<dyn TraceRead>, u64), CliError> {
+    open_input(input, draw, allow_incomplete, false)
+}
+
+/// [`open_sized`] for the tools that show where each instruction came from (`dump`,
+/// `history`): the reader hands over the notes of the instructions
+/// ([`TraceRead::note`]), a trace file's own, or a scene's as its renderer writes them
+/// into a `.cwt` trace (`# row 3 trapezium 4 (polygon 2): case 8: …`). The instructions
+/// are the same as [`open_sized`]'s.
+pub fn open_noted(input: &Path, draw: &DrawArgs) -> Result<(Box<dyn TraceRead>, u64), CliError> {
+    open_input(input, draw, false, true)
+}
+
+fn open_input(
+    input: &Path,
+    draw: &DrawArgs,
+    allow_incomplete: bool,
+    notes: bool,
+) -> Result<(Box<dyn TraceRead>, u64), CliError> {
     match InputKind::of(input)? {
         InputKind::Trace => {
             let mut reader = FileReader::open(input)?;
@@ -99,15 +121,25 @@ pub fn open_sized(
         InputKind::Scene => {
             let drawn = draw.draw(Some(input))?;
             let header = drawn.renderer.header();
+            let in_memory = |e| CliError::Internal(format!("encoding a stream in memory: {e}"));
             let mut bytes = Vec::new();
-            {
-                let mut writer = Encoding::Binary
-                    .writer(&mut bytes, &header)
-                    .map_err(|e| CliError::Internal(format!("encoding a stream in memory: {e}")))?;
-                cwisim_render::emit(&*drawn.renderer, &mut *writer)?;
-            }
+            let writer = BinaryWriter::new(&mut bytes, &header).map_err(in_memory)?;
+            let table = if notes {
+                // the renderer composes its notes only for a writer that keeps them
+                let mut taker = NoteTaker::new(writer);
+                cwisim_render::emit(&*drawn.renderer, &mut taker)?;
+                Some(taker.into_parts().1)
+            } else {
+                let mut writer = writer;
+                cwisim_render::emit(&*drawn.renderer, &mut writer)?;
+                None
+            };
             let size = bytes.len() as u64;
-            Ok((Encoding::Binary.reader(Cursor::new(bytes))?, size))
+            let reader = BinaryReader::new(BufReader::new(Cursor::new(bytes)))?;
+            Ok(match table {
+                Some(table) => (Box::new(Annotated::new(reader, table)), size),
+                None => (Box::new(reader), size),
+            })
         }
     }
 }

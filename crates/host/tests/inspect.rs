@@ -108,11 +108,12 @@ fn page_history(data: &Value, x: u64, line: u64) -> Vec<String> {
     out
 }
 
-/// `cwisim history`'s lines without its heading.
+/// `cwisim history`'s lines without its heading, and without the notes heading its
+/// visits (where each instruction came from), which the page does not show yet.
 fn cli_history(dir: &Path, args: &[&str]) -> Vec<String> {
     let out = cwisim_ok(dir, args);
     out.lines()
-        .filter(|l| !l.starts_with("# processor"))
+        .filter(|l| !l.starts_with('#') || l.ends_with("(--all lists them)"))
         .map(str::to_string)
         .collect()
 }
@@ -177,7 +178,7 @@ fn a_trace_page_holds_what_run_history_and_dump_print() {
         let cli = cwisim_ok(&dir, &["dump", t, "--lines", &ls]);
         let cli: Vec<&str> = cli
             .lines()
-            .filter(|l| !l.starts_with('#') && !l.starts_with("cwisim-trace"))
+            .filter(|l| !l.starts_with('#') && !l.is_empty() && !l.starts_with("cwisim-trace"))
             .collect();
         let page: Vec<String> = dump[starts[line]..starts[line + 1]]
             .iter()

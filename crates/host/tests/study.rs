@@ -104,13 +104,19 @@ fn history_shows_each_instruction_with_registers_before_and_after() {
     );
     assert!(out.status.success());
     let h = text(&out);
+    // each visit headed by the note of its instruction: the comment lines above it
     let expected = "\
+# near object: edge pixels accumulate partial coverage, the interior is claimed
 cycle       15  #2      Eval1 9 1 0.375
     before  acc=0.0 I=- dI=- ddI=- flags=-
     after   acc=0.375 I=- dI=- ddI=- flags=-
+# far object spans the whole line; it shows only where the near one did not claim
 cycle       18  #3      Eval2 0 16 0.0625 0.0
     before  acc=0.375 I=- dI=- ddI=- flags=-
     after   acc=0.4375 I=- dI=- ddI=- flags=-
+# a third object tries to claim 6..12: first claim wins on 6..8; on 9..11 Eval0 *sets*,
+# overwriting the near object's partial edge pixel 9 (0.4375 -> 0.125): the edge
+# error of visibility by Eval0, which the host's eval0 mode measures
 cycle       20  #4      Eval0 6 6 0.125
     before  acc=0.4375 I=- dI=- ddI=- flags=-
     after   acc=0.125 I=- dI=- ddI=- flags=locked

@@ -17,6 +17,10 @@
 //! A file that stops before its end marker is *truncated*; one whose bytes contradict the
 //! format (bad magic, unknown opcode, bad varint, checksum or count mismatch, bytes after
 //! the end marker) is *corrupt*.
+//!
+//! A `.cwb` carries no notes ([`crate::note`]): the format has no place for them, and its
+//! writer drops what it is given. A stream kept in memory as `.cwb` keeps its notes
+//! beside it ([`crate::note::NoteTaker`], [`crate::note::Annotated`]).
 
 use crate::error::{operand_error, ErrorKind, Location, TraceError};
 use crate::header::{TraceHeader, MAX_CHANNELS};

@@ -280,6 +280,9 @@ impl TraceRead for FileReader {
     fn bytes_read(&self) -> u64 {
         self.inner.bytes_read()
     }
+    fn note(&self) -> Option<crate::Note<'_>> {
+        self.inner.note()
+    }
     fn read_batch(
         &mut self,
         out: &mut Vec<crate::Instruction>,

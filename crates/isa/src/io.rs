@@ -55,6 +55,14 @@ pub trait TraceRead {
     fn incomplete(&self) -> Option<crate::Incomplete> {
         None
     }
+
+    /// The note of the last instruction returned (by [`Self::next_instruction`]; after
+    /// [`Self::read_batch`], of the batch's last): where it came from, as the trace says
+    /// (see [`crate::note`] for which instructions a note covers). `None` when no note
+    /// covers it, or for a reader of an encoding without notes (the default).
+    fn note(&self) -> Option<crate::Note<'_>> {
+        None
+    }
 }
 
 /// Reads every remaining instruction.
@@ -69,11 +77,14 @@ pub fn read_all(reader: &mut dyn TraceRead) -> Result<Vec<Instruction>, TraceErr
 pub trait TraceWrite {
     /// Appends one instruction.
     fn write(&mut self, instr: &Instruction) -> io::Result<()>;
-    /// A remark for human readers; encodings without comments drop it.
+    /// The note of the next instruction written (where it came from; it covers that
+    /// instruction and the ones after it up to the next note or `Refresh`: see
+    /// [`crate::note`]). Several before one instruction make one note of several lines.
+    /// Encodings without notes drop it (the default).
     fn comment(&mut self, _text: &str) -> io::Result<()> {
         Ok(())
     }
-    /// Whether [`comment`](Self::comment) keeps anything: writers of remarks may skip
+    /// Whether [`comment`](Self::comment) keeps anything: writers of notes may skip
     /// composing them when it does not (the default).
     fn wants_comments(&self) -> bool {
         false

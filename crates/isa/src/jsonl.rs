@@ -8,11 +8,18 @@
 //!
 //! Keys are the operand names of [`Opcode::operands`]; intensities are always arrays,
 //! one number per channel. Floats round-trip exactly (serde_json's `float_roundtrip`).
+//!
+//! A record may carry a `"note"` string (written last): the note attached to its
+//! instruction ([`crate::note`]: where it came from; it covers the instructions after it
+//! up to the next note or `Refresh`). Lines of a note are joined by `\n`. A record
+//! without one is written exactly as before notes existed; readers older than notes
+//! refuse a record with one (`unknown field "note"`).
 
 use crate::error::{operand_error, ErrorKind, Location, TraceError};
 use crate::header::TraceHeader;
 use crate::instruction::{Instruction, Intensity};
 use crate::io::{LineReader, TraceRead, TraceWrite};
+use crate::note::{append_note, Note, Scope};
 use crate::opcode::{Opcode, OperandKind};
 use crate::text::{header_from_u64, TEXT_MAGIC};
 use serde::ser::SerializeMap;
@@ -21,17 +28,30 @@ use std::io::{self, BufRead, Write};
 
 impl Serialize for Instruction {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        let kinds = self.op.operands();
-        let mut m = s.serialize_map(Some(kinds.len() + 1))?;
-        m.serialize_entry("op", self.op.name())?;
+        Noted(self, None).serialize(s)
+    }
+}
+
+/// An instruction's record, with its note when it has one.
+struct Noted<'a>(&'a Instruction, Option<&'a str>);
+
+impl Serialize for Noted<'_> {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let Noted(instr, note) = self;
+        let kinds = instr.op.operands();
+        let mut m = s.serialize_map(Some(kinds.len() + 1 + usize::from(note.is_some())))?;
+        m.serialize_entry("op", instr.op.name())?;
         for kind in kinds {
             match kind {
-                OperandKind::X => m.serialize_entry("x", &self.x)?,
-                OperandKind::Count | OperandKind::Period => m.serialize_entry("dx", &self.dx)?,
+                OperandKind::X => m.serialize_entry("x", &instr.x)?,
+                OperandKind::Count | OperandKind::Period => m.serialize_entry("dx", &instr.dx)?,
                 _ => {
-                    m.serialize_entry(kind.name(), self.value(kind.value_slot().expect("value")))?
+                    m.serialize_entry(kind.name(), instr.value(kind.value_slot().expect("value")))?
                 }
             }
+        }
+        if let Some(note) = note {
+            m.serialize_entry("note", note)?;
         }
         m.end()
     }
@@ -49,8 +69,10 @@ struct HeaderRecord {
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
-struct Record {
-    op: String,
+struct Record<'a> {
+    /// Borrowed from the line unless it holds escapes: no allocation per record.
+    #[serde(borrow)]
+    op: std::borrow::Cow<'a, str>,
     x: Option<u64>,
     dx: Option<u64>,
     #[serde(rename = "I")]
@@ -59,11 +81,14 @@ struct Record {
     di: Option<Vec<f64>>,
     #[serde(rename = "ddI")]
     ddi: Option<Vec<f64>>,
+    note: Option<String>,
 }
 
 /// Writes a `.jsonl` trace.
 pub struct JsonlWriter<W: Write> {
     out: W,
+    /// The note of the next instruction.
+    pending: Option<String>,
 }
 
 impl<W: Write> JsonlWriter<W> {
@@ -78,14 +103,24 @@ impl<W: Write> JsonlWriter<W> {
         };
         serde_json::to_writer(&mut out, &rec)?;
         out.write_all(b"\n")?;
-        Ok(JsonlWriter { out })
+        Ok(JsonlWriter { out, pending: None })
     }
 }
 
 impl<W: Write> TraceWrite for JsonlWriter<W> {
     fn write(&mut self, instr: &Instruction) -> io::Result<()> {
-        serde_json::to_writer(&mut self.out, instr)?;
+        let note = self.pending.take();
+        serde_json::to_writer(&mut self.out, &Noted(instr, note.as_deref()))?;
         self.out.write_all(b"\n")
+    }
+
+    fn comment(&mut self, text: &str) -> io::Result<()> {
+        append_note(&mut self.pending, text);
+        Ok(())
+    }
+
+    fn wants_comments(&self) -> bool {
+        true
     }
 
     fn finish(&mut self) -> io::Result<()> {
@@ -98,6 +133,9 @@ pub struct JsonlReader<R: BufRead> {
     lines: LineReader<R>,
     header: TraceHeader,
     location: Location,
+    /// The text of the last note attached.
+    note: String,
+    scope: Scope,
 }
 
 fn json_error(e: &serde_json::Error, line: u64) -> TraceError {
@@ -161,11 +199,19 @@ impl<R: BufRead> JsonlReader<R> {
             lines,
             header,
             location: at1,
+            note: String::new(),
+            scope: Scope::default(),
         })
     }
 }
 
-fn parse_record(line: &str, line_no: u64, header: &TraceHeader) -> Result<Instruction, TraceError> {
+/// One record's instruction; its note, if it has one, into `note`.
+fn parse_record(
+    line: &str,
+    line_no: u64,
+    header: &TraceHeader,
+    note: &mut String,
+) -> Result<(Instruction, bool), TraceError> {
     let at = Location::Line {
         line: line_no,
         column: 1,
@@ -242,7 +288,11 @@ fn parse_record(line: &str, line_no: u64, header: &TraceHeader) -> Result<Instru
         ],
     );
     instr.check(header).map_err(|e| operand_error(e, at, op))?;
-    Ok(instr)
+    let attached = rec.note.is_some();
+    if let Some(text) = rec.note {
+        *note = text;
+    }
+    Ok((instr, attached))
 }
 
 impl<R: BufRead> TraceRead for JsonlReader<R> {
@@ -264,12 +314,20 @@ impl<R: BufRead> TraceRead for JsonlReader<R> {
                 "empty line; JSON Lines holds one JSON object on every line",
             ));
         }
-        let instr = parse_record(line, line_no, &self.header)?;
+        let (instr, attached) = parse_record(line, line_no, &self.header, &mut self.note)?;
         self.location = Location::Line {
             line: line_no,
             column: 1,
         };
+        self.scope.step(instr.op, attached);
         Ok(Some(instr))
+    }
+
+    fn note(&self) -> Option<Note<'_>> {
+        self.scope.serial().map(|serial| Note {
+            serial,
+            text: &self.note,
+        })
     }
 
     fn location(&self) -> Location {
@@ -316,6 +374,42 @@ mod tests {
         assert_eq!(
             read(&s[HEAD.len()..]).unwrap()[0].di().as_slice()[0].to_bits(),
             (-0.0f64).to_bits()
+        );
+    }
+
+    #[test]
+    fn a_note_is_written_last_and_read_back() {
+        let mut buf = Vec::new();
+        let h = TraceHeader::new(8, 2, 1).unwrap();
+        let mut w = JsonlWriter::new(&mut buf, &h).unwrap();
+        w.comment("row 0 trapezium 1 (polygon 0): case 8").unwrap();
+        w.comment("\"quoted\"").unwrap();
+        w.write(&Instruction::eval1(0, 4, Intensity::grey(0.5)))
+            .unwrap();
+        w.write(&Instruction::eval1(4, 4, Intensity::grey(0.5)))
+            .unwrap();
+        w.write(&Instruction::refresh()).unwrap();
+        let s = String::from_utf8(buf).unwrap();
+        let body = &s[HEAD.len()..];
+        assert_eq!(
+            body,
+            "{\"op\":\"Eval1\",\"x\":0,\"dx\":4,\"I\":[0.5],\"note\":\"row 0 trapezium 1 (polygon 0): case 8\\n\\\"quoted\\\"\"}\n\
+             {\"op\":\"Eval1\",\"x\":4,\"dx\":4,\"I\":[0.5]}\n{\"op\":\"Refresh\"}\n"
+        );
+        let mut r = JsonlReader::new(s.as_bytes()).unwrap();
+        let mut got = Vec::new();
+        while r.next_instruction().unwrap().is_some() {
+            got.push(r.note().map(|n| (n.serial, n.text.to_string())));
+        }
+        let note = Some((
+            0,
+            "row 0 trapezium 1 (polygon 0): case 8\n\"quoted\"".to_string(),
+        ));
+        assert_eq!(got, [note.clone(), note, None]);
+        // a note must be a string
+        assert_eq!(
+            read("{\"op\":\"Refresh\",\"note\":3}\n").unwrap_err().kind,
+            ErrorKind::Syntax
         );
     }
 

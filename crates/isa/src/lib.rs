@@ -15,6 +15,9 @@
 //!   carry (a band of scanlines handed from one thread to another).
 //! * [`CheckedStream`] — instructions checked once against a header as they are
 //!   appended, so that the array executes them without checking them again.
+//! * [`note`] — where an instruction came from: the note a trace attaches to it (a
+//!   renderer's comment above its instructions in `.cwt`, `"note"` in `.jsonl`), handed
+//!   over by [`TraceRead::note`].
 //! * [`TraceError`] — every decoding fault is typed ([`ErrorKind`]), located
 //!   ([`Location`]: line and column, or byte offset) and says what was expected.
 //!
@@ -44,6 +47,7 @@ pub mod header;
 pub mod instruction;
 pub mod io;
 pub mod jsonl;
+pub mod note;
 pub mod opcode;
 pub mod packed;
 pub mod text;
@@ -54,5 +58,6 @@ pub use error::{printable, ErrorKind, Location, TraceError};
 pub use header::{HeaderFault, TraceHeader, FORMAT_VERSION, MAX_CHANNELS, MAX_LINES, MAX_WIDTH};
 pub use instruction::{Instruction, Intensity, OperandError};
 pub use io::{TraceRead, TraceWrite};
+pub use note::{Note, NoteTable};
 pub use opcode::{Opcode, OperandKind};
 pub use packed::PackedStream;

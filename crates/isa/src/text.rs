@@ -4,9 +4,16 @@
 //! ```text
 //! # comments run from '#' to the end of the line
 //! cwisim-trace version=1 width=16 lines=4 channels=1
+//! # a note: where the instructions below come from
 //! Eval2 0 8 0.25 0.125
 //! Refresh
 //! ```
+//!
+//! The comment lines directly above an instruction (after the header line, with no blank
+//! line between) are its **note** ([`crate::note`]): the reader hands it over
+//! ([`TraceRead::note`]) and the writer writes the notes it is given
+//! ([`TraceWrite::comment`]) that way, one `# line` per line. Trailing comments and
+//! comment blocks followed by a blank line are remarks, read past.
 //!
 //! Operands follow [`Opcode::operands`]. An intensity is its channel values joined by
 //! commas without spaces (`0.5,0.25,1.0` for RGB). Values are written in Rust's shortest
@@ -18,6 +25,7 @@ use crate::error::{operand_error, ErrorKind, Location, TraceError};
 use crate::header::{HeaderFault, TraceHeader, FORMAT_VERSION};
 use crate::instruction::{Instruction, Intensity};
 use crate::io::{LineReader, TraceRead, TraceWrite};
+use crate::note::{Note, Scope};
 use crate::opcode::{Opcode, OperandKind};
 use std::fmt::Write as _;
 use std::io::{self, BufRead, Write};
@@ -89,8 +97,12 @@ impl<W: Write> TraceWrite for TextWriter<W> {
     }
 
     fn comment(&mut self, text: &str) -> io::Result<()> {
-        for line in text.lines() {
-            writeln!(self.out, "# {line}")?;
+        for line in crate::note::note_lines(text) {
+            if line.is_empty() {
+                writeln!(self.out, "#")?;
+            } else {
+                writeln!(self.out, "# {line}")?;
+            }
         }
         Ok(())
     }
@@ -109,6 +121,14 @@ pub struct TextReader<R: BufRead> {
     lines: LineReader<R>,
     header: TraceHeader,
     location: Location,
+    /// The comment lines read since the last instruction or blank line, joined by `\n`:
+    /// the note of the next instruction if it follows directly.
+    pending: String,
+    /// Whether `pending` holds a comment block (it may be one empty line).
+    has_pending: bool,
+    /// The text of the last note attached.
+    note: String,
+    scope: Scope,
 }
 
 struct Token<'a> {
@@ -140,6 +160,28 @@ fn tokens(content: &str) -> Vec<Token<'_>> {
     out
 }
 
+/// A line without an instruction, out of the reader's loop (which stays small enough to
+/// be inlined into the batch read): a comment line's text (`comment`, after the `#`) is a
+/// line of the note of the instruction directly below, if one is; a blank line (`None`)
+/// makes the comments above it a remark.
+#[inline(never)]
+fn take_remark(pending: &mut String, has_pending: &mut bool, comment: Option<&str>) {
+    match comment {
+        Some(text) => {
+            if *has_pending {
+                pending.push('\n');
+            }
+            pending.push_str(text.strip_prefix(' ').unwrap_or(text));
+            *has_pending = true;
+        }
+        None => {
+            pending.clear();
+            *has_pending = false;
+        }
+    }
+}
+
+#[inline]
 fn strip_comment(line: &str) -> &str {
     match line.find('#') {
         Some(i) => &line[..i],
@@ -148,6 +190,37 @@ fn strip_comment(line: &str) -> &str {
 }
 
 impl<R: BufRead> TextReader<R> {
+    /// The next instruction, with the comment lines directly above it as its note. Always
+    /// inlined: into the batch read, the instruction is built in place rather than
+    /// returned through memory.
+    #[inline(always)]
+    fn read_one(&mut self) -> Result<Option<Instruction>, TraceError> {
+        loop {
+            let Some((line_no, line)) = self.lines.next_line()? else {
+                return Ok(None);
+            };
+            let content = strip_comment(line);
+            let Some(instr) = parse_instruction(content, line_no, &self.header)? else {
+                // a comment line (`#` after blanks only), or a blank one
+                let comment = (content.len() < line.len()).then(|| &line[content.len() + 1..]);
+                take_remark(&mut self.pending, &mut self.has_pending, comment);
+                continue;
+            };
+            self.location = Location::Line {
+                line: line_no,
+                column: 1,
+            };
+            let attached = self.has_pending;
+            if attached {
+                std::mem::swap(&mut self.note, &mut self.pending);
+                self.pending.clear();
+                self.has_pending = false;
+            }
+            self.scope.step(instr.op, attached);
+            return Ok(Some(instr));
+        }
+    }
+
     /// Opens a trace: reads up to and including the header line.
     pub fn new(input: R) -> Result<Self, TraceError> {
         let mut lines = LineReader::new(input);
@@ -168,6 +241,10 @@ impl<R: BufRead> TextReader<R> {
                 lines,
                 header,
                 location: Location::Line { line: 1, column: 1 },
+                pending: String::new(),
+                has_pending: false,
+                note: String::new(),
+                scope: Scope::default(),
             });
         }
     }
@@ -463,18 +540,27 @@ impl<R: BufRead> TraceRead for TextReader<R> {
     }
 
     fn next_instruction(&mut self) -> Result<Option<Instruction>, TraceError> {
-        loop {
-            let Some((line_no, line)) = self.lines.next_line()? else {
-                return Ok(None);
-            };
-            if let Some(instr) = parse_instruction(strip_comment(line), line_no, &self.header)? {
-                self.location = Location::Line {
-                    line: line_no,
-                    column: 1,
-                };
-                return Ok(Some(instr));
+        self.read_one()
+    }
+
+    /// The default's loop, over `read_one` inlined.
+    fn read_batch(&mut self, out: &mut Vec<Instruction>, max: usize) -> Result<usize, TraceError> {
+        let mut n = 0;
+        while n < max.max(1) {
+            match self.read_one()? {
+                Some(i) => out.push(i),
+                None => break,
             }
+            n += 1;
         }
+        Ok(n)
+    }
+
+    fn note(&self) -> Option<Note<'_>> {
+        self.scope.serial().map(|serial| Note {
+            serial,
+            text: &self.note,
+        })
     }
 
     fn location(&self) -> Location {
@@ -510,6 +596,76 @@ mod tests {
             format_instruction(&v[0]),
             "Eval2 0 4 1.0,0.5,0.0 -0.25,0.0,0.001"
         );
+    }
+
+    /// Each instruction's note (its text and serial), as the reader hands them over.
+    fn notes(src: &str) -> Vec<(String, Option<(u64, String)>)> {
+        let mut r = TextReader::new(src.as_bytes()).unwrap();
+        let mut out = Vec::new();
+        while let Some(i) = r.next_instruction().unwrap() {
+            let note = r.note().map(|n| (n.serial, n.text.to_string()));
+            out.push((format_instruction(&i), note));
+        }
+        out
+    }
+
+    #[test]
+    fn comment_lines_directly_above_an_instruction_are_its_note() {
+        let got = notes(
+            "# about the file, not a note\ncwisim-trace version=1 width=8 lines=2 channels=1\n\
+             # row 0 trapezium 1 (polygon 0): case 8\n\
+             #second line\n\
+             Eval1 0 4 0.5 # a trailing remark\n\
+             Eval1 4 4 0.25\n\
+             Refresh\n\
+             Eval1 0 1 1.0\n\
+             # a remark set apart by a blank line\n\
+             \n\
+             Eval1 1 1 1.0\n\
+             \t# indented\n\
+             #\n\
+             Refresh\n\
+             Eval1 2 1 1.0 # not a note\n",
+        );
+        let n = |serial, t: &str| Some((serial, t.to_string()));
+        let row = "row 0 trapezium 1 (polygon 0): case 8\nsecond line";
+        assert_eq!(
+            got,
+            [
+                ("Eval1 0 4 0.5".to_string(), n(0, row)),
+                ("Eval1 4 4 0.25".to_string(), n(0, row)),
+                ("Refresh".to_string(), None),
+                ("Eval1 0 1 1.0".to_string(), None),
+                ("Eval1 1 1 1.0".to_string(), None),
+                ("Refresh".to_string(), n(1, "indented\n")),
+                ("Eval1 2 1 1.0".to_string(), None),
+            ]
+        );
+    }
+
+    #[test]
+    fn notes_written_read_back() {
+        let header = TraceHeader::new(8, 2, 1).unwrap();
+        let mut bytes = Vec::new();
+        let mut w = TextWriter::new(&mut bytes, &header).unwrap();
+        w.comment("a\n\nb").unwrap();
+        w.comment("c\r\n").unwrap();
+        w.write(&Instruction::eval1(0, 1, Intensity::grey(0.5)))
+            .unwrap();
+        w.write(&Instruction::eval1(1, 1, Intensity::grey(0.5)))
+            .unwrap();
+        w.comment("").unwrap(); // one empty line
+        w.write(&Instruction::refresh()).unwrap();
+        w.finish().unwrap();
+        let text = String::from_utf8(bytes).unwrap();
+        assert_eq!(
+            text,
+            "cwisim-trace version=1 width=8 lines=2 channels=1\n# a\n#\n# b\n# c\n#\nEval1 0 1 0.5\nEval1 1 1 0.5\n#\nRefresh\n"
+        );
+        let got = notes(&text);
+        assert_eq!(got[0].1, Some((0, "a\n\nb\nc\n".to_string())));
+        assert_eq!(got[1].1, got[0].1);
+        assert_eq!(got[2].1, Some((1, String::new())));
     }
 
     #[test]

@@ -88,3 +88,135 @@ proptest! {
         prop_assert_eq!(text, text_again);
     }
 }
+
+/// A note's text: one to three lines of printable text (spaces, `#` and empty lines
+/// included), or none.
+fn any_note() -> impl Strategy<Value = Option<String>> {
+    proptest::option::weighted(
+        0.3,
+        proptest::collection::vec("[ -~]{0,12}", 1..4).prop_map(|lines| lines.join("\n")),
+    )
+}
+
+/// A trace with a note before some of its instructions.
+fn noted_trace() -> impl Strategy<Value = (TraceHeader, Vec<(Option<String>, Instruction)>)> {
+    trace().prop_flat_map(|(header, instrs)| {
+        let n = instrs.len();
+        (
+            Just(header),
+            Just(instrs),
+            proptest::collection::vec(any_note(), n),
+        )
+            .prop_map(|(h, instrs, notes)| (h, notes.into_iter().zip(instrs).collect()))
+    })
+}
+
+fn encode_noted(
+    enc: Encoding,
+    header: &TraceHeader,
+    stream: &[(Option<String>, Instruction)],
+) -> Vec<u8> {
+    let mut buf = Vec::new();
+    {
+        let mut w = enc.writer(&mut buf, header).unwrap();
+        for (note, i) in stream {
+            if let Some(n) = note {
+                w.comment(n).unwrap();
+            }
+            w.write(i).unwrap();
+        }
+        w.finish().unwrap();
+    }
+    buf
+}
+
+/// Each instruction with the serial and text of its note.
+type Read = Vec<(Instruction, Option<(u64, String)>)>;
+
+fn decode_noted(enc: Encoding, bytes: &[u8]) -> Read {
+    let mut r = enc.reader(bytes).unwrap();
+    let mut out = Vec::new();
+    while let Some(i) = r.next_instruction().unwrap() {
+        out.push((i, r.note().map(|n| (n.serial, n.text.to_string()))));
+    }
+    out
+}
+
+/// The notes of the rule (`cwisim_isa::note`), computed apart: a note covers its
+/// instruction and the ones after it up to the next note or `Refresh`, a `Refresh` only
+/// when attached to it.
+fn expected(stream: &[(Option<String>, Instruction)]) -> Read {
+    let (mut serial, mut in_force) = (0u64, None::<(u64, String)>);
+    let mut out = Vec::new();
+    for (note, i) in stream {
+        let refresh = i.op == Opcode::Refresh;
+        let text = note.as_deref().map(cwisim_isa::note::normalized);
+        let covered = match text {
+            Some(t) => {
+                let n = (serial, t);
+                serial += 1;
+                in_force = (!refresh).then(|| n.clone());
+                Some(n)
+            }
+            None if refresh => {
+                in_force = None;
+                None
+            }
+            None => in_force.clone(),
+        };
+        out.push((i.clone(), covered));
+    }
+    out
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(200))]
+
+    /// `.cwt` and `.jsonl` keep every note on the instructions it covers; `.cwb` drops
+    /// them; the instructions are the same in all three, with notes or without.
+    #[test]
+    fn notes_survive_the_encodings_that_carry_them((header, stream) in noted_trace()) {
+        let want = expected(&stream);
+        let plain: Vec<Instruction> = stream.iter().map(|(_, i)| i.clone()).collect();
+        for (enc, _) in Encoding::ALL {
+            let got = decode_noted(enc, &encode_noted(enc, &header, &stream));
+            let instrs: Vec<Instruction> = got.iter().map(|(i, _)| i.clone()).collect();
+            prop_assert_eq!(&instrs, &plain);
+            if enc == Encoding::Binary {
+                prop_assert!(got.iter().all(|(_, n)| n.is_none()));
+            } else {
+                prop_assert_eq!(&got, &want, "{:?}", enc);
+            }
+        }
+    }
+
+    /// Copying a trace as `cwisim convert` does (each note once, before the first
+    /// instruction it covers): `.cwt` → `.jsonl` → `.cwt` gives the same bytes.
+    #[test]
+    fn notes_convert_back_and_forth((header, stream) in noted_trace()) {
+        let text = encode_noted(Encoding::Text, &header, &stream);
+        let jsonl = copy(&text, Encoding::Text, Encoding::JsonLines);
+        let back = copy(&jsonl, Encoding::JsonLines, Encoding::Text);
+        prop_assert_eq!(String::from_utf8(back).unwrap(), String::from_utf8(text).unwrap());
+    }
+}
+
+/// `bytes` of encoding `from` re-encoded as `to`, notes and all.
+fn copy(bytes: &[u8], from: Encoding, to: Encoding) -> Vec<u8> {
+    let mut r = from.reader(bytes).unwrap();
+    let mut out = Vec::new();
+    {
+        let mut w = to.writer(&mut out, r.header()).unwrap();
+        let mut last = None;
+        while let Some(i) = r.next_instruction().unwrap() {
+            let note = r.note();
+            if let Some(n) = note.filter(|n| last != Some(n.serial)) {
+                w.comment(n.text).unwrap();
+            }
+            last = note.map(|n| n.serial);
+            w.write(&i).unwrap();
+        }
+        w.finish().unwrap();
+    }
+    out
+}

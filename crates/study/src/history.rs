@@ -3,14 +3,21 @@
 //! cycle-stepped engine through a [`Probe`]. Only scanline `y` is stepped: the fast
 //! engine runs the scanlines before it and hands its state over
 //! ([`cwisim_xproc::replay_probed_numeric`]).
+//!
+//! Each visit's instruction keeps its provenance: the note the trace attaches to it
+//! (`row 3 trapezium 4 (polygon 2): case 8: …`, [`crate::provenance`]), in the
+//! [`History`]'s table by the visit's [`Visit::index`].
 
 use crate::error::StudyError;
+use crate::provenance::{comment_lines, NoteRecorder};
 use crate::until::UntilLine;
+use cwisim_isa::note::{Note, NoteTable};
 use cwisim_isa::text::format_value;
 use cwisim_isa::{Instruction, Opcode, TraceRead};
 use cwisim_xproc::{
     replay_probed_numeric, Machine, NullSink, Numeric, Probe, ProcessorState, StepFrom,
 };
+use std::cell::RefCell;
 
 /// Replays `trace` up to scanline `y` and returns every visit of a token to processor
 /// `x` on it. `Ok(Err(n))`: the trace outputs only `n` scanlines.
@@ -20,12 +27,33 @@ pub fn pixel_history(
     x: usize,
     y: u64,
 ) -> Result<Result<Vec<Visit>, u64>, StudyError> {
-    pixel_history_with_progress(trace, machine, &Numeric::F64, x, y, &mut |_| {})
+    let history = pixel_history_with_progress(trace, machine, &Numeric::F64, x, y, &mut |_| {})?;
+    Ok(history.map(|h| h.visits))
+}
+
+/// A pixel's history: the visits, and where their instructions came from.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct History {
+    /// Every visit of a token to the processor on the scanline, in order.
+    pub visits: Vec<Visit>,
+    /// The notes of the scanline's instructions, by their index in the trace
+    /// ([`Visit::index`]): see [`Self::provenance`].
+    pub notes: NoteTable,
+}
+
+impl History {
+    /// Where the instruction of a visit came from: the note the trace attaches to it
+    /// (a renderer's `row 3 trapezium 4 (polygon 2): case 8: …`), if it has one. Visits
+    /// of the instructions one note covers share its [`Note::serial`].
+    pub fn provenance(&self, visit: &Visit) -> Option<Note<'_>> {
+        self.notes.get(visit.index)
+    }
 }
 
 /// [`pixel_history`] with registers of the format `numeric` (the values the history shows
 /// are the registers' own, as `f64`), calling `progress` with the bytes of `trace` read so
-/// far every few thousand instructions (and at the end): for a progress bar.
+/// far every few thousand instructions (and at the end): for a progress bar. The history
+/// keeps the notes of the scanline's instructions ([`History::provenance`]).
 pub fn pixel_history_with_progress(
     trace: &mut dyn TraceRead,
     machine: &Machine,
@@ -33,13 +61,15 @@ pub fn pixel_history_with_progress(
     x: usize,
     y: u64,
     progress: &mut dyn FnMut(u64),
-) -> Result<Result<Vec<Visit>, u64>, StudyError> {
+) -> Result<Result<History, u64>, StudyError> {
     let mut watch = Watch {
         x,
         y,
         visits: Vec::new(),
     };
-    let mut reader = UntilLine::new(trace, Some(y));
+    let notes = RefCell::new(NoteTable::new());
+    let mut recorder = NoteRecorder::new(trace, &notes, y);
+    let mut reader = UntilLine::new(&mut recorder, Some(y));
     replay_probed_numeric(
         &mut reader,
         machine,
@@ -53,7 +83,10 @@ pub fn pixel_history_with_progress(
     if lines <= y {
         return Ok(Err(lines));
     }
-    Ok(Ok(watch.visits))
+    Ok(Ok(History {
+        visits: watch.visits,
+        notes: notes.into_inner(),
+    }))
 }
 
 /// One visit of a token to the watched processor.
@@ -134,14 +167,23 @@ pub fn hidden_line(hidden: usize) -> String {
     format!("# {hidden} more instruction(s) passed through without acting (--all lists them)")
 }
 
-/// Everything `cwisim history` prints after its heading: each shown visit's lines, the
-/// value shifted out, and how many visits were left out. The `inspect` page holds the same
+/// Everything `cwisim history` prints after its heading: each shown visit's lines, headed
+/// by the note of its instruction as the trace writes it (`# row 3 trapezium 4 (polygon
+/// 2): case 8: …`, once above the visits of the instructions one note covers), the value
+/// shifted out, and how many visits were left out. The `inspect` page holds the same
 /// lines for every pixel of its window.
-pub fn history_lines(visits: &[Visit], all: bool) -> Vec<String> {
+pub fn history_lines(history: &History, all: bool) -> Vec<String> {
+    let visits = &history.visits;
     let mut out = Vec::new();
     let mut shown_count = 0;
+    let mut last_note = None;
     for v in visits.iter().filter(|v| shown(v, all)) {
         shown_count += 1;
+        let note = history.provenance(v);
+        if let Some(n) = note.filter(|n| last_note != Some(n.serial)) {
+            out.extend(comment_lines(n.text));
+        }
+        last_note = note.map(|n| n.serial);
         out.extend(visit_lines(v));
     }
     if let Some(r) = visits.iter().rev().find(|v| v.instr.op == Opcode::Refresh) {
@@ -236,6 +278,55 @@ mod tests {
     use super::*;
     use crate::window_tests::{machines, reader, trace};
     use cwisim_xproc::replay_probed;
+
+    /// Each visit's instruction keeps the note the trace attaches to it; the lines show it
+    /// once above the visits it covers; notes change nothing else.
+    #[test]
+    fn every_visit_keeps_its_note() {
+        let noted = "cwisim-trace version=1 width=8 lines=2 channels=1
+# row 0 trapezium 1 (polygon 0): case 8
+Eval1 0 8 0.5
+Refresh
+# row 1 trapezium 1 (polygon 0): case 5
+# a second line
+Eval1 0 4 0.25
+Eval1 2 4 0.25
+Refresh
+";
+        let plain: String = noted
+            .lines()
+            .filter(|l| !l.starts_with('#'))
+            .map(|l| format!("{l}\n"))
+            .collect();
+        let machine = Machine::default();
+        let read = |text: &str| {
+            let mut r = cwisim_isa::text::TextReader::new(text.as_bytes()).unwrap();
+            pixel_history_with_progress(&mut r, &machine, &Numeric::F64, 3, 1, &mut |_| {})
+                .unwrap()
+                .unwrap()
+        };
+        let h = read(noted);
+        let notes: Vec<_> = h
+            .visits
+            .iter()
+            .map(|v| h.provenance(v).map(|n| (n.serial, n.text)))
+            .collect();
+        let row1 = Some((1, "row 1 trapezium 1 (polygon 0): case 5\na second line"));
+        assert_eq!(notes, [row1, row1, None]);
+        // only the scanline's notes are kept
+        assert_eq!(h.notes.len(), 1);
+        let lines = history_lines(&h, false);
+        assert_eq!(lines[0], "# row 1 trapezium 1 (polygon 0): case 5");
+        assert_eq!(lines[1], "# a second line");
+        assert!(lines[2].contains("#2      Eval1 0 4 0.25"), "{lines:?}");
+        assert!(lines[5].contains("#3      Eval1 2 4 0.25"), "{lines:?}");
+        assert!(lines.iter().filter(|l| l.starts_with("# ")).count() == 2);
+        // without the notes: the same visits, the same lines but for the notes
+        let bare = read(&plain);
+        assert_eq!(bare.visits, h.visits);
+        assert!(bare.notes.is_empty());
+        assert_eq!(history_lines(&bare, false), lines[2..]);
+    }
 
     /// Every pixel's history, with the scanlines before it on the fast engine, is the
     /// history a stepped run from the start of the trace gives.

@@ -16,7 +16,8 @@
 //! * [`history`] — one pixel's history: every instruction that reached it on a scanline,
 //!   registers before and after; [`vcd`] — a scanline's per-cycle waveform as a Value
 //!   Change Dump; both from the cycle-stepped engine's probe. [`until`] ends a trace
-//!   after a given scanline.
+//!   after a given scanline; [`provenance`] keeps the notes a trace attaches to its
+//!   instructions (where each came from) through them.
 //! * [`inspect`] — one frame as one self-contained HTML page: the image with overlays, the
 //!   scanline timeline and disassembly, every pixel history of a window.
 //! * [`error`] — [`StudyError`].
@@ -29,6 +30,7 @@ pub mod fit;
 pub mod history;
 pub mod inspect;
 pub mod plot;
+pub mod provenance;
 pub mod refine;
 pub mod refine_ids;
 pub mod refine_plot;

@@ -44,8 +44,11 @@ pub fn run(args: &ConvertArgs) -> Result<u64, CliError> {
 
 /// Copies every instruction of the trace `input` into a new trace `output`, each in the
 /// encoding its extension names. Every instruction is checked on the way; `output` is
-/// written all-or-nothing, so a malformed input leaves no partial file. Comments of a
-/// `.cwt` input are not kept.
+/// written all-or-nothing, so a malformed input leaves no partial file. The notes of the
+/// instructions (where each came from: the comment lines directly above an instruction
+/// of a `.cwt`, `"note"` in a `.jsonl`; `cwisim_isa::note`) are kept when `output`'s
+/// encoding carries them (`.cwt`, `.jsonl`; `.cwb` carries none); other comments are
+/// not.
 pub fn convert(input: &Path, output: &Path) -> Result<u64, CliError> {
     Encoding::from_path(input)?;
     let out_encoding = Encoding::from_path(output)?;
@@ -61,7 +64,17 @@ pub fn convert(input: &Path, output: &Path) -> Result<u64, CliError> {
     write_atomic(output, |out| {
         let io_err = |e| CliError::write(output, e);
         let mut writer = out_encoding.writer(out, &header).map_err(io_err)?;
+        let notes = writer.wants_comments();
+        let mut last_note = None;
         while let Some(instr) = reader.next_instruction()? {
+            if notes {
+                // each note once, before the first instruction it covers
+                let note = reader.note();
+                if let Some(n) = note.filter(|n| last_note != Some(n.serial)) {
+                    writer.comment(n.text).map_err(io_err)?;
+                }
+                last_note = note.map(|n| n.serial);
+            }
             writer.write(&instr).map_err(io_err)?;
             count += 1;
         }

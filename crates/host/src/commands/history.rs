@@ -3,7 +3,9 @@
 //! just **before** and just **after** it acted there (values as at that moment).
 //!
 //! It replays the trace on the cycle-stepped engine (the reference model) up to the
-//! scanline asked for, watching one processor.
+//! scanline asked for, watching one processor. Each instruction is headed by its note
+//! (where it came from: the renderer's `# row 3 trapezium 4 (polygon 2): case 8: …`), as
+//! in the trace.
 
 use super::MachineArgs;
 use crate::error::CliError;
@@ -47,7 +49,7 @@ pub struct HistoryArgs {
 pub fn run(args: &HistoryArgs, stdout: &mut dyn Write, progress: bool) -> Result<(), CliError> {
     crate::input::drawing_applies(&args.draw, &[Some(&args.trace)])?;
     let machine = args.machine.load()?;
-    let (mut file, size) = crate::input::open_sized(&args.trace, &args.draw, false)?;
+    let (mut file, size) = crate::input::open_noted(&args.trace, &args.draw)?;
     let header = *file.header();
     if args.x >= header.width {
         return Err(CliError::Usage(format!(
@@ -58,7 +60,7 @@ pub fn run(args: &HistoryArgs, stdout: &mut dyn Write, progress: bool) -> Result
         )));
     }
     let mut bar = Progress::new(size, progress);
-    let visits = pixel_history_with_progress(
+    let history = pixel_history_with_progress(
         &mut *file,
         &machine,
         &args.numeric,
@@ -69,8 +71,8 @@ pub fn run(args: &HistoryArgs, stdout: &mut dyn Write, progress: bool) -> Result
     drop(bar);
     // the rest of the file, checked though not replayed: no success on a damaged trace
     file.check_to_end()?;
-    let visits = match visits {
-        Ok(visits) => visits,
+    let history = match history {
+        Ok(history) => history,
         Err(lines) => {
             return Err(CliError::Usage(format!(
                 "--line {}: {} outputs only {lines} scanline(s) (0..={})",
@@ -91,7 +93,7 @@ arrived, and the registers before → after it acted",
             args.trace.display()
         ),
     )?;
-    for line in history_lines(&visits, args.all) {
+    for line in history_lines(&history, args.all) {
         w(stdout, line)?;
     }
     Ok(())
