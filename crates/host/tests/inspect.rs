@@ -712,8 +712,8 @@ fn an_ab_page_holds_both_runs() {
         (runs[0]["label"].as_str(), runs[1]["label"].as_str()),
         (Some("A"), Some("B"))
     );
-    assert_eq!(runs[0]["name"], "pot (A)");
-    assert_eq!(runs[1]["name"], "pot (B)");
+    assert_eq!(runs[0]["name"], "pot");
+    assert_eq!(runs[1]["name"], "pot");
     assert_eq!(
         runs[0]["history_command"],
         "cwisim history pot --size 64x48"
@@ -870,7 +870,7 @@ fn bad_requests_are_refused_with_exit_2() {
                 "-o",
                 "x.html",
             ],
-            "is 64×48 with 1 channel(s) but B (pot (B)) is",
+            "A (pot) is 64×48 with 1 channel(s) but B (pot) is",
         ),
         (
             vec!["inspect", t, "--against", "pot --bogus 3", "-o", "x.html"],

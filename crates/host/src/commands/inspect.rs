@@ -499,17 +499,9 @@ pub fn run(args: &InspectArgs, stdout: &mut dyn Write, progress: bool) -> Result
     }
 
     let stage = Stage::new(progress, "inspect: preparing the input");
-    let mut a = open(&args.input, &args.draw, &args.machine, args.numeric)?;
+    let a = open(&args.input, &args.draw, &args.machine, args.numeric)?;
     let mut b = match &against {
-        Some(spec) => {
-            let mut b = open(&spec.input, &spec.draw, &spec.machine, spec.numeric)?;
-            // the same input on both sides: say which is which
-            if b.name == a.name {
-                b.name = format!("{} (B)", b.name);
-                a.name = format!("{} (A)", a.name);
-            }
-            Some(b)
-        }
+        Some(spec) => Some(open(&spec.input, &spec.draw, &spec.machine, spec.numeric)?),
         None => None,
     };
     if let Some(b) = &b {
