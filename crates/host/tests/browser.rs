@@ -289,6 +289,20 @@ const steps = {
     await go('pixel=80,60&overlay=error&floor=1e-16');
     out.error_low_floor = differing(plain, pixels('view'));
   },
+  async frames() {
+    out.first_title = text('title');
+    await go('frame=3');
+    out.frame_title = text('title');
+    el('frame-next').click();
+    await until('the next frame', () => text('title').includes('frame 4 '));
+    out.next_hash = win().location.hash;
+    await back();
+    out.back_title = text('title');
+    await go('pixel=3,9');
+    out.pixel_title = text('title');
+    out.pixel_history_title = text('history-title');
+    out.pixel_history = text('history');
+  },
   async ab() {
     await go('pixel=32,24');
     const a = pixels('view');
@@ -469,6 +483,39 @@ fn the_address_follows_clicks_and_the_back_button_and_the_event_view_is_drawn() 
     );
     let out = harness(&bin, &dir, "f32.html#pixel=80,60", "threshold");
     assert!(out["error_default"].as_u64().unwrap() > 1000, "{out}");
+}
+
+#[test]
+fn a_page_of_frames_selects_them_by_address_and_buttons() {
+    let Some(bin) = chromium() else { return };
+    let dir = scratch("browser_frames");
+    let mut text = String::from("cwisim-trace version=1 width=8 lines=2 channels=1\n");
+    for f in 0..5 {
+        let v = (f + 1) as f64 / 16.0;
+        text += &format!(
+            "Eval2 {} 4 {v} 0.125\nRefresh\nEval1 0 8 {v}\nRefresh\n",
+            f % 4
+        );
+    }
+    std::fs::write(dir.join("five.cwt"), text).unwrap();
+    let said = cwisim_ok(
+        &dir,
+        &["inspect", "five.cwt", "--frames", "1..", "-o", "five.html"],
+    );
+    assert!(said.contains("8×2 frames 1..5"), "{said}");
+    let out = harness(&bin, &dir, "five.html", "frames");
+    let title =
+        |f: u64| format!("cwisim inspect: five.cwt (trace), frame {f} of 1..5, registers f64");
+    assert_eq!(out["first_title"], title(1));
+    assert_eq!(out["frame_title"], title(3));
+    assert_eq!(out["next_hash"], "#frame=4");
+    assert_eq!(out["back_title"], title(3));
+    assert_eq!(out["pixel_title"], title(4));
+    assert_eq!(out["pixel_history_title"], "processor 3 on scanline 9");
+    assert_eq!(
+        out["pixel_history"],
+        history(&dir, &["history", "five.cwt", "--x", "3", "--line", "9"])
+    );
 }
 
 #[test]
