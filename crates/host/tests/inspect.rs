@@ -789,6 +789,7 @@ fn bad_requests_are_refused_with_exit_2() {
     let rgb = traces().join("rgb.cwt");
     let rgb = rgb.to_str().unwrap();
     frames_trace(&dir, "five.cwt", 5);
+    frames_trace(&dir, "short.cwt", 2);
     for (args, says) in [
         (vec!["inspect", t, "-o", "x.png"], "does not end in .html"),
         (
@@ -890,6 +891,19 @@ fn bad_requests_are_refused_with_exit_2() {
         (
             vec!["inspect", t, "--against", "'unclosed", "-o", "x.html"],
             "unclosed",
+        ),
+        (
+            vec![
+                "inspect",
+                "five.cwt",
+                "--frames",
+                "1..3",
+                "--against",
+                "short.cwt",
+                "-o",
+                "x.html",
+            ],
+            "B (short.cwt): frame 2 is not in the input",
         ),
         (
             vec![

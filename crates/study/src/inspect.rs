@@ -1008,7 +1008,10 @@ pub fn inspect_pair(
         ..b.opts.clone()
     };
     let ra = gather(a.trace, a.machine, &a.opts, &plan, progress)?;
-    let rb = gather(b.trace, b.machine, &b_opts, &plan, progress)?;
+    let rb = gather(b.trace, b.machine, &b_opts, &plan, progress).map_err(|e| match e {
+        StudyError::Usage(m) => StudyError::Usage(format!("B ({}): {m}", b.opts.name)),
+        e => e,
+    })?;
     let title = format!(
         "cwisim inspect: {} against {} {}",
         a.opts.name,
