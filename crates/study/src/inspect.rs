@@ -1,18 +1,25 @@
-//! `cwisim inspect`: one frame as one self-contained HTML page to explore in a browser —
-//! the image (values on hover, overlays of the cost, the error against a reference and
-//! the late scanlines), the scanline timeline with each scanline's disassembly, and the
-//! pixel history of every pixel in a window.
+//! `cwisim inspect`: frames as one self-contained HTML page to explore in a browser — the
+//! image (values on hover, overlays of the cost, the error against a reference, the
+//! difference between two runs and the late scanlines), the scanline timeline, each
+//! scanline's events cycle by cycle (which processor each token reaches when) with its
+//! disassembly, and the pixel history of every pixel in a window.
 //!
-//! Everything the page shows is computed here, by one replay with a [`Probe`] on the
-//! cycle-stepped engine (the reference model), which steps the frame from the state the
-//! fast engine hands it after the frames before: the same figures as `cwisim stats`, the
-//! same lines as `cwisim dump` and `cwisim history`. The page's script only decodes,
+//! Everything the page shows is computed here, by one replay per run with a [`Probe`] on
+//! the cycle-stepped engine (the reference model), which steps the frames from the state
+//! the fast engine hands it after the frames before: the same figures as `cwisim stats`,
+//! the same lines as `cwisim dump` and `cwisim history`. The page's script only decodes,
 //! draws and looks up; it simulates nothing.
 //!
+//! A page holds one run ([`inspect`]) or two of the same dimensions, A and B
+//! ([`inspect_pair`]: two traces, or one scene drawn two ways), of one frame or a range
+//! of frames ([`Options::frames`]), within [`MAX_FRAME_PIXELS`], [`MAX_PAGE_FRAMES`],
+//! [`MAX_HISTORY_PIXELS`] and [`MAX_PAGE_BYTES`], all checked before the replay but the
+//! last.
+//!
 //! The data is embedded as JSON with the large arrays as base64 of zlib streams
-//! (little-endian `f64` values, `u32` counts and indices, text joined by newlines), which
-//! the browser inflates with its own `DecompressionStream`. The same input gives the same
-//! bytes.
+//! (little-endian `f64` values, `u32` counts and indices, bytes, text joined by
+//! newlines), which the browser inflates with its own `DecompressionStream`. The same
+//! input gives the same bytes.
 
 use crate::cost::{viridis, CostMap, CostReader};
 use crate::error::StudyError;
@@ -20,31 +27,44 @@ use crate::history::{state, values, Visit};
 use crate::plot::{group_cycles, issue_costs, GROUPS, OVERRUN};
 use crate::until::UntilLine;
 use cwisim_isa::text::format_instruction;
-use cwisim_isa::{Instruction, Opcode, TraceRead};
+use cwisim_isa::{Instruction, Opcode, OperandKind, TraceHeader, TraceRead};
 use cwisim_xproc::{
-    replay_probed_numeric, LineOut, LineSink, Machine, Numeric, Probe, ProcessorState, StepFrom,
+    replay_probed_numeric, FixedFormat, LineOut, LineSink, Machine, Numeric, Probe, ProcessorState,
+    Register, StepFrom, Q,
 };
+use serde_json::{json, Value};
 use std::collections::{HashMap, VecDeque};
 use std::io::Write;
 
 /// The page's template: HTML, CSS and script, with the data put in at `__CWISIM_DATA__`.
 const TEMPLATE: &str = include_str!("inspect.html");
 
-/// The largest frame a page holds, in pixels (2048 × 2048): beyond it the page would be
-/// hundreds of MB, which browsers load slowly or not at all.
+/// The most pixels a page's images hold, every frame of every run together, in pixels
+/// (2048 × 2048): beyond it the page would be hundreds of MB, which browsers load slowly
+/// or not at all.
 pub const MAX_FRAME_PIXELS: u64 = 1 << 22;
 
-/// The most pixels whose history a page holds (512 × 512 = 262,144). A larger frame gets
-/// histories for a window only (the default: [`DEFAULT_WINDOW`] pixels square around the
-/// centre; `--x` and `--lines` choose another); a larger window is refused.
+/// The most frames a page holds (of each run).
+pub const MAX_PAGE_FRAMES: u64 = 64;
+
+/// The most pixels whose history a page holds, every frame of every run together (512 ×
+/// 512 = 262,144). Without `--x` and `--lines`, each frame gets histories for all its
+/// pixels when its share of this fits, else for a square around its centre of at most
+/// [`DEFAULT_WINDOW`] pixels a side ([`default_window_in`]); a larger window is refused.
 pub const MAX_HISTORY_PIXELS: u64 = 1 << 18;
 
-/// The side of the default history window of a frame larger than [`MAX_HISTORY_PIXELS`].
+/// The side of the default history window of a frame larger than its share of
+/// [`MAX_HISTORY_PIXELS`].
 pub const DEFAULT_WINDOW: u64 = 256;
 
 /// The largest page written, in bytes (128 MiB): a bigger one is refused, naming the
 /// options that make it smaller.
 pub const MAX_PAGE_BYTES: usize = 128 << 20;
+
+/// Where the error and difference overlays' scale starts: a pixel whose largest
+/// difference over its channels is below it is not coloured (rounding in `f64`, about
+/// `1e-14`, stays invisible). The page has a control for it.
+pub const ERROR_FLOOR: f64 = 1e-12;
 
 /// The pixels whose histories the page holds: processors `x.0..x.1`, scanlines
 /// `lines.0..lines.1` (counted over the whole trace), both ends excluded.
@@ -67,24 +87,48 @@ impl Window {
     }
 }
 
-/// What to put on the page besides what the replay measures.
-#[derive(Clone, Debug, Default)]
+/// What to put on the page besides what the replay measures: one run's.
+#[derive(Clone, Debug)]
 pub struct Options<'a> {
     /// The input's name, shown as the title.
     pub name: &'a str,
     /// `"trace"` or `"scene"`.
     pub kind: &'a str,
-    /// The frame, from 0.
-    pub frame: u64,
-    /// The history window; `None`: the whole frame, or the default window of a big one.
+    /// The frames, `[first, end)`, from 0: at most [`MAX_PAGE_FRAMES`], their pixels
+    /// (times the runs) at most [`MAX_FRAME_PIXELS`]. A page of two runs takes the
+    /// first's.
+    pub frames: (u64, u64),
+    /// The history window, scanlines over the whole trace within the frames (a window
+    /// over several frames holds each frame's part); `None`: each frame's default
+    /// ([`default_window_in`]). A page of two runs takes the first's.
     pub window: Option<Window>,
     /// The render summary (a scene's), shown at the top.
     pub summary: Option<&'a str>,
-    /// The reference image of the frame (`lines × width × channels`) with what it is,
-    /// for the error overlay.
+    /// The reference image of the frames (`frames × lines × width × channels`) with what
+    /// it is, for the error overlay.
     pub reference: Option<(&'a [f64], &'a str)>,
-    /// The array's registers (the histories show their values).
+    /// The array's registers (the histories show their values; in fixed point also the
+    /// raw integers).
     pub numeric: Numeric,
+    /// The input as given and the flags that make it what the page shows (drawing flags,
+    /// `--numeric`, `--machine`, `--set`, as given): the page suggests
+    /// `cwisim history REPRODUCE… --x X --line Y` for a clicked pixel. Empty: the name.
+    pub reproduce: &'a [String],
+}
+
+impl Default for Options<'_> {
+    fn default() -> Self {
+        Options {
+            name: "",
+            kind: "trace",
+            frames: (0, 1),
+            window: None,
+            summary: None,
+            reference: None,
+            numeric: Numeric::F64,
+            reproduce: &[],
+        }
+    }
 }
 
 /// A written page and what it holds.
@@ -92,14 +136,17 @@ pub struct Options<'a> {
 pub struct Page {
     /// The HTML.
     pub html: String,
-    /// The pixels with histories.
-    pub window: Window,
-    /// Scanlines of the frame.
+    /// The frames, `[first, end)`.
+    pub frames: (u64, u64),
+    /// The pixels with histories: one window per frame that has any (the same in every
+    /// run), in order.
+    pub windows: Vec<Window>,
+    /// Scanlines of a frame.
     pub lines: u64,
     /// Its width.
     pub width: u64,
-    /// Late scanlines of the frame.
-    pub late_lines: u64,
+    /// Late scanlines over the frames, per run.
+    pub late_lines: Vec<u64>,
 }
 
 /// One line of `cwisim dump`: the instruction, its number, scanline and bus cycles.
@@ -111,23 +158,31 @@ pub fn dump_line(index: u64, line: u64, issue: u64, enter: u64, instr: &Instruct
 }
 
 /// The default history window of a frame `width` wide, of scanlines
-/// `first..first + lines`: all of it up to [`MAX_HISTORY_PIXELS`], else a
-/// [`DEFAULT_WINDOW`]-sided square around the centre.
+/// `first..first + lines`, when the frame is the page's only one: all of it up to
+/// [`MAX_HISTORY_PIXELS`], else a [`DEFAULT_WINDOW`]-sided square around the centre.
 pub fn default_window(width: u64, first: u64, lines: u64) -> Window {
-    if width * lines <= MAX_HISTORY_PIXELS {
+    default_window_in(width, first, lines, MAX_HISTORY_PIXELS)
+}
+
+/// The default history window of a frame with `budget` history pixels (its share of
+/// [`MAX_HISTORY_PIXELS`] among the page's frames and runs): all of it when it fits, else
+/// a square around the centre of at most [`DEFAULT_WINDOW`] pixels a side that fits.
+pub fn default_window_in(width: u64, first: u64, lines: u64, budget: u64) -> Window {
+    if width * lines <= budget {
         return Window {
             x: (0, width),
             lines: (first, first + lines),
         };
     }
-    let side = |n: u64| {
-        let w = n.min(DEFAULT_WINDOW);
+    let side = DEFAULT_WINDOW.min(budget.isqrt()).max(1);
+    let centre = |n: u64| {
+        let w = n.min(side);
         let a = (n - w) / 2;
         (a, a + w)
     };
-    let (y0, y1) = side(lines);
+    let (y0, y1) = centre(lines);
     Window {
-        x: side(width),
+        x: centre(width),
         lines: (first + y0, first + y1),
     }
 }
@@ -153,7 +208,7 @@ impl Strings {
 
 /// The visits `cwisim history` lists, as columns: the instruction's number and the
 /// cycle its token arrived, what it amounted to ([`NOTES`]), the states before and after
-/// (numbers of strings).
+/// (numbers of strings), and in fixed point the same states as raw integers.
 #[derive(Default)]
 struct Visits {
     index: Vec<f64>,
@@ -161,6 +216,8 @@ struct Visits {
     note: Vec<u8>,
     before: Vec<u32>,
     after: Vec<u32>,
+    before_raw: Vec<u32>,
+    after_raw: Vec<u32>,
 }
 
 /// What a visit amounted to, numbered on the page (0: a plain action).
@@ -174,28 +231,97 @@ pub const NOTES: [&str; 3] = [
 struct Pixel {
     visits: Vec<u32>,
     hidden: u32,
-    shifted: Option<u32>,
+    shifted: Option<(u32, u32)>,
 }
 
-/// The probe: every instruction of the frame with its cycles, and every visit to a pixel
-/// of the window.
-struct Collector {
-    frame: (u64, u64),
-    window: Window,
-    pending: VecDeque<(u64, u64, u64, Instruction)>,
+/// Which processors an opcode's instruction names, as the page's event view draws it:
+/// `"range"` `[x, x + dx)`, `"one"` processor `x`, `"periodic"` `x, x + dx, …`, `"all"`,
+/// `"none"` (`Nop`).
+pub fn reach(op: Opcode) -> &'static str {
+    let kinds = op.operands();
+    if kinds.contains(&OperandKind::Count) {
+        "range"
+    } else if kinds.contains(&OperandKind::Period) {
+        "periodic"
+    } else if kinds.contains(&OperandKind::X) {
+        "one"
+    } else if op == Opcode::Nop {
+        "none"
+    } else {
+        "all"
+    }
+}
+
+/// A fixed-point register's value as its raw integer, `value · 2^N`; marked `≈` when the
+/// register is wider than an `f64`'s 53 bits and the value may have been rounded on its
+/// way out.
+pub fn raw_value(v: f64, q: Q) -> String {
+    let r = v * (q.frac_bits as f64).exp2();
+    if !(r.is_finite() && r.fract() == 0.0 && r.abs() < 63f64.exp2()) {
+        return format!("≈{r}");
+    }
+    let exact = q.width() <= 53 || r.abs() <= 53f64.exp2();
+    format!("{}{}", if exact { "" } else { "≈" }, r as i64)
+}
+
+fn raw_values(v: &[f64], q: Q) -> String {
+    v.iter()
+        .map(|x| raw_value(*x, q))
+        .collect::<Vec<_>>()
+        .join(",")
+}
+
+/// The registers of [`state`] as raw integers of their fixed-point formats:
+/// `acc=… I=… dI=… ddI=…` (`-` for a preload register holding no value).
+pub fn raw_state(s: &ProcessorState, f: &FixedFormat) -> String {
+    let reg = |k: usize| {
+        if s.has[k] {
+            raw_values(&s.reg[k], f.q(Register::of_slot(k)))
+        } else {
+            "-".to_string()
+        }
+    };
+    format!(
+        "acc={} I={} dI={} ddI={}",
+        raw_values(&s.acc, f.acc),
+        reg(0),
+        reg(1),
+        reg(2)
+    )
+}
+
+/// What the probe keeps of one frame: its instructions with their cycles and operands,
+/// and the visits to the pixels of its window.
+#[derive(Default)]
+struct FrameLog {
     first_index: Option<u64>,
     texts: Vec<String>,
     issue: Vec<f64>,
     enter: Vec<f64>,
-    dump_lines: Vec<u64>,
+    lines: Vec<u64>,
+    ops: Vec<u8>,
+    xs: Vec<u32>,
+    dxs: Vec<u32>,
+    window: Option<Window>,
     pixels: Vec<Pixel>,
     visits: Visits,
     strings: Strings,
 }
 
+/// The probe: every instruction of the frames with its cycles, and every visit to a pixel
+/// of a window.
+struct Collector {
+    lines: (u64, u64),
+    per_frame: u64,
+    x: (u64, u64),
+    pending: VecDeque<(u64, u64, u64, Instruction)>,
+    frames: Vec<FrameLog>,
+    fixed: Option<FixedFormat>,
+}
+
 impl Probe for Collector {
     fn watches(&self, p: usize) -> bool {
-        (self.window.x.0..self.window.x.1).contains(&(p as u64))
+        (self.x.0..self.x.1).contains(&(p as u64))
     }
 
     fn issue(&mut self, cycle: u64, index: u64, line: u64, instr: &Instruction) {
@@ -206,12 +332,16 @@ impl Probe for Collector {
         let Some((index, line, issue, instr)) = self.pending.pop_front() else {
             return;
         };
-        if (self.frame.0..self.frame.1).contains(&line) {
-            self.first_index.get_or_insert(index);
-            self.texts.push(format_instruction(&instr));
-            self.issue.push(issue as f64);
-            self.enter.push(cycle as f64);
-            self.dump_lines.push(line);
+        if (self.lines.0..self.lines.1).contains(&line) {
+            let f = &mut self.frames[((line - self.lines.0) / self.per_frame) as usize];
+            f.first_index.get_or_insert(index);
+            f.texts.push(format_instruction(&instr));
+            f.issue.push(issue as f64);
+            f.enter.push(cycle as f64);
+            f.lines.push(line);
+            f.ops.push(instr.op.index() as u8);
+            f.xs.push(instr.x);
+            f.dxs.push(instr.dx);
         }
     }
 
@@ -227,13 +357,20 @@ impl Probe for Collector {
         after: &ProcessorState,
     ) {
         let x = p as u64;
-        if !self.window.contains(x, line) {
+        if !(self.lines.0..self.lines.1).contains(&line) {
             return;
         }
-        let w = self.window.x.1 - self.window.x.0;
-        let k = ((line - self.window.lines.0) * w + (x - self.window.x.0)) as usize;
+        let fixed = self.fixed;
+        let f = &mut self.frames[((line - self.lines.0) / self.per_frame) as usize];
+        let Some(window) = f.window.filter(|w| w.contains(x, line)) else {
+            return;
+        };
+        let w = window.x.1 - window.x.0;
+        let k = ((line - window.lines.0) * w + (x - window.x.0)) as usize;
         if instr.op == Opcode::Refresh {
-            self.pixels[k].shifted = Some(self.strings.id(values(&before.acc)));
+            let shown = f.strings.id(values(&before.acc));
+            let raw = fixed.map_or(u32::MAX, |q| f.strings.id(raw_values(&before.acc, q.acc)));
+            f.pixels[k].shifted = Some((shown, raw));
         }
         if addressed || before != after {
             let v = Visit {
@@ -247,24 +384,30 @@ impl Probe for Collector {
             let note = v.note().map_or(0, |n| {
                 1 + NOTES.iter().position(|&m| m == n).expect("a known note") as u8
             });
-            let at = self.visits.index.len() as u32;
-            self.visits.index.push(index as f64);
-            self.visits.cycle.push(cycle as f64);
-            self.visits.note.push(note);
-            let b = self.strings.id(state(before));
-            let a = self.strings.id(state(after));
-            self.visits.before.push(b);
-            self.visits.after.push(a);
-            self.pixels[k].visits.push(at);
+            let at = f.visits.index.len() as u32;
+            f.visits.index.push(index as f64);
+            f.visits.cycle.push(cycle as f64);
+            f.visits.note.push(note);
+            let b = f.strings.id(state(before));
+            let a = f.strings.id(state(after));
+            f.visits.before.push(b);
+            f.visits.after.push(a);
+            if let Some(q) = fixed {
+                let b = f.strings.id(raw_state(before, &q));
+                let a = f.strings.id(raw_state(after, &q));
+                f.visits.before_raw.push(b);
+                f.visits.after_raw.push(a);
+            }
+            f.pixels[k].visits.push(at);
         } else {
-            self.pixels[k].hidden += 1;
+            f.pixels[k].hidden += 1;
         }
     }
 }
 
-/// The frame's image, as the array shifts it out.
+/// The frames' image, as the array shifts it out.
 struct FrameImage {
-    frame: (u64, u64),
+    lines: (u64, u64),
     width: usize,
     channels: usize,
     data: Vec<f64>,
@@ -272,10 +415,10 @@ struct FrameImage {
 
 impl LineSink<f64> for FrameImage {
     fn line(&mut self, line: LineOut<'_, f64>) {
-        if !(self.frame.0..self.frame.1).contains(&line.index) {
+        if !(self.lines.0..self.lines.1).contains(&line.index) {
             return;
         }
-        let row = (line.index - self.frame.0) as usize * self.width * self.channels;
+        let row = (line.index - self.lines.0) as usize * self.width * self.channels;
         let start = row + line.span.0 * self.channels;
         self.data[start..start + line.values.len()].copy_from_slice(line.values);
     }
@@ -387,22 +530,416 @@ fn html_escape(s: &str) -> String {
 /// Refuses a frame over [`MAX_FRAME_PIXELS`] (callers that draw a scene check before
 /// drawing it).
 pub fn check_frame(width: u64, lines: u64) -> Result<(), StudyError> {
-    if width * lines > MAX_FRAME_PIXELS {
+    check_frames(width, lines, 1, 1)
+}
+
+/// Refuses a page of `frames` frames `width` × `lines` in each of `runs` runs over
+/// [`MAX_PAGE_FRAMES`] or [`MAX_FRAME_PIXELS`], naming how many frames fit.
+pub fn check_frames(width: u64, lines: u64, frames: u64, runs: u64) -> Result<(), StudyError> {
+    let one = width * lines;
+    if one > MAX_FRAME_PIXELS {
         return Err(StudyError::Usage(format!(
-            "a frame of {width}×{lines} = {} pixels is over the page's limit of {MAX_FRAME_PIXELS} (2048×2048): \
-a browser could not open the page; study it with `cwisim stats`, `dump` and `history`",
-            width * lines
+            "a frame of {width}×{lines} = {one} pixels is over the page's limit of {MAX_FRAME_PIXELS} (2048×2048): \
+a browser could not open the page; study it with `cwisim stats`, `dump` and `history`"
+        )));
+    }
+    if frames > MAX_PAGE_FRAMES {
+        return Err(StudyError::Usage(format!(
+            "{frames} frames are more than a page holds ({MAX_PAGE_FRAMES}); choose fewer with --frames A..B"
+        )));
+    }
+    let total = one * frames * runs;
+    if total > MAX_FRAME_PIXELS {
+        let fit = MAX_FRAME_PIXELS / (one * runs);
+        let of_runs = if runs > 1 { " in each of two runs" } else { "" };
+        return Err(StudyError::Usage(format!(
+            "{frames} frames of {width}×{lines}{of_runs} are {total} pixels, over the page's limit of \
+{MAX_FRAME_PIXELS} (2048×2048): it holds {fit} such frame(s); choose fewer with --frames A..B"
         )));
     }
     Ok(())
 }
 
-/// Replays `trace` up to the end of frame `opts.frame` and builds the page: the frames
-/// before on the fast engine, the frame on the cycle-stepped engine from the fast
+/// `frame N` or `frames A..B`.
+fn frames_text((a, b): (u64, u64)) -> String {
+    if b == a + 1 {
+        format!("frame {a}")
+    } else {
+        format!("frames {a}..{b}")
+    }
+}
+
+/// What a page holds, decided before any replay.
+struct Plan {
+    width: u64,
+    lines: u64,
+    channels: usize,
+    frames: (u64, u64),
+    /// The frames' scanlines over the whole trace, `[start, end)`.
+    span: (u64, u64),
+    /// Each frame's history window.
+    windows: Vec<Option<Window>>,
+}
+
+/// Checks the request against the limits and the header, and chooses the windows.
+fn plan(header: &TraceHeader, opts: &Options<'_>, runs: u64) -> Result<Plan, StudyError> {
+    let width = u64::from(header.width);
+    let lines = u64::from(header.lines);
+    let (f0, f1) = opts.frames;
+    if f1 <= f0 {
+        return Err(StudyError::Usage(format!(
+            "the frames {f0}..{f1} are none: give at least one"
+        )));
+    }
+    let n = f1 - f0;
+    check_frames(width, lines, n, runs)?;
+    let beyond = || StudyError::Usage(format!("frame {f1} is beyond any trace"));
+    let span = (
+        f0.checked_mul(lines).ok_or_else(beyond)?,
+        f1.checked_mul(lines).ok_or_else(beyond)?,
+    );
+    let windows = match opts.window {
+        Some(w) => {
+            if w.x.0 >= w.x.1
+                || w.x.1 > width
+                || w.lines.0 < span.0
+                || w.lines.1 > span.1
+                || w.lines.0 >= w.lines.1
+            {
+                return Err(StudyError::Usage(format!(
+                    "the history window (processors {}..{}, scanlines {}..{}) is not inside {} \
+(processors 0..{width}, scanlines {}..{})",
+                    w.x.0,
+                    w.x.1,
+                    w.lines.0,
+                    w.lines.1,
+                    frames_text(opts.frames),
+                    span.0,
+                    span.1
+                )));
+            }
+            let limit = MAX_HISTORY_PIXELS / runs;
+            if w.pixels() > limit {
+                let shared = if runs > 1 {
+                    ", shared by the two runs"
+                } else {
+                    ""
+                };
+                return Err(StudyError::Usage(format!(
+                    "the history window holds {} pixels, over the limit of {limit} (512×512{shared}); \
+choose a smaller one with --x and --lines",
+                    w.pixels()
+                )));
+            }
+            (f0..f1)
+                .map(|f| {
+                    let (a, b) = (w.lines.0.max(f * lines), w.lines.1.min((f + 1) * lines));
+                    (a < b).then_some(Window {
+                        x: w.x,
+                        lines: (a, b),
+                    })
+                })
+                .collect()
+        }
+        None => {
+            let budget = MAX_HISTORY_PIXELS / (n * runs);
+            (f0..f1)
+                .map(|f| Some(default_window_in(width, f * lines, lines, budget)))
+                .collect()
+        }
+    };
+    Ok(Plan {
+        width,
+        lines,
+        channels: header.channel_count(),
+        frames: opts.frames,
+        span,
+        windows,
+    })
+}
+
+/// One run's part of the page.
+struct RunData {
+    json: Value,
+    late: u64,
+}
+
+/// A word for a POSIX shell: as it is when it needs no quoting, else in single quotes.
+pub fn shell_word(s: &str) -> String {
+    let plain = !s.is_empty()
+        && s.chars().all(|c| {
+            c.is_ascii_alphanumeric()
+                || matches!(c, '_' | '.' | '/' | ':' | '=' | ',' | '+' | '@' | '%' | '-')
+        });
+    if plain {
+        s.to_string()
+    } else {
+        format!("'{}'", s.replace('\'', "'\\''"))
+    }
+}
+
+/// `cwisim history` with the input and the flags that make it the run on the page: the
+/// page appends `--x X --line Y`.
+fn history_command(opts: &Options<'_>) -> String {
+    let words: Vec<String> = if opts.reproduce.is_empty() {
+        vec![shell_word(opts.name)]
+    } else {
+        opts.reproduce.iter().map(|w| shell_word(w)).collect()
+    };
+    format!("cwisim history {}", words.join(" "))
+}
+
+/// The fixed-point formats as `[M, N]` per register, for the page.
+fn formats_json(numeric: &Numeric) -> Value {
+    match numeric {
+        Numeric::Fixed(f) => {
+            let q = |q: Q| json!([q.int_bits, q.frac_bits]);
+            json!({
+                "I": q(f.i), "dI": q(f.di), "ddI": q(f.ddi), "acc": q(f.acc),
+                "overflow": f.overflow.to_string(),
+            })
+        }
+        _ => Value::Null,
+    }
+}
+
+/// Replays one run over the plan's frames and gathers its part of the page.
+fn gather(
+    trace: &mut dyn TraceRead,
+    machine: &Machine,
+    opts: &Options<'_>,
+    plan: &Plan,
+    progress: &mut dyn FnMut(u64),
+) -> Result<RunData, StudyError> {
+    let header = *trace.header();
+    let (width, lines, channels) = (plan.width, plan.lines, plan.channels);
+    let n = plan.frames.1 - plan.frames.0;
+    let frame_values = (width * lines) as usize * channels;
+    if let Some((r, _)) = opts.reference {
+        if r.len() != frame_values * n as usize {
+            return Err(StudyError::Usage(format!(
+                "the reference image holds {} values, the {} {n}×{width}×{lines}×{channels}",
+                r.len(),
+                if n == 1 { "frame" } else { "frames" }
+            )));
+        }
+    }
+    let x = plan
+        .windows
+        .iter()
+        .flatten()
+        .map(|w| w.x)
+        .next()
+        .unwrap_or((0, 0));
+    let mut collector = Collector {
+        lines: plan.span,
+        per_frame: lines,
+        x,
+        pending: VecDeque::new(),
+        frames: plan
+            .windows
+            .iter()
+            .map(|w| FrameLog {
+                window: *w,
+                pixels: vec![Pixel::default(); w.map_or(0, |w| w.pixels() as usize)],
+                ..FrameLog::default()
+            })
+            .collect(),
+        fixed: match opts.numeric {
+            Numeric::Fixed(f) => Some(f),
+            _ => None,
+        },
+    };
+    let mut image = FrameImage {
+        lines: plan.span,
+        width: width as usize,
+        channels,
+        data: vec![0.0; frame_values * n as usize],
+    };
+    let mut cost = CostMap::new(width as usize);
+    let (stats, read) = {
+        let mut until = UntilLine::new(trace, Some(plan.span.1 - 1));
+        let stats = {
+            let mut reader = CostReader::new(&mut until, &mut cost);
+            replay_probed_numeric(
+                &mut reader,
+                machine,
+                &opts.numeric,
+                StepFrom::Scanline(plan.span.0),
+                &mut collector,
+                &mut image,
+                progress,
+            )?
+        };
+        (stats, until.lines_read())
+    };
+    if read < plan.span.1 {
+        let whole = read / lines;
+        return Err(StudyError::Usage(format!(
+            "frame {} is not in the input: it outputs {read} scanline(s), {whole} whole frame(s) of {lines}",
+            whole.max(plan.frames.0)
+        )));
+    }
+    cost.check()?;
+
+    let timeline_m = machine.timeline(&header)?;
+    let op_cost = issue_costs(&timeline_m);
+    let mut late = 0;
+    let mut frames = Vec::with_capacity(n as usize);
+    for (fi, log) in collector.frames.into_iter().enumerate() {
+        let frame = plan.frames.0 + fi as u64;
+        let first = frame * lines;
+        let recs: Vec<_> = stats
+            .lines
+            .iter()
+            .filter(|l| (first..first + lines).contains(&l.line))
+            .collect();
+        late += recs.iter().filter(|l| l.slack < 0).count() as u64;
+        let costs: Vec<u32> = (first..first + lines)
+            .flat_map(|l| cost.row(l as usize).iter().copied())
+            .collect();
+        let values = &image.data[fi * frame_values..(fi + 1) * frame_values];
+        let reference = opts
+            .reference
+            .map(|(r, _)| &r[fi * frame_values..(fi + 1) * frame_values]);
+        frames.push(frame_json(
+            frame,
+            first,
+            lines,
+            log,
+            values,
+            reference,
+            &costs,
+            &recs,
+            &op_cost,
+            collector.fixed.is_some(),
+        ));
+    }
+    let json = json!({
+        "name": opts.name,
+        "kind": opts.kind,
+        "numeric": opts.numeric.to_string(),
+        "formats": formats_json(&opts.numeric),
+        "summary": opts.summary,
+        "reference_name": opts.reference.map(|(_, n)| n),
+        "reproduce": opts.reproduce,
+        "history_command": history_command(opts),
+        "line_period": stats.line_period,
+        "hop": machine.hop_cycles,
+        "op_cost": op_cost.to_vec(),
+        "frames": frames,
+    });
+    Ok(RunData { json, late })
+}
+
+/// One frame of one run: the image, the costs, the timeline, the disassembly with each
+/// instruction's cycles and operands, and the histories of its window.
+#[allow(clippy::too_many_arguments)]
+fn frame_json(
+    frame: u64,
+    first: u64,
+    lines: u64,
+    log: FrameLog,
+    image: &[f64],
+    reference: Option<&[f64]>,
+    costs: &[u32],
+    recs: &[&cwisim_xproc::LineStats],
+    op_cost: &[u64; Opcode::COUNT],
+    fixed: bool,
+) -> Value {
+    let mut groups = Vec::new();
+    for l in recs {
+        groups.extend(group_cycles(l, op_cost).iter().map(|&c| c as f64));
+    }
+    let col = |f: &dyn Fn(&cwisim_xproc::LineStats) -> f64| -> Vec<f64> {
+        recs.iter().map(|l| f(l)).collect()
+    };
+
+    // the disassembly, by scanline
+    let mut line_start = vec![0u32; lines as usize + 1];
+    for &l in &log.lines {
+        line_start[(l - first) as usize + 1] += 1;
+    }
+    for k in 0..lines as usize {
+        line_start[k + 1] += line_start[k];
+    }
+
+    let history = log.window.map(|window| {
+        // per pixel its visits (consecutive), the value shifted out and how many visits
+        // it left out
+        let mut starts = Vec::with_capacity(log.pixels.len() + 1);
+        let mut order: Vec<u32> = Vec::with_capacity(log.visits.index.len());
+        let mut shifted = Vec::with_capacity(log.pixels.len());
+        let mut shifted_raw = Vec::with_capacity(log.pixels.len());
+        let mut hidden = Vec::with_capacity(log.pixels.len());
+        starts.push(0u32);
+        for p in &log.pixels {
+            order.extend(&p.visits);
+            starts.push(order.len() as u32);
+            shifted.push(p.shifted.map_or(u32::MAX, |s| s.0));
+            shifted_raw.push(p.shifted.map_or(u32::MAX, |s| s.1));
+            hidden.push(p.hidden);
+        }
+        let v = &log.visits;
+        let pick_f = |c: &[f64]| order.iter().map(|&k| c[k as usize]).collect::<Vec<_>>();
+        let pick_u = |c: &[u32]| order.iter().map(|&k| c[k as usize]).collect::<Vec<_>>();
+        let notes: Vec<u8> = order.iter().map(|&k| v.note[k as usize]).collect();
+        json!({
+            "x": [window.x.0, window.x.1],
+            "lines": [window.lines.0, window.lines.1],
+            "strings": text_blob(&log.strings.list),
+            "starts": u32_blob(&starts),
+            "shifted": u32_blob(&shifted),
+            "hidden": u32_blob(&hidden),
+            "visit_index": f64_blob(&pick_f(&v.index)),
+            "visit_cycle": f64_blob(&pick_f(&v.cycle)),
+            "visit_note": blob(&notes),
+            "visit_before": u32_blob(&pick_u(&v.before)),
+            "visit_after": u32_blob(&pick_u(&v.after)),
+            "raw": fixed.then(|| json!({
+                "before": u32_blob(&pick_u(&v.before_raw)),
+                "after": u32_blob(&pick_u(&v.after_raw)),
+                "shifted": u32_blob(&shifted_raw),
+            })),
+        })
+    });
+    json!({
+        "frame": frame,
+        "first_line": first,
+        "image": f64_blob(image),
+        "reference": reference.map(f64_blob),
+        "cost": u32_blob(costs),
+        "timeline": {
+            "cycles": groups,
+            "busy": col(&|l| l.busy_cycles as f64),
+            "stall": col(&|l| l.stall_cycles as f64),
+            "instructions": col(&|l| l.instructions as f64),
+            "updates": col(&|l| l.processor_updates as f64),
+            "first_issue": col(&|l| l.first_issue as f64),
+            "ready": col(&|l| l.ready as f64),
+            "deadline": col(&|l| l.deadline as f64),
+            "slack": col(&|l| l.slack as f64),
+        },
+        "dump": {
+            "first_index": log.first_index.unwrap_or(0),
+            "text": text_blob(&log.texts),
+            "issue": f64_blob(&log.issue),
+            "enter": f64_blob(&log.enter),
+            "op": blob(&log.ops),
+            "x": u32_blob(&log.xs),
+            "dx": u32_blob(&log.dxs),
+            "line_start": line_start,
+        },
+        "history": history,
+    })
+}
+
+/// Replays `trace` up to the end of the frames `opts.frames` and builds the page: the
+/// frames before on the fast engine, the frames on the cycle-stepped engine from the fast
 /// engine's state ([`cwisim_xproc::replay_probed_from`]). Refuses (as
-/// [`StudyError::Usage`]) a frame beyond the trace, a frame over [`MAX_FRAME_PIXELS`], a
-/// window outside the frame or over [`MAX_HISTORY_PIXELS`], and a page over
-/// [`MAX_PAGE_BYTES`].
+/// [`StudyError::Usage`]) a frame beyond the trace, frames over [`MAX_PAGE_FRAMES`] or
+/// [`MAX_FRAME_PIXELS`], a window outside the frames or over [`MAX_HISTORY_PIXELS`], and
+/// a page over [`MAX_PAGE_BYTES`].
 pub fn inspect(
     trace: &mut dyn TraceRead,
     machine: &Machine,
@@ -419,140 +956,73 @@ pub fn inspect_with_progress(
     opts: &Options<'_>,
     progress: &mut dyn FnMut(u64),
 ) -> Result<Page, StudyError> {
-    let header = *trace.header();
-    let width = u64::from(header.width);
-    let lines = u64::from(header.lines);
-    let channels = header.channel_count();
-    check_frame(width, lines)?;
-    let first = opts
-        .frame
-        .checked_mul(lines)
-        .ok_or_else(|| StudyError::Usage(format!("frame {} is beyond any trace", opts.frame)))?;
-    let frame = (first, first + lines);
-    let window = match opts.window {
-        Some(w) => w,
-        None => default_window(width, first, lines),
-    };
-    if window.x.0 >= window.x.1
-        || window.x.1 > width
-        || window.lines.0 < frame.0
-        || window.lines.1 > frame.1
-        || window.lines.0 >= window.lines.1
-    {
-        return Err(StudyError::Usage(format!(
-            "the history window (processors {}..{}, scanlines {}..{}) is not inside frame {} \
-(processors 0..{width}, scanlines {}..{})",
-            window.x.0, window.x.1, window.lines.0, window.lines.1, opts.frame, frame.0, frame.1
-        )));
-    }
-    if window.pixels() > MAX_HISTORY_PIXELS {
-        return Err(StudyError::Usage(format!(
-            "the history window holds {} pixels, over the limit of {MAX_HISTORY_PIXELS} (512×512); \
-choose a smaller one with --x and --lines",
-            window.pixels()
-        )));
-    }
-    if let Some((r, _)) = opts.reference {
-        if r.len() as u64 != width * lines * channels as u64 {
-            return Err(StudyError::Usage(format!(
-                "the reference image holds {} values, the frame {width}×{lines}×{channels}",
-                r.len()
-            )));
-        }
-    }
+    let plan = plan(trace.header(), opts, 1)?;
+    let run = gather(trace, machine, opts, &plan, progress)?;
+    let title = format!("cwisim inspect: {} {}", opts.name, frames_text(plan.frames));
+    assemble(&plan, vec![run], &title)
+}
 
-    let mut collector = Collector {
-        frame,
-        window,
-        pending: VecDeque::new(),
-        first_index: None,
-        texts: Vec::new(),
-        issue: Vec::new(),
-        enter: Vec::new(),
-        dump_lines: Vec::new(),
-        visits: Visits::default(),
-        pixels: vec![Pixel::default(); window.pixels() as usize],
-        strings: Strings::default(),
-    };
-    let mut image = FrameImage {
-        frame,
-        width: width as usize,
-        channels,
-        data: vec![0.0; (width * lines) as usize * channels],
-    };
-    let mut cost = CostMap::new(width as usize);
-    let (stats, read) = {
-        let mut until = UntilLine::new(trace, Some(frame.1 - 1));
-        let stats = {
-            let mut reader = CostReader::new(&mut until, &mut cost);
-            replay_probed_numeric(
-                &mut reader,
-                machine,
-                &opts.numeric,
-                StepFrom::Scanline(first),
-                &mut collector,
-                &mut image,
-                progress,
-            )?
+/// One run of an A/B page: its input, machine and options.
+pub struct Run<'a, 'b> {
+    /// The trace (or a scene's stream).
+    pub trace: &'b mut dyn TraceRead,
+    /// The machine model.
+    pub machine: &'b Machine,
+    /// The run's options; the frames and the window are the first run's.
+    pub opts: Options<'a>,
+}
+
+/// An A/B page: two runs of the same dimensions (two traces, or one scene drawn two
+/// ways) over the same frames, each with everything [`inspect`] gathers, and on the page
+/// a toggle between them and an overlay of their difference. Refuses runs of different
+/// width, lines or channels before replaying either; the limits hold for both together
+/// (each run has half of [`MAX_HISTORY_PIXELS`]).
+pub fn inspect_pair(
+    a: Run<'_, '_>,
+    b: Run<'_, '_>,
+    progress: &mut dyn FnMut(u64),
+) -> Result<Page, StudyError> {
+    let (ha, hb) = (*a.trace.header(), *b.trace.header());
+    let dims = |h: &TraceHeader| (h.width, h.lines, h.channel_count());
+    if dims(&ha) != dims(&hb) {
+        let text = |h: &TraceHeader| {
+            format!(
+                "{}×{} with {} channel(s)",
+                h.width,
+                h.lines,
+                h.channel_count()
+            )
         };
-        (stats, until.lines_read())
-    };
-    if read < frame.1 {
-        let frames = read / lines;
         return Err(StudyError::Usage(format!(
-            "frame {} is not in the input: it outputs {read} scanline(s), {frames} whole frame(s) of {lines}",
-            opts.frame
+            "A ({}) is {} but B ({}) is {}: an A/B page compares runs of the same dimensions",
+            a.opts.name,
+            text(&ha),
+            b.opts.name,
+            text(&hb)
         )));
     }
-    cost.check()?;
-    let costs: Vec<u32> = (frame.0..frame.1)
-        .flat_map(|l| cost.row(l as usize).iter().copied())
-        .collect();
-
-    // the timeline: the frame's scanline records
-    let timeline_m = machine.timeline(&header)?;
-    let op_cost = issue_costs(&timeline_m);
-    let recs: Vec<_> = stats
-        .lines
-        .iter()
-        .filter(|l| (frame.0..frame.1).contains(&l.line))
-        .collect();
-    let mut groups = Vec::new();
-    for l in &recs {
-        groups.extend(group_cycles(l, &op_cost).iter().map(|&c| c as f64));
-    }
-    let col = |f: &dyn Fn(&cwisim_xproc::LineStats) -> f64| -> Vec<f64> {
-        recs.iter().map(|l| f(l)).collect()
+    let plan = plan(&ha, &a.opts, 2)?;
+    let b_opts = Options {
+        frames: a.opts.frames,
+        window: a.opts.window,
+        ..b.opts.clone()
     };
-    let late = recs.iter().filter(|l| l.slack < 0).count() as u64;
+    let ra = gather(a.trace, a.machine, &a.opts, &plan, progress)?;
+    let rb = gather(b.trace, b.machine, &b_opts, &plan, progress).map_err(|e| match e {
+        StudyError::Usage(m) => StudyError::Usage(format!("B ({}): {m}", b.opts.name)),
+        e => e,
+    })?;
+    let title = format!(
+        "cwisim inspect: {} against {} {}",
+        a.opts.name,
+        b.opts.name,
+        frames_text(plan.frames)
+    );
+    assemble(&plan, vec![ra, rb], &title)
+}
 
-    // the disassembly, by scanline
-    let mut line_start = vec![0u32; lines as usize + 1];
-    for &l in &collector.dump_lines {
-        line_start[(l - frame.0) as usize + 1] += 1;
-    }
-    for k in 0..lines as usize {
-        line_start[k + 1] += line_start[k];
-    }
-
-    // the histories: per pixel its visits (consecutive), the value shifted out and how
-    // many visits it left out
-    let mut starts = Vec::with_capacity(collector.pixels.len() + 1);
-    let mut order: Vec<u32> = Vec::with_capacity(collector.visits.index.len());
-    let mut shifted = Vec::with_capacity(collector.pixels.len());
-    let mut hidden = Vec::with_capacity(collector.pixels.len());
-    starts.push(0u32);
-    for p in &collector.pixels {
-        order.extend(&p.visits);
-        starts.push(order.len() as u32);
-        shifted.push(p.shifted.unwrap_or(u32::MAX));
-        hidden.push(p.hidden);
-    }
-    let v = &collector.visits;
-    let pick_f = |c: &[f64]| order.iter().map(|&k| c[k as usize]).collect::<Vec<_>>();
-    let pick_u = |c: &[u32]| order.iter().map(|&k| c[k as usize]).collect::<Vec<_>>();
-    let notes: Vec<u8> = order.iter().map(|&k| v.note[k as usize]).collect();
-
+/// Puts the runs into the template.
+fn assemble(plan: &Plan, runs: Vec<RunData>, title: &str) -> Result<Page, StudyError> {
     let lut: Vec<String> = (0..256)
         .map(|k| {
             let c = viridis(k as f64 / 255.0);
@@ -560,75 +1030,62 @@ choose a smaller one with --x and --lines",
         })
         .collect();
     let hex = |c: [u8; 3]| format!("#{:02x}{:02x}{:02x}", c[0], c[1], c[2]);
-    let data = serde_json::json!({
-        "name": opts.name,
-        "kind": opts.kind,
-        "numeric": opts.numeric.to_string(),
-        "width": width,
-        "lines": lines,
-        "channels": channels,
-        "frame": opts.frame,
-        "first_line": first,
-        "summary": opts.summary,
-        "image": f64_blob(&image.data),
-        "reference": opts.reference.map(|(r, _)| f64_blob(r)),
-        "reference_name": opts.reference.map(|(_, n)| n),
-        "cost": u32_blob(&costs),
+    let op_group: Vec<usize> = Opcode::ALL
+        .iter()
+        .map(|op| {
+            GROUPS
+                .iter()
+                .position(|g| g.ops.contains(op))
+                .expect("every opcode in a group")
+        })
+        .collect();
+    let late: Vec<u64> = runs.iter().map(|r| r.late).collect();
+    let labels = if runs.len() == 2 {
+        ["A", "B"]
+    } else {
+        ["", ""]
+    };
+    let runs: Vec<Value> = runs
+        .into_iter()
+        .zip(labels)
+        .map(|(mut r, label)| {
+            r.json["label"] = json!(label);
+            r.json
+        })
+        .collect();
+    let data = json!({
+        "width": plan.width,
+        "lines": plan.lines,
+        "channels": plan.channels,
+        "frames": [plan.frames.0, plan.frames.1],
         "viridis": lut,
-        "timeline": {
-            "line_period": stats.line_period,
-            "groups": GROUPS.iter().map(|g| serde_json::json!({"name": g.name, "color": hex(g.color)})).collect::<Vec<_>>(),
-            "overrun_color": hex(OVERRUN),
-            "cycles": groups,
-            "busy": col(&|l| l.busy_cycles as f64),
-            "stall": col(&|l| l.stall_cycles as f64),
-            "instructions": col(&|l| l.instructions as f64),
-            "updates": col(&|l| l.processor_updates as f64),
-            "first_issue": col(&|l| l.first_issue as f64),
-            "ready": col(&|l| l.ready as f64),
-            "deadline": col(&|l| l.deadline as f64),
-            "slack": col(&|l| l.slack as f64),
-        },
-        "dump": {
-            "first_index": collector.first_index.unwrap_or(0),
-            "text": text_blob(&collector.texts),
-            "issue": f64_blob(&collector.issue),
-            "enter": f64_blob(&collector.enter),
-            "line_start": line_start,
-        },
-        "history": {
-            "x": [window.x.0, window.x.1],
-            "lines": [window.lines.0, window.lines.1],
-            "strings": text_blob(&collector.strings.list),
-            "starts": u32_blob(&starts),
-            "shifted": u32_blob(&shifted),
-            "hidden": u32_blob(&hidden),
-            "notes": NOTES,
-            "visit_index": f64_blob(&pick_f(&v.index)),
-            "visit_cycle": f64_blob(&pick_f(&v.cycle)),
-            "visit_note": blob(&notes),
-            "visit_before": u32_blob(&pick_u(&v.before)),
-            "visit_after": u32_blob(&pick_u(&v.after)),
-        },
+        "groups": GROUPS.iter().map(|g| json!({"name": g.name, "color": hex(g.color)})).collect::<Vec<_>>(),
+        "overrun_color": hex(OVERRUN),
+        "opcodes": Opcode::ALL.iter().map(|op| op.name()).collect::<Vec<_>>(),
+        "op_group": op_group,
+        "op_reach": Opcode::ALL.iter().map(|op| reach(*op)).collect::<Vec<_>>(),
+        "notes": NOTES,
+        "error_floor": ERROR_FLOOR,
+        "runs": runs,
     });
     // no `</script>` inside the script element: every `<` as its JSON escape
     let json = data.to_string().replace('<', "\\u003c");
-    let title = format!("cwisim inspect: {} frame {}", opts.name, opts.frame);
     let html = TEMPLATE
-        .replace("__CWISIM_TITLE__", &html_escape(&title))
+        .replace("__CWISIM_TITLE__", &html_escape(title))
         .replace("__CWISIM_DATA__", &json);
     if html.len() > MAX_PAGE_BYTES {
         return Err(StudyError::Usage(format!(
-            "the page would be {} MB, over the limit of {} MB: choose a smaller history window (--x, --lines)",
+            "the page would be {} MB, over the limit of {} MB: choose a smaller history window (--x, --lines) or fewer frames (--frames)",
             html.len() >> 20,
             MAX_PAGE_BYTES >> 20
         )));
     }
     Ok(Page {
         html,
-        window,
-        lines,
-        width,
+        frames: plan.frames,
+        windows: plan.windows.iter().flatten().copied().collect(),
+        lines: plan.lines,
+        width: plan.width,
         late_lines: late,
     })
 }
@@ -658,5 +1115,62 @@ mod tests {
         assert_eq!(w.x, (384, 640));
         assert_eq!(w.lines, (2048 + 384, 2048 + 640));
         assert_eq!(w.pixels(), DEFAULT_WINDOW * DEFAULT_WINDOW);
+        // a frame's share of the budget among several: four 400×400 frames get 256×256
+        // each, sixteen 128×128
+        let w = default_window_in(400, 0, 400, MAX_HISTORY_PIXELS / 4);
+        assert_eq!(w.pixels(), 256 * 256);
+        let w = default_window_in(400, 400, 400, MAX_HISTORY_PIXELS / 16);
+        assert_eq!((w.x, w.lines), ((136, 264), (536, 664)));
+        // small frames whole
+        let w = default_window_in(16, 3, 3, MAX_HISTORY_PIXELS / 64);
+        assert_eq!((w.x, w.lines), ((0, 16), (3, 6)));
+    }
+
+    #[test]
+    fn the_frames_are_checked_together() {
+        assert!(check_frames(2048, 2048, 1, 1).is_ok());
+        let e = check_frames(1024, 1024, 5, 1).unwrap_err().to_string();
+        assert!(e.contains("it holds 4 such frame(s)"), "{e}");
+        let e = check_frames(1024, 1024, 3, 2).unwrap_err().to_string();
+        assert!(
+            e.contains("in each of two runs") && e.contains("holds 2 such"),
+            "{e}"
+        );
+        let e = check_frames(4, 4, MAX_PAGE_FRAMES + 1, 1)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("more than a page holds"), "{e}");
+    }
+
+    #[test]
+    fn raw_values_are_the_registers_integers() {
+        let q = Q::new(12, 20).unwrap();
+        assert_eq!(raw_value(0.375, q), "393216");
+        assert_eq!(raw_value(-1.0, q), "-1048576");
+        assert_eq!(raw_value(0.0, q), "0");
+        // wider than an f64's mantissa: exact only when the value is small enough
+        let wide = Q::new(4, 60).unwrap();
+        assert_eq!(raw_value(0.5, wide), "≈576460752303423488");
+        assert_eq!(raw_value(1.0 / 1024.0, wide), "1125899906842624");
+    }
+
+    #[test]
+    fn shell_words_are_quoted_when_they_need_it() {
+        assert_eq!(shell_word("pot"), "pot");
+        assert_eq!(shell_word("fixed:I=12.20,dI=4.28"), "fixed:I=12.20,dI=4.28");
+        assert_eq!(shell_word("my scene.json"), "'my scene.json'");
+        assert_eq!(shell_word("it's"), "'it'\\''s'");
+        assert_eq!(shell_word(""), "''");
+    }
+
+    #[test]
+    fn every_opcode_reaches_what_its_operands_say() {
+        assert_eq!(reach(Opcode::Eval3), "range");
+        assert_eq!(reach(Opcode::Dis), "range");
+        assert_eq!(reach(Opcode::SetPdI), "periodic");
+        assert_eq!(reach(Opcode::SetI), "one");
+        assert_eq!(reach(Opcode::Refresh), "all");
+        assert_eq!(reach(Opcode::AccMode), "all");
+        assert_eq!(reach(Opcode::Nop), "none");
     }
 }
