@@ -220,19 +220,24 @@ Example:\n  cwisim history traces/visibility.cwt --x 9 --line 0",
     )]
     History(history::HistoryArgs),
 
-    /// One frame as one self-contained HTML page to explore in a browser
+    /// Frames as one self-contained HTML page to explore in a browser (A/B: two runs)
     #[command(
-        long_about = "Write one self-contained HTML page (no network: it opens from disk) for one \
-frame: the image, zoomable to single pixels, every channel's value on hover, with overlays of the \
-cost image, the error against the exact reference (scenes) and the late scanlines; the scanline \
-timeline (bus cycles by opcode against the line period, as `cwisim stats`) where a click shows \
-the scanline's disassembly (as `cwisim dump`); and a click on a pixel shows its history (as \
-`cwisim history`). Everything is computed by the cycle-stepped model. A frame over 512×512 \
-pixels holds histories for a window only (--x, --lines; the middle 256×256 by default); \
-frames over 2048×2048 are refused.\n\n\
-The page reads its address: `frame.html#pixel=150,200` selects processor 150 on scanline 200, \
-`#click=150,200` clicks it on the image, `#line=200` selects a scanline.\n\n\
-Example:\n  cwisim inspect pot -o pot.html",
+        long_about = "Write one self-contained HTML page (no network: it opens from disk) of one \
+frame or a range of them (--frames A..B, at most 64): the image, zoomable to single pixels, every \
+channel's value on hover, with overlays of the cost image, the error against the exact reference \
+(scenes; coloured from a floor of 1e-12, so rounding shows nothing) and the late scanlines; the \
+scanline timeline (bus cycles by opcode against the line period, as `cwisim stats`) where a click \
+shows the scanline's disassembly (as `cwisim dump`) and its events cycle by cycle (which \
+processor each token reaches when); and a click on a pixel shows its history (as `cwisim \
+history`, with the command that repeats it; with --numeric fixed:…, the raw registers too). \
+Everything is computed by the cycle-stepped model. --against \"B [FLAGS]\" makes an A/B page of \
+two runs of the same dimensions (a trace or a scene with its own flags), with an A − B overlay. \
+Frames over 512×512 pixels hold histories for a window only (--x, --lines; the middle 256×256 by \
+default); over 2048×2048 pixels in all they are refused.\n\n\
+The page keeps its place in its address: `page.html#pixel=150,200` selects processor 150 on \
+scanline 200, `#line=200` a scanline, `#frame=2` a frame, `#run=b` the B run; a click updates \
+it and the back button returns.\n\n\
+Examples:\n  cwisim inspect pot -o pot.html\n  cwisim inspect pot -o ab.html --against \"pot --aa none\"",
         after_help = AFTER_HELP
     )]
     Inspect(inspect::InspectArgs),

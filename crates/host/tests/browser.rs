@@ -371,11 +371,12 @@ fn harness(bin: &Path, dir: &Path, page: &str, steps: &str) -> serde_json::Value
     out
 }
 
-/// `cwisim history`'s lines without its heading, joined.
+/// `cwisim history`'s lines without its heading and without the notes heading its visits
+/// (where each instruction came from), which the page does not show yet; joined.
 fn history(dir: &Path, args: &[&str]) -> String {
     let out = cwisim_ok(dir, args);
     out.lines()
-        .filter(|l| !l.starts_with("# processor"))
+        .filter(|l| !l.starts_with('#') || l.ends_with("(--all lists them)"))
         .collect::<Vec<_>>()
         .join("\n")
 }

@@ -18,7 +18,7 @@
 //!   Change Dump; both from the cycle-stepped engine's probe. [`until`] ends a trace
 //!   after a given scanline; [`provenance`] keeps the notes a trace attaches to its
 //!   instructions (where each came from) through them.
-//! * [`inspect`] — one frame as one self-contained HTML page: the image with overlays, the
+//! * [`inspect`] — frames (one, a range, or two runs A/B) as one self-contained HTML page: the image with overlays, the
 //!   scanline timeline and disassembly, every pixel history of a window.
 //! * [`error`] — [`StudyError`].
 
