@@ -120,26 +120,35 @@ fn open_input(
         }
         InputKind::Scene => {
             let drawn = draw.draw(Some(input))?;
-            let header = drawn.renderer.header();
-            let in_memory = |e| CliError::Internal(format!("encoding a stream in memory: {e}"));
-            let mut bytes = Vec::new();
-            let writer = BinaryWriter::new(&mut bytes, &header).map_err(in_memory)?;
-            let table = if notes {
-                // the renderer composes its notes only for a writer that keeps them
-                let mut taker = NoteTaker::new(writer);
-                cwisim_render::emit(&*drawn.renderer, &mut taker)?;
-                Some(taker.into_parts().1)
-            } else {
-                let mut writer = writer;
-                cwisim_render::emit(&*drawn.renderer, &mut writer)?;
-                None
-            };
-            let size = bytes.len() as u64;
-            let reader = BinaryReader::new(BufReader::new(Cursor::new(bytes)))?;
-            Ok(match table {
-                Some(table) => (Box::new(Annotated::new(reader, table)), size),
-                None => (Box::new(reader), size),
-            })
+            emitted(&*drawn.renderer, notes)
         }
     }
+}
+
+/// A renderer's stream emitted into memory and read back as a trace, and its size in
+/// bytes; with `notes`, where each instruction came from too (the renderer composes its
+/// notes only for a writer that keeps them).
+pub fn emitted(
+    renderer: &dyn cwisim_render::Renderer,
+    notes: bool,
+) -> Result<(Box<dyn TraceRead>, u64), CliError> {
+    let header = renderer.header();
+    let in_memory = |e| CliError::Internal(format!("encoding a stream in memory: {e}"));
+    let mut bytes = Vec::new();
+    let writer = BinaryWriter::new(&mut bytes, &header).map_err(in_memory)?;
+    let table = if notes {
+        let mut taker = NoteTaker::new(writer);
+        cwisim_render::emit(renderer, &mut taker)?;
+        Some(taker.into_parts().1)
+    } else {
+        let mut writer = writer;
+        cwisim_render::emit(renderer, &mut writer)?;
+        None
+    };
+    let size = bytes.len() as u64;
+    let reader = BinaryReader::new(BufReader::new(Cursor::new(bytes)))?;
+    Ok(match table {
+        Some(table) => (Box::new(Annotated::new(reader, table)), size),
+        None => (Box::new(reader), size),
+    })
 }

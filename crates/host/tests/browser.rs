@@ -104,8 +104,18 @@ fn pre(dom: &str, id: &str) -> String {
         .unwrap_or_else(|| panic!("no #{id} in the DOM"));
     let start = start + dom[start..].find('>').unwrap() + 1;
     let end = start + dom[start..].find("</pre>").unwrap();
-    dom[start..end]
-        .replace("&lt;", "<")
+    // its text: the spans that make lines links left out (a literal `<` is `&lt;` here)
+    let mut text = String::new();
+    let mut in_tag = false;
+    for c in dom[start..end].chars() {
+        match c {
+            '<' => in_tag = true,
+            '>' if in_tag => in_tag = false,
+            c if !in_tag => text.push(c),
+            _ => {}
+        }
+    }
+    text.replace("&lt;", "<")
         .replace("&gt;", ">")
         .replace("&quot;", "\"")
         .replace("&#39;", "'")
@@ -151,13 +161,17 @@ fn the_page_shows_a_clicked_pixels_history_in_chromium() {
             "history", "pot", size[0], size[1], "--x", "80", "--line", "60",
         ],
     );
-    // without the notes heading the visits (where each instruction came from), which the
-    // page does not show yet
+    // with the notes heading the visits (where each instruction came from), as the page
+    // shows them: without the heading line only
     let expected: Vec<&str> = history
         .lines()
-        .filter(|l| !l.starts_with('#') || l.ends_with("(--all lists them)"))
+        .filter(|l| !l.starts_with("# processor"))
         .collect();
     assert!(expected.len() >= 4, "{history}");
+    assert!(
+        expected.iter().any(|l| l.starts_with("# row 60 trapezium")),
+        "the renderer's notes head the visits: {history}"
+    );
     assert_eq!(pre(&dom, "history"), expected.join("\n"));
     assert!(pre(&dom, "pixel").starts_with("x 80, scanline 60\n"));
 
@@ -165,9 +179,11 @@ fn the_page_shows_a_clicked_pixels_history_in_chromium() {
     let expected: Vec<&str> = dump
         .lines()
         .filter(|l| !l.starts_with("cwisim-trace") && !l.starts_with("# cycles"))
-        // nor the notes, nor the blank line that sets the scanline's marker apart from them
-        .filter(|l| !l.is_empty() && (!l.starts_with('#') || l.starts_with("# --- scanline")))
         .collect();
+    assert!(
+        expected.iter().any(|l| l.starts_with("# row 60 trapezium")),
+        "the renderer's notes head the instructions: {dump}"
+    );
     assert_eq!(pre(&dom, "dump"), expected.join("\n"));
 
     // the screenshot shows the image
@@ -264,6 +280,17 @@ const steps = {
     await go('line=30');
     out.line_dump = text('dump').split('\n')[0];
     out.line_hash = win().location.hash;
+  },
+  async link() {
+    // a history entry links to its instruction in the disassembly, and the instructions
+    // of the same polygon are marked there
+    await go('pixel=80,60');
+    const visit = doc().querySelector('#history .visit');
+    out.link_visit = visit ? visit.textContent : null;
+    if (visit) visit.click();
+    const at = doc().querySelector('#dump span.at');
+    out.link_at = at ? at.textContent : null;
+    out.link_same = doc().querySelectorAll('#dump span.same').length;
   },
   async events() {
     await go('pixel=80,60');
@@ -371,12 +398,12 @@ fn harness(bin: &Path, dir: &Path, page: &str, steps: &str) -> serde_json::Value
     out
 }
 
-/// `cwisim history`'s lines without its heading and without the notes heading its visits
-/// (where each instruction came from), which the page does not show yet; joined.
+/// `cwisim history`'s lines without its heading (the notes heading its visits kept: the
+/// page shows them too), joined.
 fn history(dir: &Path, args: &[&str]) -> String {
     let out = cwisim_ok(dir, args);
     out.lines()
-        .filter(|l| !l.starts_with('#') || l.ends_with("(--all lists them)"))
+        .filter(|l| !l.starts_with("# processor"))
         .collect::<Vec<_>>()
         .join("\n")
 }
@@ -394,7 +421,26 @@ fn the_address_follows_clicks_and_the_back_button_and_the_event_view_is_drawn() 
         &bin,
         &dir,
         "pot.html#pixel=80,60",
-        "address,events,threshold",
+        "address,link,events,threshold",
+    );
+    // a history entry's instruction, marked in its scanline's disassembly (RenderDoc's
+    // jump to the draw call), with the others its polygon made
+    let visit = out["link_visit"].as_str().expect("a visit to click");
+    let index = visit
+        .split('#')
+        .nth(1)
+        .unwrap()
+        .split_whitespace()
+        .next()
+        .unwrap();
+    let marked = out["link_at"].as_str().expect("the instruction marked");
+    assert!(
+        marked.contains(&format!("# #{index} line 60")),
+        "{visit} → {marked}"
+    );
+    assert!(
+        out["link_same"].as_u64().unwrap() >= 1,
+        "the polygon's other instructions"
     );
 
     // a click writes the address; back returns to the pixel before

@@ -25,7 +25,9 @@ use crate::cost::{viridis, CostMap, CostReader};
 use crate::error::StudyError;
 use crate::history::{state, values, Visit};
 use crate::plot::{group_cycles, issue_costs, GROUPS, OVERRUN};
+use crate::provenance::NoteRecorder;
 use crate::until::UntilLine;
+use cwisim_isa::note::NoteTable;
 use cwisim_isa::text::format_instruction;
 use cwisim_isa::{Instruction, Opcode, OperandKind, TraceHeader, TraceRead};
 use cwisim_xproc::{
@@ -33,6 +35,7 @@ use cwisim_xproc::{
     Register, StepFrom, Q,
 };
 use serde_json::{json, Value};
+use std::cell::RefCell;
 use std::collections::{HashMap, VecDeque};
 use std::io::Write;
 
@@ -757,10 +760,13 @@ fn gather(
         data: vec![0.0; frame_values * n as usize],
     };
     let mut cost = CostMap::new(width as usize);
+    // where each instruction came from (the trace's notes), by instruction index
+    let notes = RefCell::new(NoteTable::new());
     let (stats, read) = {
         let mut until = UntilLine::new(trace, Some(plan.span.1 - 1));
         let stats = {
-            let mut reader = CostReader::new(&mut until, &mut cost);
+            let mut noted = NoteRecorder::new(&mut until, &notes, plan.span.0);
+            let mut reader = CostReader::new(&mut noted, &mut cost);
             replay_probed_numeric(
                 &mut reader,
                 machine,
@@ -784,9 +790,24 @@ fn gather(
 
     let timeline_m = machine.timeline(&header)?;
     let op_cost = issue_costs(&timeline_m);
+    let notes = notes.into_inner();
+    // the notes' texts, each once, in the order met; an instruction names its note by
+    // its place in this list, plus one (0: no note)
+    let mut provenance: Vec<String> = Vec::new();
+    let mut note_id: HashMap<u64, u32> = HashMap::new();
     let mut late = 0;
     let mut frames = Vec::with_capacity(n as usize);
     for (fi, log) in collector.frames.into_iter().enumerate() {
+        let first_index = log.first_index.unwrap_or(0);
+        let prov: Vec<u32> = (0..log.texts.len() as u64)
+            .map(|i| match notes.get(first_index + i) {
+                Some(note) => *note_id.entry(note.serial).or_insert_with(|| {
+                    provenance.push(note.text.to_string());
+                    provenance.len() as u32
+                }),
+                None => 0,
+            })
+            .collect();
         let frame = plan.frames.0 + fi as u64;
         let first = frame * lines;
         let recs: Vec<_> = stats
@@ -807,6 +828,7 @@ fn gather(
             first,
             lines,
             log,
+            &prov,
             values,
             reference,
             &costs,
@@ -824,6 +846,7 @@ fn gather(
         "reference_name": opts.reference.map(|(_, n)| n),
         "reproduce": opts.reproduce,
         "history_command": history_command(opts),
+        "provenance": provenance,
         "line_period": stats.line_period,
         "hop": machine.hop_cycles,
         "op_cost": op_cost.to_vec(),
@@ -840,6 +863,7 @@ fn frame_json(
     first: u64,
     lines: u64,
     log: FrameLog,
+    prov: &[u32],
     image: &[f64],
     reference: Option<&[f64]>,
     costs: &[u32],
@@ -928,6 +952,7 @@ fn frame_json(
             "op": blob(&log.ops),
             "x": u32_blob(&log.xs),
             "dx": u32_blob(&log.dxs),
+            "prov": u32_blob(prov),
             "line_start": line_start,
         },
         "history": history,

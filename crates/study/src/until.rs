@@ -49,4 +49,8 @@ impl TraceRead for UntilLine<'_> {
     fn bytes_read(&self) -> u64 {
         self.inner.bytes_read()
     }
+
+    fn note(&self) -> Option<cwisim_isa::Note<'_>> {
+        self.inner.note()
+    }
 }

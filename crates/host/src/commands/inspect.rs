@@ -14,7 +14,7 @@ use crate::progress::Stage;
 use crate::range::{parse_range, Range};
 use crate::summary::{write_render_summary, StageTimes};
 use clap::{Args, CommandFactory, FromArgMatches, Parser, ValueEnum};
-use cwisim_isa::{Encoding, Opcode, TraceHeader, TraceRead};
+use cwisim_isa::{Opcode, TraceHeader, TraceRead};
 use cwisim_render::{render, ArrayConfig, Taps};
 use cwisim_scene::Shading;
 use cwisim_study::inspect::{
@@ -22,7 +22,7 @@ use cwisim_study::inspect::{
     MAX_HISTORY_PIXELS,
 };
 use cwisim_xproc::{Machine, NullSink, Numeric, Timing};
-use std::io::{Cursor, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// The arguments of `cwisim inspect`.
@@ -359,14 +359,9 @@ impl Opened {
         stage.message("inspect: the reference image");
         let image = cwisim_study::tradeoff::reference_image(Some(input), &settings)?;
         prepared.reference = Some((image, what));
-        let mut bytes = Vec::new();
-        {
-            let mut writer = Encoding::Binary
-                .writer(&mut bytes, &self.header)
-                .map_err(|e| CliError::Internal(format!("encoding a stream in memory: {e}")))?;
-            cwisim_render::emit(renderer, &mut *writer)?;
-        }
-        Ok((prepared, Encoding::Binary.reader(Cursor::new(bytes))?))
+        // with its notes: the page shows where each instruction came from
+        let (reader, _) = crate::input::emitted(renderer, true)?;
+        Ok((prepared, reader))
     }
 }
 
