@@ -997,6 +997,31 @@ pub struct Run<'a, 'b> {
     pub opts: Options<'a>,
 }
 
+/// Refuses two runs of an A/B page whose dimensions differ (width, lines, channels),
+/// naming both: checked before either is rendered or replayed.
+pub fn check_same_dimensions(
+    (a_name, a): (&str, &TraceHeader),
+    (b_name, b): (&str, &TraceHeader),
+) -> Result<(), StudyError> {
+    let dims = |h: &TraceHeader| (h.width, h.lines, h.channel_count());
+    if dims(a) == dims(b) {
+        return Ok(());
+    }
+    let text = |h: &TraceHeader| {
+        format!(
+            "{}×{} with {} channel(s)",
+            h.width,
+            h.lines,
+            h.channel_count()
+        )
+    };
+    Err(StudyError::Usage(format!(
+        "A ({a_name}) is {} but B ({b_name}) is {}: an A/B page compares runs of the same dimensions",
+        text(a),
+        text(b)
+    )))
+}
+
 /// An A/B page: two runs of the same dimensions (two traces, or one scene drawn two
 /// ways) over the same frames, each with everything [`inspect`] gathers, and on the page
 /// a toggle between them and an overlay of their difference. Refuses runs of different
@@ -1008,24 +1033,7 @@ pub fn inspect_pair(
     progress: &mut dyn FnMut(u64),
 ) -> Result<Page, StudyError> {
     let (ha, hb) = (*a.trace.header(), *b.trace.header());
-    let dims = |h: &TraceHeader| (h.width, h.lines, h.channel_count());
-    if dims(&ha) != dims(&hb) {
-        let text = |h: &TraceHeader| {
-            format!(
-                "{}×{} with {} channel(s)",
-                h.width,
-                h.lines,
-                h.channel_count()
-            )
-        };
-        return Err(StudyError::Usage(format!(
-            "A ({}) is {} but B ({}) is {}: an A/B page compares runs of the same dimensions",
-            a.opts.name,
-            text(&ha),
-            b.opts.name,
-            text(&hb)
-        )));
-    }
+    check_same_dimensions((a.opts.name, &ha), (b.opts.name, &hb))?;
     let plan = plan(&ha, &a.opts, 2)?;
     let b_opts = Options {
         frames: a.opts.frames,

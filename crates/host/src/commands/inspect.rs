@@ -500,24 +500,7 @@ pub fn run(args: &InspectArgs, stdout: &mut dyn Write, progress: bool) -> Result
         None => None,
     };
     if let Some(b) = &b {
-        let dims = |h: &TraceHeader| (h.width, h.lines, h.channel_count());
-        let text = |h: &TraceHeader| {
-            format!(
-                "{}×{} with {} channel(s)",
-                h.width,
-                h.lines,
-                h.channel_count()
-            )
-        };
-        if dims(&a.header) != dims(&b.header) {
-            return Err(CliError::Usage(format!(
-                "A ({}) is {} but B ({}) is {}: an A/B page compares runs of the same dimensions",
-                a.name,
-                text(&a.header),
-                b.name,
-                text(&b.header)
-            )));
-        }
+        cwisim_study::inspect::check_same_dimensions((&a.name, &a.header), (&b.name, &b.header))?;
     }
     let (width, lines) = (u64::from(a.header.width), u64::from(a.header.lines));
     let frames = match args.frames {
