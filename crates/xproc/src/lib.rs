@@ -53,6 +53,7 @@ mod processors;
 pub mod sample;
 pub mod stats;
 pub mod stepped;
+pub mod visits;
 pub mod window;
 
 pub use arith::{Arith, F32Arith, FixedArith, Native};
@@ -70,4 +71,5 @@ pub use output::{Image, ImageLimit, ImageSink, LineOut, LineSink, NullSink};
 pub use probe::{NoProbe, Probe, ProcessorState};
 pub use sample::Sample;
 pub use stats::{LineRecords, LineStats, OpcodeCounts, RunStats, Totals};
+pub use visits::replay_visits_numeric;
 pub use window::{Handover, StepFrom};

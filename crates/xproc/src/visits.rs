@@ -1,0 +1,423 @@
+//! The visits a history shows, without stepping: the fast engine runs the trace (its
+//! scanlines, its statistics), and beside it a model of the processors executes each
+//! instruction over the processors it reaches, in trace order, reporting to a [`Probe`]
+//! the events of the scanlines asked for with their cycles in closed form
+//! ([`replay_visits_numeric`]).
+//!
+//! It rests on what makes the stepped engine's hand-over sound
+//! ([`crate::stepped::SteppedEngine::resume`]): tokens never overtake, each enters the
+//! chain when its issue is done and the token before has moved on a hop (`docs/TIMING.md`,
+//! [`crate::clock`]), and moves one processor a hop, so the token of an instruction that
+//! entered at cycle `e` reaches processor `p` at `e + p · hop`, and each processor sees the
+//! tokens in trace order. The processor's registers before and after a token are then
+//! those of executing the instructions in order. `tests/visits.rs` holds every event to the
+//! stepped engine's, cycle for cycle and bit for bit.
+
+use crate::arith::{vector, Arith, F32Arith, FixedArith, Native};
+use crate::engine::{Engine, ReplayError};
+use crate::fast::FastEngine;
+use crate::machine::{Machine, MachineError, Timeline};
+use crate::numeric::{Numeric, Register};
+use crate::output::LineSink;
+use crate::probe::{Probe, ProcessorState};
+use crate::stats::RunStats;
+use cwisim_isa::{Instruction, Opcode, TraceRead, MAX_CHANNELS};
+
+/// Instructions between progress reports.
+const PROGRESS_EVERY: u64 = 4096;
+
+/// The latest cycle a report starts from: as [`crate::replay_probed_from`], which steps
+/// from there, refuses a hand-over at or beyond it, so does this.
+const LATEST_START: u64 = 1 << 63;
+
+/// Replays `reader` on the fast engine with registers of the format `numeric` (the
+/// scanlines to `sink`, the statistics returned: those of [`crate::replay_numeric`]) and
+/// reports to `probe` the events of scanline `first` and later that
+/// [`crate::replay_probed_numeric`] with [`crate::StepFrom::Scanline`]`(first)` reports,
+/// computed without stepping cycles, in a different order and leaving some out:
+///
+/// * [`Probe::resume`] first, as the stepped engine's hand-over tells it (the cycle the
+///   last instruction before scanline `first` entered the chain, the watched processors'
+///   states then), once the reader reaches scanline `first` (not at all if the trace
+///   outputs fewer scanlines, where the stepped engine reports the instructions after
+///   its last `Refresh`);
+/// * then per instruction, in trace order: [`Probe::issue`], [`Probe::enter`], the
+///   [`Probe::visit`]s of its token to watched processors, and for a `Refresh`
+///   [`Probe::line_ready`];
+/// * only the visits `cwisim history` shows: those that address the processor or leave
+///   its [`ProcessorState`] different (`!=`: a processor holding a `NaN` is different from
+///   itself); a token that passes a watched processor and changes nothing is not reported.
+///   To each watched processor the visits come in the same order, with the same cycles
+///   and states, as the stepped engine's.
+///
+/// The watched processors are asked of `probe` once, before the first instruction.
+/// `progress` is called with the bytes read every few thousand instructions, and at the
+/// end. A scanline `first` whose first instruction starts after cycle 2⁶³ is refused as
+/// [`crate::replay_probed_from`] refuses it.
+pub fn replay_visits_numeric(
+    reader: &mut dyn TraceRead,
+    machine: &Machine,
+    numeric: &Numeric,
+    first: u64,
+    probe: &mut dyn Probe,
+    sink: &mut dyn LineSink<f64>,
+    progress: &mut dyn FnMut(u64),
+) -> Result<RunStats, ReplayError> {
+    let t = machine.timeline(reader.header())?;
+    match numeric {
+        Numeric::F64 => visits(
+            reader,
+            t,
+            Native::<f64>::new(),
+            first,
+            probe,
+            sink,
+            progress,
+        ),
+        Numeric::F32 => visits(reader, t, F32Arith, first, probe, sink, progress),
+        Numeric::Fixed(f) => {
+            let arith = FixedArith::new(f).map_err(|e| MachineError::Invalid {
+                name: "numeric".into(),
+                message: e.message().to_string(),
+            })?;
+            visits(reader, t, arith, first, probe, sink, progress)
+        }
+    }
+}
+
+/// One processor's registers and flags, as the stepped engine keeps them.
+#[derive(Clone, Copy)]
+struct Proc<R> {
+    acc: [R; MAX_CHANNELS],
+    reg: [[R; MAX_CHANNELS]; 3],
+    has: [bool; 3],
+    locked: bool,
+    masked: bool,
+}
+
+/// The processors, executed one instruction at a time over what it reaches.
+struct Model<A: Arith> {
+    arith: A,
+    channels: usize,
+    procs: Vec<Proc<A::Reg>>,
+    /// `Acc_mode`: every processor's copy toggles at once, so one flag is all of them.
+    negative: bool,
+    /// Processors masked by a `Dis` since the last `Eval` (which unmasks every one).
+    masked: Vec<usize>,
+    watched: Vec<bool>,
+    watched_list: Vec<usize>,
+    /// Watched processors holding a `NaN` (every token's visit shows there).
+    nan: Vec<usize>,
+}
+
+impl<A: Arith> Model<A> {
+    fn state(&self, p: usize) -> ProcessorState {
+        let pr = &self.procs[p];
+        let c = self.channels;
+        let v = |reg: Register, x: &[A::Reg; MAX_CHANNELS]| {
+            x[..c]
+                .iter()
+                .map(|s| self.arith.value(reg, *s))
+                .collect::<Vec<f64>>()
+        };
+        ProcessorState {
+            acc: v(Register::Acc, &pr.acc),
+            reg: [
+                v(Register::I, &pr.reg[0]),
+                v(Register::DI, &pr.reg[1]),
+                v(Register::DDI, &pr.reg[2]),
+            ],
+            has: pr.has,
+            locked: pr.locked,
+            masked: pr.masked,
+            negative_enabled: self.negative,
+        }
+    }
+
+    /// The value operands of `instr` as the stepped engine converts them when its token
+    /// enters the chain: `I` (for `Eval0` in the accumulator's format), `dI`, `ddI`.
+    fn operands(&self, instr: &Instruction) -> [[A::Reg; MAX_CHANNELS]; 3] {
+        let mut out = [[A::ZERO; MAX_CHANNELS]; 3];
+        let mut overflows = 0;
+        for kind in instr.op.operands() {
+            if let Some(slot) = kind.value_slot() {
+                let reg = if instr.op == Opcode::Eval0 {
+                    Register::Acc
+                } else {
+                    Register::of_slot(slot)
+                };
+                out[slot] = vector(
+                    &self.arith,
+                    reg,
+                    instr.value(slot),
+                    self.channels,
+                    &mut overflows,
+                );
+            }
+        }
+        out
+    }
+
+    /// Executes `instr` on every processor; with `report`, tells `probe` of each shown
+    /// visit to a watched processor, its token having entered the chain at `entry`.
+    #[allow(clippy::too_many_arguments)]
+    fn execute(
+        &mut self,
+        instr: &Instruction,
+        index: u64,
+        line: u64,
+        entry: u64,
+        hop: u64,
+        report: bool,
+        probe: &mut dyn Probe,
+    ) {
+        let w = self.procs.len();
+        let (x, dx) = (instr.x as usize, instr.dx as usize);
+        let range = x.min(w)..x.saturating_add(dx).min(w);
+        let [v0, d0, dd0] = self.operands(instr);
+        let c = self.channels;
+        // the visits shown, in the order made: processor, state before
+        let mut shown: Vec<(usize, ProcessorState)> = Vec::new();
+        let touched = |m: &Self, p: usize, shown: &mut Vec<(usize, ProcessorState)>| {
+            if report && m.watched[p] {
+                shown.push((p, m.state(p)));
+            }
+        };
+        let mut unmask_all = false;
+        match instr.op {
+            Opcode::SetI | Opcode::SetdI | Opcode::SetddI => {
+                if x < w {
+                    let slot = instr.op as usize - Opcode::SetI as usize;
+                    touched(self, x, &mut shown);
+                    let pr = &mut self.procs[x];
+                    pr.reg[slot] = [v0, d0, dd0][slot];
+                    pr.has[slot] = true;
+                }
+            }
+            Opcode::SetPI | Opcode::SetPdI | Opcode::SetPddI => {
+                let slot = instr.op as usize - Opcode::SetPI as usize;
+                let step = dx.max(1);
+                let mut p = x;
+                while p < w && (p == x || dx > 0) {
+                    touched(self, p, &mut shown);
+                    let pr = &mut self.procs[p];
+                    pr.reg[slot] = [v0, d0, dd0][slot];
+                    pr.has[slot] = true;
+                    p += step;
+                }
+            }
+            Opcode::Eval0 => {
+                for p in range.clone() {
+                    touched(self, p, &mut shown);
+                    let pr = &mut self.procs[p];
+                    if !(pr.locked || pr.masked) {
+                        pr.acc = v0;
+                        pr.locked = true;
+                    }
+                    pr.masked = false;
+                }
+                unmask_all = true;
+            }
+            Opcode::Eval1 | Opcode::Eval2 | Opcode::Eval3 => {
+                let order = 1 + instr.op as usize - Opcode::Eval1 as usize;
+                let (mut v, mut d, mut dd) = (v0, d0, dd0);
+                let mut ovf = 0;
+                for p in range.clone() {
+                    touched(self, p, &mut shown);
+                    let ar = &self.arith;
+                    let negative = self.negative;
+                    let pr = &mut self.procs[p];
+                    if pr.has[0] {
+                        v = pr.reg[0];
+                        pr.has[0] = false;
+                    }
+                    if order >= 2 && pr.has[1] {
+                        d = pr.reg[1];
+                        pr.has[1] = false;
+                    }
+                    if order >= 3 && pr.has[2] {
+                        dd = pr.reg[2];
+                        pr.has[2] = false;
+                    }
+                    let blocked = pr.locked || pr.masked;
+                    for k in 0..c {
+                        if !blocked && (negative || !ar.is_negative(v[k])) {
+                            pr.acc[k] = ar.accumulate(pr.acc[k], v[k], &mut ovf);
+                        }
+                        if order >= 2 {
+                            v[k] = ar.advance_v(v[k], d[k], &mut ovf);
+                        }
+                        if order >= 3 {
+                            d[k] = ar.advance_d(d[k], dd[k], &mut ovf);
+                        }
+                    }
+                    pr.masked = false;
+                }
+                unmask_all = true;
+            }
+            Opcode::Dis => {
+                for p in range.clone() {
+                    touched(self, p, &mut shown);
+                    if !self.procs[p].masked {
+                        self.procs[p].masked = true;
+                        self.masked.push(p);
+                    }
+                }
+            }
+            Opcode::AccMode => {
+                for k in 0..self.watched_list.len() {
+                    touched(self, self.watched_list[k], &mut shown);
+                }
+                self.negative = !self.negative;
+            }
+            Opcode::Refresh => {
+                for k in 0..self.watched_list.len() {
+                    touched(self, self.watched_list[k], &mut shown);
+                }
+                for pr in &mut self.procs {
+                    pr.acc = [A::ZERO; MAX_CHANNELS];
+                    pr.has = [false; 3];
+                    pr.locked = false;
+                    pr.masked = false;
+                }
+                self.masked.clear();
+            }
+            Opcode::Nop => {}
+        }
+        let addressed = shown.len();
+        if unmask_all {
+            // the token passes every processor and unmasks it: a change where it does
+            // not address it
+            for k in 0..self.masked.len() {
+                let p = self.masked[k];
+                if self.procs[p].masked {
+                    touched(self, p, &mut shown);
+                    self.procs[p].masked = false;
+                }
+            }
+            self.masked.clear();
+        }
+        if !report {
+            return;
+        }
+        // a processor holding a NaN differs from itself: every token's visit shows
+        if !self.nan.is_empty() {
+            for k in 0..self.nan.len() {
+                let p = self.nan[k];
+                if !shown.iter().any(|s| s.0 == p) {
+                    touched(self, p, &mut shown);
+                }
+            }
+        }
+        for (k, (p, before)) in shown.iter().enumerate() {
+            let after = self.state(*p);
+            let is_nan = |s: &ProcessorState| {
+                s.acc
+                    .iter()
+                    .chain(s.reg.iter().flatten())
+                    .any(|v| v.is_nan())
+            };
+            match (self.nan.iter().position(|q| q == p), is_nan(&after)) {
+                (None, true) => self.nan.push(*p),
+                (Some(i), false) => {
+                    self.nan.swap_remove(i);
+                }
+                _ => {}
+            }
+            let cycle = entry + *p as u64 * hop;
+            probe.visit(cycle, *p, index, line, instr, k < addressed, before, &after);
+        }
+    }
+}
+
+fn visits<A: Arith<Out = f64>>(
+    reader: &mut dyn TraceRead,
+    timeline: Timeline,
+    arith: A,
+    first: u64,
+    probe: &mut dyn Probe,
+    sink: &mut dyn LineSink<f64>,
+    progress: &mut dyn FnMut(u64),
+) -> Result<RunStats, ReplayError> {
+    let header = *reader.header();
+    let w = header.width as usize;
+    let watched: Vec<bool> = (0..w).map(|p| probe.watches(p)).collect();
+    let blank = Proc {
+        acc: [A::ZERO; MAX_CHANNELS],
+        reg: [[A::ZERO; MAX_CHANNELS]; 3],
+        has: [false; 3],
+        locked: false,
+        masked: false,
+    };
+    let mut model = Model {
+        arith: arith.clone(),
+        channels: header.channel_count(),
+        procs: vec![blank; w],
+        negative: false,
+        masked: Vec::new(),
+        watched_list: (0..w).filter(|&p| watched[p]).collect(),
+        watched,
+        nan: Vec::new(),
+    };
+    let hop = timeline.hop;
+    let mut fast = Box::new(FastEngine::with_arith(&header, timeline.clone(), arith));
+    let (mut index, mut line) = (0u64, 0u64);
+    let mut last_entry: Option<u64> = None;
+    let mut resumed = false;
+    while let Some(instr) = reader.next_instruction()? {
+        if line >= first && !resumed {
+            resumed = true;
+            let cycle = last_entry.unwrap_or(0);
+            if cycle >= LATEST_START {
+                return Err(ReplayError::Machine(MachineError::Invalid {
+                    name: "line_period_cycles".into(),
+                    message: format!(
+                        "scanline {line} starts at cycle {cycle}, beyond what the cycle-stepped \
+                         engine steps to (2^63); shorten the line period or the blanking"
+                    ),
+                }));
+            }
+            let states: Vec<(usize, ProcessorState)> = model
+                .watched_list
+                .iter()
+                .map(|&p| (p, model.state(p)))
+                .collect();
+            probe.resume(cycle, line, &states);
+        }
+        let refresh = instr.op == Opcode::Refresh;
+        let gate = if refresh {
+            timeline.refresh_gate(line)
+        } else {
+            0
+        };
+        let begin = last_entry.unwrap_or(0).max(gate);
+        let issued = begin.saturating_add(timeline.issue_cycles(&instr));
+        let entry = issued.max(last_entry.map_or(0, |e| e.saturating_add(hop)));
+        last_entry = Some(entry);
+        let report = resumed;
+        if report {
+            probe.issue(begin, index, line, &instr);
+            probe.enter(entry, index);
+        }
+        model.execute(&instr, index, line, entry, hop, report, probe);
+        if report && refresh {
+            probe.line_ready(timeline.exit(entry), line);
+        }
+        fast.execute(&instr, sink);
+        index += 1;
+        line += u64::from(refresh);
+        if index.is_multiple_of(PROGRESS_EVERY) {
+            progress(reader.bytes_read());
+        }
+    }
+    if line >= first && !resumed {
+        let states: Vec<(usize, ProcessorState)> = model
+            .watched_list
+            .iter()
+            .map(|&p| (p, model.state(p)))
+            .collect();
+        probe.resume(last_entry.unwrap_or(0), line, &states);
+    }
+    progress(reader.bytes_read());
+    Ok(fast.finish(sink))
+}
