@@ -115,22 +115,31 @@ impl Visit {
     /// What the visit amounted to, when not a plain action: `"passes through"`,
     /// `"suppressed: locked by Eval0"`, `"suppressed: masked by Dis"`.
     pub fn note(&self) -> Option<&'static str> {
-        let changed = self.changed();
-        if !self.addressed {
-            Some("passes through")
-        } else if !changed
-            && self.before.locked
-            && matches!(
-                self.instr.op,
-                Opcode::Eval0 | Opcode::Eval1 | Opcode::Eval2 | Opcode::Eval3
-            )
-        {
-            Some("suppressed: locked by Eval0")
-        } else if self.before.masked && !self.after.masked && self.before.acc == self.after.acc {
-            Some("suppressed: masked by Dis")
-        } else {
-            None
-        }
+        visit_note(self.instr.op, self.addressed, &self.before, &self.after)
+    }
+}
+
+/// [`Visit::note`] of a visit of an `op` instruction's token, from its parts.
+pub fn visit_note(
+    op: Opcode,
+    addressed: bool,
+    before: &ProcessorState,
+    after: &ProcessorState,
+) -> Option<&'static str> {
+    if !addressed {
+        Some("passes through")
+    } else if before == after
+        && before.locked
+        && matches!(
+            op,
+            Opcode::Eval0 | Opcode::Eval1 | Opcode::Eval2 | Opcode::Eval3
+        )
+    {
+        Some("suppressed: locked by Eval0")
+    } else if before.masked && !after.masked && before.acc == after.acc {
+        Some("suppressed: masked by Dis")
+    } else {
+        None
     }
 }
 

@@ -4,11 +4,12 @@
 //! scanline's events cycle by cycle (which processor each token reaches when) with its
 //! disassembly, and the pixel history of every pixel in a window.
 //!
-//! Everything the page shows is computed here, by one replay per run with a [`Probe`] on
-//! the cycle-stepped engine (the reference model), which steps the frames from the state
-//! the fast engine hands it after the frames before: the same figures as `cwisim stats`,
-//! the same lines as `cwisim dump` and `cwisim history`. The page's script only decodes,
-//! draws and looks up; it simulates nothing.
+//! Everything the page shows is computed here, by one replay per run on the fast engine
+//! with a [`Probe`] told every instruction's cycles and every visit a history shows
+//! ([`cwisim_xproc::replay_visits_numeric`]: the stepped engine's events, held to it by
+//! its tests, without stepping cycles): the same figures as `cwisim stats`, the same
+//! lines as `cwisim dump` and `cwisim history`. The page's script only decodes, draws and
+//! looks up; it simulates nothing.
 //!
 //! A page holds one run ([`inspect`]) or two of the same dimensions, A and B
 //! ([`inspect_pair`]: two traces, or one scene drawn two ways), of one frame or a range
@@ -23,7 +24,7 @@
 
 use crate::cost::{viridis, CostMap, CostReader};
 use crate::error::StudyError;
-use crate::history::{state, values, Visit};
+use crate::history::{state, values, visit_note};
 use crate::plot::{group_cycles, issue_costs, GROUPS, OVERRUN};
 use crate::provenance::NoteRecorder;
 use crate::until::UntilLine;
@@ -31,8 +32,8 @@ use cwisim_isa::note::NoteTable;
 use cwisim_isa::text::format_instruction;
 use cwisim_isa::{Instruction, Opcode, OperandKind, TraceHeader, TraceRead};
 use cwisim_xproc::{
-    replay_probed_numeric, FixedFormat, LineOut, LineSink, Machine, Numeric, Probe, ProcessorState,
-    Register, StepFrom, Q,
+    replay_visits_numeric, FixedFormat, LineOut, LineSink, Machine, Numeric, Probe, ProcessorState,
+    Register, Q,
 };
 use serde_json::{json, Value};
 use std::cell::RefCell;
@@ -117,6 +118,9 @@ pub struct Options<'a> {
     /// `--numeric`, `--machine`, `--set`, as given): the page suggests
     /// `cwisim history REPRODUCE… --x X --line Y` for a clicked pixel. Empty: the name.
     pub reproduce: &'a [String],
+    /// Threads to build the page on (0: one per core); the page is the same at any
+    /// count. A page of two runs takes the first's.
+    pub threads: usize,
 }
 
 impl Default for Options<'_> {
@@ -130,6 +134,7 @@ impl Default for Options<'_> {
             reference: None,
             numeric: Numeric::F64,
             reproduce: &[],
+            threads: 1,
         }
     }
 }
@@ -233,8 +238,10 @@ pub const NOTES: [&str; 3] = [
 #[derive(Default, Clone)]
 struct Pixel {
     visits: Vec<u32>,
-    hidden: u32,
     shifted: Option<(u32, u32)>,
+    /// The state after its last visit and its strings' numbers (shown, raw): what the
+    /// next visit finds.
+    last: Option<Box<(ProcessorState, u32, u32)>>,
 }
 
 /// Which processors an opcode's instruction names, as the page's event view draws it:
@@ -312,7 +319,8 @@ struct FrameLog {
 }
 
 /// The probe: every instruction of the frames with its cycles, and every visit to a pixel
-/// of a window.
+/// of a window that a history shows (the others are counted from the scanline's
+/// instructions).
 struct Collector {
     lines: (u64, u64),
     per_frame: u64,
@@ -370,41 +378,52 @@ impl Probe for Collector {
         };
         let w = window.x.1 - window.x.0;
         let k = ((line - window.lines.0) * w + (x - window.x.0)) as usize;
+        let pixel = &mut f.pixels[k];
+        let strings = &mut f.strings;
         if instr.op == Opcode::Refresh {
-            let shown = f.strings.id(values(&before.acc));
-            let raw = fixed.map_or(u32::MAX, |q| f.strings.id(raw_values(&before.acc, q.acc)));
-            f.pixels[k].shifted = Some((shown, raw));
+            let shown = strings.id(values(&before.acc));
+            let raw = fixed.map_or(u32::MAX, |q| strings.id(raw_values(&before.acc, q.acc)));
+            pixel.shifted = Some((shown, raw));
         }
-        if addressed || before != after {
-            let v = Visit {
-                cycle,
-                index,
-                instr: instr.clone(),
-                addressed,
-                before: before.clone(),
-                after: after.clone(),
-            };
-            let note = v.note().map_or(0, |n| {
-                1 + NOTES.iter().position(|&m| m == n).expect("a known note") as u8
-            });
-            let at = f.visits.index.len() as u32;
-            f.visits.index.push(index as f64);
-            f.visits.cycle.push(cycle as f64);
-            f.visits.note.push(note);
-            let b = f.strings.id(state(before));
-            let a = f.strings.id(state(after));
-            f.visits.before.push(b);
-            f.visits.after.push(a);
-            if let Some(q) = fixed {
-                let b = f.strings.id(raw_state(before, &q));
-                let a = f.strings.id(raw_state(after, &q));
-                f.visits.before_raw.push(b);
-                f.visits.after_raw.push(a);
-            }
-            f.pixels[k].visits.push(at);
+        // every visit reported is one `cwisim history` shows (replay_visits_numeric);
+        // the state before is most often the one the last visit left
+        let note = visit_note(instr.op, addressed, before, after).map_or(0, |n| {
+            1 + NOTES.iter().position(|&m| m == n).expect("a known note") as u8
+        });
+        let at = f.visits.index.len() as u32;
+        f.visits.index.push(index as f64);
+        f.visits.cycle.push(cycle as f64);
+        f.visits.note.push(note);
+        let (b, b_raw) = match pixel.last.as_deref() {
+            Some((s, shown, raw)) if s == before => (*shown, *raw),
+            _ => (
+                strings.id(state(before)),
+                fixed.map_or(u32::MAX, |q| strings.id(raw_state(before, &q))),
+            ),
+        };
+        let (a, a_raw) = if after == before {
+            (b, b_raw)
         } else {
-            f.pixels[k].hidden += 1;
+            (
+                strings.id(state(after)),
+                fixed.map_or(u32::MAX, |q| strings.id(raw_state(after, &q))),
+            )
+        };
+        f.visits.before.push(b);
+        f.visits.after.push(a);
+        if fixed.is_some() {
+            f.visits.before_raw.push(b_raw);
+            f.visits.after_raw.push(a_raw);
         }
+        match &mut pixel.last {
+            Some(last) => {
+                last.0.clone_from(after);
+                last.1 = a;
+                last.2 = a_raw;
+            }
+            None => pixel.last = Some(Box::new((after.clone(), a, a_raw))),
+        }
+        pixel.visits.push(at);
     }
 }
 
@@ -427,33 +446,105 @@ impl LineSink<f64> for FrameImage {
     }
 }
 
+/// How hard the arrays are compressed: zlib's level 2 — level 9 makes a page a tenth
+/// smaller in seven times the time (the pot's page: 4.5 s against 0.2 s of compression).
+const LEVEL: u32 = 2;
+
 /// zlib, then base64: how the page carries its arrays.
 fn blob(bytes: &[u8]) -> String {
-    let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::new(9));
+    let mut z = flate2::write::ZlibEncoder::new(
+        Vec::with_capacity(bytes.len() / 4),
+        flate2::Compression::new(LEVEL),
+    );
     z.write_all(bytes).expect("writing to memory");
     base64(&z.finish().expect("writing to memory"))
 }
 
-fn f64_blob(values: &[f64]) -> String {
-    blob(
-        &values
-            .iter()
-            .flat_map(|v| v.to_le_bytes())
-            .collect::<Vec<_>>(),
-    )
+/// The page's arrays, gathered while the page's data is built (each stands in the data
+/// as a placeholder) and compressed together at the end, on threads ([`Blobs::fill`]):
+/// each array's stream is the same on any thread, so the page is the same at any count.
+#[derive(Default)]
+struct Blobs(RefCell<Vec<Vec<u8>>>);
+
+/// What a placeholder starts with: no text of the page's data holds a NUL.
+const PLACEHOLDER: char = '\0';
+
+impl Blobs {
+    fn bytes(&self, bytes: Vec<u8>) -> Value {
+        let mut list = self.0.borrow_mut();
+        list.push(bytes);
+        Value::String(format!("{PLACEHOLDER}{}", list.len() - 1))
+    }
+
+    fn f64s(&self, values: &[f64]) -> Value {
+        self.bytes(values.iter().flat_map(|v| v.to_le_bytes()).collect())
+    }
+
+    fn u32s(&self, values: &[u32]) -> Value {
+        self.bytes(values.iter().flat_map(|v| v.to_le_bytes()).collect())
+    }
+
+    fn texts(&self, lines: &[String]) -> Value {
+        self.bytes(lines.join("\n").into_bytes())
+    }
+
+    /// Compresses every array on `threads` threads (0: one per core), the largest first,
+    /// and puts each in its placeholder's place in `data`.
+    fn fill(self, data: &mut Value, threads: usize) {
+        let raw = self.0.into_inner();
+        let threads = match threads {
+            0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
+            n => n,
+        }
+        .clamp(1, raw.len().max(1));
+        let mut order: Vec<usize> = (0..raw.len()).collect();
+        order.sort_by_key(|&k| std::cmp::Reverse(raw[k].len()));
+        let mut done: Vec<Option<String>> = vec![None; raw.len()];
+        if threads == 1 {
+            for (d, r) in done.iter_mut().zip(&raw) {
+                *d = Some(blob(r));
+            }
+        } else {
+            let next = std::sync::atomic::AtomicUsize::new(0);
+            let work = || {
+                let mut out = Vec::new();
+                loop {
+                    let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                    let Some(&k) = order.get(i) else { break };
+                    out.push((k, blob(&raw[k])));
+                }
+                out
+            };
+            std::thread::scope(|s| {
+                let handles: Vec<_> = (1..threads).map(|_| s.spawn(work)).collect();
+                let mut parts = vec![work()];
+                parts.extend(
+                    handles
+                        .into_iter()
+                        .map(|h| h.join().expect("compressing in memory")),
+                );
+                for (k, b) in parts.into_iter().flatten() {
+                    done[k] = Some(b);
+                }
+            });
+        }
+        put_blobs(data, &mut done);
+    }
 }
 
-fn u32_blob(values: &[u32]) -> String {
-    blob(
-        &values
-            .iter()
-            .flat_map(|v| v.to_le_bytes())
-            .collect::<Vec<_>>(),
-    )
-}
-
-fn text_blob(lines: &[String]) -> String {
-    blob(lines.join("\n").as_bytes())
+/// Replaces each placeholder in `v` by its compressed array.
+fn put_blobs(v: &mut Value, done: &mut [Option<String>]) {
+    match v {
+        Value::String(s) => {
+            if let Some(k) = s.strip_prefix(PLACEHOLDER) {
+                let k: usize = k.parse().expect("a placeholder's number");
+                *s = done[k].take().expect("each array once");
+            }
+        }
+        Value::Array(a) => a.iter_mut().for_each(|v| put_blobs(v, done)),
+        Value::Object(o) => o.values_mut().for_each(|v| put_blobs(v, done)),
+        _ => {}
+    }
 }
 
 /// Standard base64 with padding.
@@ -712,6 +803,7 @@ fn gather(
     machine: &Machine,
     opts: &Options<'_>,
     plan: &Plan,
+    blobs: &Blobs,
     progress: &mut dyn FnMut(u64),
 ) -> Result<RunData, StudyError> {
     let header = *trace.header();
@@ -767,11 +859,11 @@ fn gather(
         let stats = {
             let mut noted = NoteRecorder::new(&mut until, &notes, plan.span.0);
             let mut reader = CostReader::new(&mut noted, &mut cost);
-            replay_probed_numeric(
+            replay_visits_numeric(
                 &mut reader,
                 machine,
                 &opts.numeric,
-                StepFrom::Scanline(plan.span.0),
+                plan.span.0,
                 &mut collector,
                 &mut image,
                 progress,
@@ -835,6 +927,7 @@ fn gather(
             &recs,
             &op_cost,
             collector.fixed.is_some(),
+            blobs,
         ));
     }
     let json = json!({
@@ -870,6 +963,7 @@ fn frame_json(
     recs: &[&cwisim_xproc::LineStats],
     op_cost: &[u64; Opcode::COUNT],
     fixed: bool,
+    blobs: &Blobs,
 ) -> Value {
     let mut groups = Vec::new();
     for l in recs {
@@ -902,7 +996,12 @@ fn frame_json(
             starts.push(order.len() as u32);
             shifted.push(p.shifted.map_or(u32::MAX, |s| s.0));
             shifted_raw.push(p.shifted.map_or(u32::MAX, |s| s.1));
-            hidden.push(p.hidden);
+        }
+        // the visits not shown: every token of the pixel's scanline passes it
+        let w = (window.x.1 - window.x.0) as usize;
+        for (k, p) in log.pixels.iter().enumerate() {
+            let l = (window.lines.0 - first) as usize + k / w;
+            hidden.push(line_start[l + 1] - line_start[l] - p.visits.len() as u32);
         }
         let v = &log.visits;
         let pick_f = |c: &[f64]| order.iter().map(|&k| c[k as usize]).collect::<Vec<_>>();
@@ -911,28 +1010,28 @@ fn frame_json(
         json!({
             "x": [window.x.0, window.x.1],
             "lines": [window.lines.0, window.lines.1],
-            "strings": text_blob(&log.strings.list),
-            "starts": u32_blob(&starts),
-            "shifted": u32_blob(&shifted),
-            "hidden": u32_blob(&hidden),
-            "visit_index": f64_blob(&pick_f(&v.index)),
-            "visit_cycle": f64_blob(&pick_f(&v.cycle)),
-            "visit_note": blob(&notes),
-            "visit_before": u32_blob(&pick_u(&v.before)),
-            "visit_after": u32_blob(&pick_u(&v.after)),
+            "strings": blobs.texts(&log.strings.list),
+            "starts": blobs.u32s(&starts),
+            "shifted": blobs.u32s(&shifted),
+            "hidden": blobs.u32s(&hidden),
+            "visit_index": blobs.f64s(&pick_f(&v.index)),
+            "visit_cycle": blobs.f64s(&pick_f(&v.cycle)),
+            "visit_note": blobs.bytes(notes),
+            "visit_before": blobs.u32s(&pick_u(&v.before)),
+            "visit_after": blobs.u32s(&pick_u(&v.after)),
             "raw": fixed.then(|| json!({
-                "before": u32_blob(&pick_u(&v.before_raw)),
-                "after": u32_blob(&pick_u(&v.after_raw)),
-                "shifted": u32_blob(&shifted_raw),
+                "before": blobs.u32s(&pick_u(&v.before_raw)),
+                "after": blobs.u32s(&pick_u(&v.after_raw)),
+                "shifted": blobs.u32s(&shifted_raw),
             })),
         })
     });
     json!({
         "frame": frame,
         "first_line": first,
-        "image": f64_blob(image),
-        "reference": reference.map(f64_blob),
-        "cost": u32_blob(costs),
+        "image": blobs.f64s(image),
+        "reference": reference.map(|r| blobs.f64s(r)),
+        "cost": blobs.u32s(costs),
         "timeline": {
             "cycles": groups,
             "busy": col(&|l| l.busy_cycles as f64),
@@ -946,22 +1045,22 @@ fn frame_json(
         },
         "dump": {
             "first_index": log.first_index.unwrap_or(0),
-            "text": text_blob(&log.texts),
-            "issue": f64_blob(&log.issue),
-            "enter": f64_blob(&log.enter),
-            "op": blob(&log.ops),
-            "x": u32_blob(&log.xs),
-            "dx": u32_blob(&log.dxs),
-            "prov": u32_blob(prov),
+            "text": blobs.texts(&log.texts),
+            "issue": blobs.f64s(&log.issue),
+            "enter": blobs.f64s(&log.enter),
+            "op": blobs.bytes(log.ops),
+            "x": blobs.u32s(&log.xs),
+            "dx": blobs.u32s(&log.dxs),
+            "prov": blobs.u32s(prov),
             "line_start": line_start,
         },
         "history": history,
     })
 }
 
-/// Replays `trace` up to the end of the frames `opts.frames` and builds the page: the
-/// frames before on the fast engine, the frames on the cycle-stepped engine from the fast
-/// engine's state ([`cwisim_xproc::replay_probed_from`]). Refuses (as
+/// Replays `trace` up to the end of the frames `opts.frames` on the fast engine, with the
+/// events of the frames' scanlines that the cycle-stepped engine reports
+/// ([`cwisim_xproc::replay_visits_numeric`]), and builds the page. Refuses (as
 /// [`StudyError::Usage`]) a frame beyond the trace, frames over [`MAX_PAGE_FRAMES`] or
 /// [`MAX_FRAME_PIXELS`], a window outside the frames or over [`MAX_HISTORY_PIXELS`], and
 /// a page over [`MAX_PAGE_BYTES`].
@@ -982,9 +1081,10 @@ pub fn inspect_with_progress(
     progress: &mut dyn FnMut(u64),
 ) -> Result<Page, StudyError> {
     let plan = plan(trace.header(), opts, 1)?;
-    let run = gather(trace, machine, opts, &plan, progress)?;
+    let blobs = Blobs::default();
+    let run = gather(trace, machine, opts, &plan, &blobs, progress)?;
     let title = format!("cwisim inspect: {} {}", opts.name, frames_text(plan.frames));
-    assemble(&plan, vec![run], &title)
+    assemble(&plan, vec![run], blobs, opts.threads, &title)
 }
 
 /// One run of an A/B page: its input, machine and options.
@@ -1040,8 +1140,9 @@ pub fn inspect_pair(
         window: a.opts.window,
         ..b.opts.clone()
     };
-    let ra = gather(a.trace, a.machine, &a.opts, &plan, progress)?;
-    let rb = gather(b.trace, b.machine, &b_opts, &plan, progress).map_err(|e| match e {
+    let blobs = Blobs::default();
+    let ra = gather(a.trace, a.machine, &a.opts, &plan, &blobs, progress)?;
+    let rb = gather(b.trace, b.machine, &b_opts, &plan, &blobs, progress).map_err(|e| match e {
         StudyError::Usage(m) => StudyError::Usage(format!("B ({}): {m}", b.opts.name)),
         e => e,
     })?;
@@ -1051,11 +1152,17 @@ pub fn inspect_pair(
         b.opts.name,
         frames_text(plan.frames)
     );
-    assemble(&plan, vec![ra, rb], &title)
+    assemble(&plan, vec![ra, rb], blobs, a.opts.threads, &title)
 }
 
 /// Puts the runs into the template.
-fn assemble(plan: &Plan, runs: Vec<RunData>, title: &str) -> Result<Page, StudyError> {
+fn assemble(
+    plan: &Plan,
+    runs: Vec<RunData>,
+    blobs: Blobs,
+    threads: usize,
+    title: &str,
+) -> Result<Page, StudyError> {
     let lut: Vec<String> = (0..256)
         .map(|k| {
             let c = viridis(k as f64 / 255.0);
@@ -1086,7 +1193,7 @@ fn assemble(plan: &Plan, runs: Vec<RunData>, title: &str) -> Result<Page, StudyE
             r.json
         })
         .collect();
-    let data = json!({
+    let mut data = json!({
         "width": plan.width,
         "lines": plan.lines,
         "channels": plan.channels,
@@ -1101,6 +1208,7 @@ fn assemble(plan: &Plan, runs: Vec<RunData>, title: &str) -> Result<Page, StudyE
         "error_floor": ERROR_FLOOR,
         "runs": runs,
     });
+    blobs.fill(&mut data, threads);
     // no `</script>` inside the script element: every `<` as its JSON escape
     let json = data.to_string().replace('<', "\\u003c");
     let html = TEMPLATE

@@ -66,6 +66,11 @@ pub struct InspectArgs {
     /// width, lines and channels.
     #[arg(long, value_name = "B [FLAGS]")]
     pub against: Option<String>,
+    /// Threads: a scene's exact visibility and its summary's rendering run on N threads,
+    /// as `render --threads N` runs them, and the page's arrays are compressed on N
+    /// threads (0: one per core). The page is identical at any N, byte for byte.
+    #[arg(long, default_value_t = 1, value_name = "N")]
+    pub threads: usize,
     /// How to draw a scene (refused with a trace).
     #[command(flatten, next_help_heading = crate::draw::SCENE_ONLY)]
     pub draw: DrawArgs,
@@ -264,6 +269,7 @@ fn open(
     draw: &DrawArgs,
     machine_args: &MachineArgs,
     numeric: Numeric,
+    threads: usize,
 ) -> Result<Opened, CliError> {
     let kind = InputKind::of(input)?;
     let machine = machine_args.load()?;
@@ -273,7 +279,7 @@ fn open(
             (*reader.header(), OpenedSource::Trace(reader))
         }
         InputKind::Scene => {
-            let drawn = draw.draw(Some(input))?;
+            let drawn = draw.draw_on(Some(input), threads)?;
             (drawn.renderer.header(), OpenedSource::Scene(drawn))
         }
     };
@@ -310,6 +316,7 @@ impl Opened {
         self,
         draw: &DrawArgs,
         input: &Path,
+        threads: usize,
         stage: &Stage,
     ) -> Result<(Prepared, Box<dyn TraceRead>), CliError> {
         let mut prepared = Prepared {
@@ -332,7 +339,7 @@ impl Opened {
             timing: Timing::Fast,
         };
         stage.message("inspect: rendering the scene for its summary");
-        let rendered = render(renderer, &array, 1, &mut NullSink, Taps::default())?;
+        let rendered = render(renderer, &array, threads, &mut NullSink, Taps::default())?;
         let mut text = Vec::new();
         write_render_summary(
             &mut text,
@@ -366,7 +373,12 @@ impl Opened {
 }
 
 impl Prepared {
-    fn options<'a>(&'a self, frames: (u64, u64), window: Option<Window>) -> Options<'a> {
+    fn options<'a>(
+        &'a self,
+        frames: (u64, u64),
+        window: Option<Window>,
+        threads: usize,
+    ) -> Options<'a> {
         Options {
             name: &self.name,
             kind: self.kind.name(),
@@ -376,6 +388,7 @@ impl Prepared {
             reference: self.reference.as_ref().map(|(r, n)| (r.as_slice(), *n)),
             numeric: self.numeric,
             reproduce: &self.reproduce,
+            threads,
         }
     }
 }
@@ -494,9 +507,22 @@ pub fn run(args: &InspectArgs, stdout: &mut dyn Write, progress: bool) -> Result
     }
 
     let stage = Stage::new(progress, "inspect: preparing the input");
-    let a = open(&args.input, &args.draw, &args.machine, args.numeric)?;
+    let threads = cwisim_scene::budget::check_threads(args.threads).map_err(CliError::Usage)?;
+    let a = open(
+        &args.input,
+        &args.draw,
+        &args.machine,
+        args.numeric,
+        threads,
+    )?;
     let mut b = match &against {
-        Some(spec) => Some(open(&spec.input, &spec.draw, &spec.machine, spec.numeric)?),
+        Some(spec) => Some(open(
+            &spec.input,
+            &spec.draw,
+            &spec.machine,
+            spec.numeric,
+            threads,
+        )?),
         None => None,
     };
     if let Some(b) = &b {
@@ -518,24 +544,28 @@ pub fn run(args: &InspectArgs, stdout: &mut dyn Write, progress: bool) -> Result
     // the limits, before any scene is rendered or anything replayed
     check_frames(width, lines, frames.1.saturating_sub(frames.0), runs)?;
     let window = window(args, width, lines, frames, runs)?;
-    let (a, mut reader_a) = a.finish(&args.draw, &args.input, &stage)?;
+    let (a, mut reader_a) = a.finish(&args.draw, &args.input, threads, &stage)?;
     let mut b = match (b.take(), &against) {
-        (Some(b), Some(spec)) => Some(b.finish(&spec.draw, &spec.input, &stage)?),
+        (Some(b), Some(spec)) => Some(b.finish(&spec.draw, &spec.input, threads, &stage)?),
         _ => None,
     };
-    stage.message("inspect: replaying on the stepped model, gathering every pixel's history");
+    stage.message("inspect: replaying, gathering every pixel's history");
     let page: Page = match &mut b {
-        None => inspect(&mut *reader_a, &a.machine, &a.options(frames, window))?,
+        None => inspect(
+            &mut *reader_a,
+            &a.machine,
+            &a.options(frames, window, threads),
+        )?,
         Some((b, reader_b)) => inspect_pair(
             Run {
                 trace: &mut *reader_a,
                 machine: &a.machine,
-                opts: a.options(frames, window),
+                opts: a.options(frames, window, threads),
             },
             Run {
                 trace: &mut **reader_b,
                 machine: &b.machine,
-                opts: b.options(frames, window),
+                opts: b.options(frames, window, threads),
             },
             &mut |_| {},
         )?,
