@@ -12,12 +12,12 @@ use crate::error::StudyError;
 use crate::provenance::{comment_lines, NoteRecorder};
 use crate::until::UntilLine;
 use cwisim_isa::note::{Note, NoteTable};
-use cwisim_isa::text::format_value;
 use cwisim_isa::{Instruction, Opcode, TraceRead};
 use cwisim_xproc::{
     replay_probed_numeric, Machine, NullSink, Numeric, Probe, ProcessorState, StepFrom,
 };
 use std::cell::RefCell;
+use std::fmt::Write as _;
 
 /// Replays `trace` up to scanline `y` and returns every visit of a token to processor
 /// `x` on it. `Ok(Err(n))`: the trace outputs only `n` scanlines.
@@ -242,44 +242,59 @@ impl Probe for Watch {
 
 /// Values as the text trace writes them, comma-separated.
 pub fn values(v: &[f64]) -> String {
-    v.iter()
-        .map(|x| format_value(*x))
-        .collect::<Vec<_>>()
-        .join(",")
+    let mut out = String::new();
+    write_values(&mut out, v);
+    out
+}
+
+/// [`values`], appended to `out`.
+pub fn write_values(out: &mut String, v: &[f64]) {
+    for (k, x) in v.iter().enumerate() {
+        if k > 0 {
+            out.push(',');
+        }
+        // as cwisim_isa::text::format_value writes it
+        let _ = write!(out, "{x:?}");
+    }
 }
 
 /// The registers and flags, one line: `acc=… I=… dI=… ddI=… [locked masked neg]`;
 /// a preload register shows `-` when it holds no unconsumed value.
 pub fn state(s: &ProcessorState) -> String {
-    let reg = |k: usize| {
+    let mut out = String::new();
+    write_state(&mut out, s);
+    out
+}
+
+/// [`state`], appended to `out`.
+pub fn write_state(out: &mut String, s: &ProcessorState) {
+    out.push_str("acc=");
+    write_values(out, &s.acc);
+    for (k, name) in [" I=", " dI=", " ddI="].into_iter().enumerate() {
+        out.push_str(name);
         if s.has[k] {
-            values(&s.reg[k])
+            write_values(out, &s.reg[k]);
         } else {
-            "-".to_string()
+            out.push('-');
         }
-    };
-    let mut flags = Vec::new();
-    if s.locked {
-        flags.push("locked");
     }
-    if s.masked {
-        flags.push("masked");
-    }
-    if s.negative_enabled {
-        flags.push("neg");
-    }
-    format!(
-        "acc={} I={} dI={} ddI={} flags={}",
-        values(&s.acc),
-        reg(0),
-        reg(1),
-        reg(2),
-        if flags.is_empty() {
-            "-".to_string()
-        } else {
-            flags.join(",")
+    out.push_str(" flags=");
+    let flags = [
+        (s.locked, "locked"),
+        (s.masked, "masked"),
+        (s.negative_enabled, "neg"),
+    ];
+    let mut any = false;
+    for (_, name) in flags.iter().filter(|f| f.0) {
+        if any {
+            out.push(',');
         }
-    )
+        out.push_str(name);
+        any = true;
+    }
+    if !any {
+        out.push('-');
+    }
 }
 
 #[cfg(test)]
@@ -335,6 +350,18 @@ Refresh
         assert_eq!(bare.visits, h.visits);
         assert!(bare.notes.is_empty());
         assert_eq!(history_lines(&bare, false), lines[2..]);
+    }
+
+    /// The values are written as the text trace writes them.
+    #[test]
+    fn values_are_the_text_traces() {
+        let v = [0.1, -0.0, 1e300, -2.5e-310, f64::NAN, f64::INFINITY, 3.0];
+        let want: Vec<String> = v
+            .iter()
+            .map(|x| cwisim_isa::text::format_value(*x))
+            .collect();
+        assert_eq!(values(&v), want.join(","));
+        assert_eq!(values(&[]), "");
     }
 
     /// Every pixel's history, with the scanlines before it on the fast engine, is the

@@ -24,7 +24,7 @@
 
 use crate::cost::{viridis, CostMap, CostReader};
 use crate::error::StudyError;
-use crate::history::{state, values, visit_note};
+use crate::history::{visit_note, write_state, write_values};
 use crate::plot::{group_cycles, issue_costs, GROUPS, OVERRUN};
 use crate::provenance::NoteRecorder;
 use crate::until::UntilLine;
@@ -38,6 +38,7 @@ use cwisim_xproc::{
 use serde_json::{json, Value};
 use std::cell::RefCell;
 use std::collections::{HashMap, VecDeque};
+use std::hash::{BuildHasherDefault, Hasher};
 use std::io::Write;
 
 /// The page's template: HTML, CSS and script, with the data put in at `__CWISIM_DATA__`.
@@ -198,19 +199,61 @@ pub fn default_window_in(width: u64, first: u64, lines: u64, budget: u64) -> Win
 /// Distinct strings, numbered in the order first seen.
 #[derive(Default)]
 struct Strings {
-    ids: HashMap<String, u32>,
-    list: Vec<String>,
+    ids: HashMap<Box<str>, u32, BuildHasherDefault<Fnv>>,
+    /// Scratch space a string is written in before it is looked up.
+    buf: String,
 }
 
 impl Strings {
     fn id(&mut self, s: String) -> u32 {
-        if let Some(&id) = self.ids.get(&s) {
+        self.buf = s;
+        self.take_buf()
+    }
+
+    /// The number of the string `write` writes.
+    fn id_of(&mut self, write: impl FnOnce(&mut String)) -> u32 {
+        self.buf.clear();
+        write(&mut self.buf);
+        self.take_buf()
+    }
+
+    fn take_buf(&mut self) -> u32 {
+        if let Some(&id) = self.ids.get(self.buf.as_str()) {
             return id;
         }
-        let id = self.list.len() as u32;
-        self.ids.insert(s.clone(), id);
-        self.list.push(s);
+        let id = self.ids.len() as u32;
+        self.ids.insert(self.buf.as_str().into(), id);
         id
+    }
+
+    /// The strings in the order of their numbers.
+    fn into_list(self) -> Vec<Box<str>> {
+        let mut list: Vec<(u32, Box<str>)> = self.ids.into_iter().map(|(s, k)| (k, s)).collect();
+        list.sort_unstable_by_key(|e| e.0);
+        list.into_iter().map(|e| e.1).collect()
+    }
+}
+
+/// FNV-1a, 64 bits: the string table's hash (its keys are the page's own text; SipHash's
+/// guard against chosen keys costs a tenth of the page's time).
+#[derive(Default)]
+struct Fnv(u64);
+
+impl Hasher for Fnv {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+
+    fn write(&mut self, bytes: &[u8]) {
+        let mut h = if self.0 == 0 {
+            0xcbf2_9ce4_8422_2325
+        } else {
+            self.0
+        };
+        for &b in bytes {
+            h = (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
+        }
+        self.0 = h;
     }
 }
 
@@ -239,9 +282,9 @@ pub const NOTES: [&str; 3] = [
 struct Pixel {
     visits: Vec<u32>,
     shifted: Option<(u32, u32)>,
-    /// The state after its last visit and its strings' numbers (shown, raw): what the
-    /// next visit finds.
-    last: Option<Box<(ProcessorState, u32, u32)>>,
+    /// The numbers of the strings (shown, raw) of the state its last visit left: what the
+    /// next visit finds, since the tokens between them changed nothing.
+    last: Option<(u32, u32)>,
 }
 
 /// Which processors an opcode's instruction names, as the page's event view draws it:
@@ -381,12 +424,13 @@ impl Probe for Collector {
         let pixel = &mut f.pixels[k];
         let strings = &mut f.strings;
         if instr.op == Opcode::Refresh {
-            let shown = strings.id(values(&before.acc));
+            let shown = strings.id_of(|b| write_values(b, &before.acc));
             let raw = fixed.map_or(u32::MAX, |q| strings.id(raw_values(&before.acc, q.acc)));
             pixel.shifted = Some((shown, raw));
         }
-        // every visit reported is one `cwisim history` shows (replay_visits_numeric);
-        // the state before is most often the one the last visit left
+        // every visit reported is one `cwisim history` shows (replay_visits_numeric): a
+        // token between two of them changed nothing, so the state before is the one the
+        // last visit left
         let note = visit_note(instr.op, addressed, before, after).map_or(0, |n| {
             1 + NOTES.iter().position(|&m| m == n).expect("a known note") as u8
         });
@@ -394,10 +438,10 @@ impl Probe for Collector {
         f.visits.index.push(index as f64);
         f.visits.cycle.push(cycle as f64);
         f.visits.note.push(note);
-        let (b, b_raw) = match pixel.last.as_deref() {
-            Some((s, shown, raw)) if s == before => (*shown, *raw),
-            _ => (
-                strings.id(state(before)),
+        let (b, b_raw) = match pixel.last {
+            Some(ids) => ids,
+            None => (
+                strings.id_of(|b| write_state(b, before)),
                 fixed.map_or(u32::MAX, |q| strings.id(raw_state(before, &q))),
             ),
         };
@@ -405,7 +449,7 @@ impl Probe for Collector {
             (b, b_raw)
         } else {
             (
-                strings.id(state(after)),
+                strings.id_of(|b| write_state(b, after)),
                 fixed.map_or(u32::MAX, |q| strings.id(raw_state(after, &q))),
             )
         };
@@ -415,14 +459,7 @@ impl Probe for Collector {
             f.visits.before_raw.push(b_raw);
             f.visits.after_raw.push(a_raw);
         }
-        match &mut pixel.last {
-            Some(last) => {
-                last.0.clone_from(after);
-                last.1 = a;
-                last.2 = a_raw;
-            }
-            None => pixel.last = Some(Box::new((after.clone(), a, a_raw))),
-        }
+        pixel.last = Some((a, a_raw));
         pixel.visits.push(at);
     }
 }
@@ -484,7 +521,7 @@ impl Blobs {
         self.bytes(values.iter().flat_map(|v| v.to_le_bytes()).collect())
     }
 
-    fn texts(&self, lines: &[String]) -> Value {
+    fn texts<S: std::borrow::Borrow<str>>(&self, lines: &[S]) -> Value {
         self.bytes(lines.join("\n").into_bytes())
     }
 
@@ -982,6 +1019,7 @@ fn frame_json(
         line_start[k + 1] += line_start[k];
     }
 
+    let strings = log.strings.into_list();
     let history = log.window.map(|window| {
         // per pixel its visits (consecutive), the value shifted out and how many visits
         // it left out
@@ -1010,7 +1048,7 @@ fn frame_json(
         json!({
             "x": [window.x.0, window.x.1],
             "lines": [window.lines.0, window.lines.1],
-            "strings": blobs.texts(&log.strings.list),
+            "strings": blobs.texts(&strings),
             "starts": blobs.u32s(&starts),
             "shifted": blobs.u32s(&shifted),
             "hidden": blobs.u32s(&hidden),
