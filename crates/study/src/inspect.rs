@@ -199,7 +199,7 @@ pub fn default_window_in(width: u64, first: u64, lines: u64, budget: u64) -> Win
 /// Distinct strings, numbered in the order first seen.
 #[derive(Default)]
 struct Strings {
-    ids: HashMap<Box<str>, u32, BuildHasherDefault<Fnv>>,
+    ids: HashMap<Box<str>, u32, BuildHasherDefault<WordHash>>,
     /// Scratch space a string is written in before it is looked up.
     buf: String,
 }
@@ -234,24 +234,27 @@ impl Strings {
     }
 }
 
-/// FNV-1a, 64 bits: the string table's hash (its keys are the page's own text; SipHash's
-/// guard against chosen keys costs a tenth of the page's time).
+/// The string table's hash, eight bytes at a time (FxHash's step: rotate, xor, multiply):
+/// its keys are the page's own text, so SipHash's guard against chosen keys is not needed,
+/// and it cost a tenth of the page's time.
 #[derive(Default)]
-struct Fnv(u64);
+struct WordHash(u64);
 
-impl Hasher for Fnv {
+impl Hasher for WordHash {
     fn finish(&self) -> u64 {
         self.0
     }
 
     fn write(&mut self, bytes: &[u8]) {
-        let mut h = if self.0 == 0 {
-            0xcbf2_9ce4_8422_2325
-        } else {
-            self.0
-        };
-        for &b in bytes {
-            h = (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
+        const K: u64 = 0x517c_c1b7_2722_0a95;
+        let mut h = self.0;
+        let mut chunks = bytes.chunks_exact(8);
+        for c in &mut chunks {
+            let w = u64::from_le_bytes(c.try_into().expect("eight bytes"));
+            h = (h.rotate_left(5) ^ w).wrapping_mul(K);
+        }
+        for &b in chunks.remainder() {
+            h = (h.rotate_left(5) ^ u64::from(b)).wrapping_mul(K);
         }
         self.0 = h;
     }
