@@ -14,6 +14,11 @@
 //!   its first touch of every page it writes (the image, the buffers) and its exit
 //!   included. Five more runs print the process's own stage times to standard error.
 //!
+//! * `cli_inspect/pot/1`, `cli_inspect/pot/2` — `cwisim inspect pot -o i.html --threads
+//!   N` as a fresh process: the page of the pot's frame with every pixel's history (the
+//!   scene drawn, its summary and reference image, the replay with the visits, the page's
+//!   arrays compressed).
+//!
 //! The figures are in docs/PERFORMANCE.md.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
@@ -95,6 +100,34 @@ fn cli_process(c: &mut Criterion) {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+fn cli_inspect(c: &mut Criterion) {
+    let dir = std::env::temp_dir().join(format!("cwisim-bench-inspect-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temporary directory");
+    let page = dir.join("i.html");
+    let mut g = c.benchmark_group("cli_inspect");
+    g.sample_size(10).measurement_time(Duration::from_secs(8));
+    for threads in ["1", "2"] {
+        let run = || {
+            let out = Command::new(env!("CARGO_BIN_EXE_cwisim"))
+                .args(["inspect", "pot", "--threads", threads, "-o"])
+                .arg(&page)
+                .output()
+                .expect("the cwisim binary runs");
+            assert!(
+                out.status.success(),
+                "{}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+            out.stdout
+        };
+        g.bench_function(BenchmarkId::new("pot", threads), |b| {
+            b.iter(|| black_box(run()))
+        });
+    }
+    g.finish();
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// The `time` line of five more runs' summaries, to standard error: the command's own
 /// account of its stages, after the warm-up (the figures to hold against `stages_1024`).
 fn print_stage_times(group: &str, vis: &str, mut run: impl FnMut() -> Vec<u8>) {
@@ -105,5 +138,5 @@ fn print_stage_times(group: &str, vis: &str, mut run: impl FnMut() -> Vec<u8>) {
     }
 }
 
-criterion_group!(benches, cli_render, cli_process);
+criterion_group!(benches, cli_render, cli_process, cli_inspect);
 criterion_main!(benches);
