@@ -108,30 +108,57 @@ struct Model<A: Arith> {
     watched_list: Vec<usize>,
     /// Watched processors holding a `NaN` (every token's visit shows there).
     nan: Vec<usize>,
+    /// Room for an instruction's visits and a state after, kept from one to the next.
+    shown: Shown,
+    after: ProcessorState,
+}
+
+/// An instruction's visits shown so far, in the order made: processor, state before. The
+/// states' room is kept from one instruction to the next.
+#[derive(Default)]
+struct Shown {
+    len: usize,
+    list: Vec<(usize, ProcessorState)>,
+}
+
+impl Shown {
+    /// Room for one more visit.
+    fn next(&mut self) -> &mut (usize, ProcessorState) {
+        if self.len == self.list.len() {
+            self.list.push(Default::default());
+        }
+        self.len += 1;
+        &mut self.list[self.len - 1]
+    }
+
+    fn items(&self) -> &[(usize, ProcessorState)] {
+        &self.list[..self.len]
+    }
 }
 
 impl<A: Arith> Model<A> {
     fn state(&self, p: usize) -> ProcessorState {
+        let mut s = ProcessorState::default();
+        self.fill_state(p, &mut s);
+        s
+    }
+
+    /// Processor `p`'s registers as `f64`, into `s` (in the room it has).
+    fn fill_state(&self, p: usize, s: &mut ProcessorState) {
         let pr = &self.procs[p];
         let c = self.channels;
-        let v = |reg: Register, x: &[A::Reg; MAX_CHANNELS]| {
-            x[..c]
-                .iter()
-                .map(|s| self.arith.value(reg, *s))
-                .collect::<Vec<f64>>()
+        let fill = |out: &mut Vec<f64>, reg: Register, x: &[A::Reg; MAX_CHANNELS]| {
+            out.clear();
+            out.extend(x[..c].iter().map(|r| self.arith.value(reg, *r)));
         };
-        ProcessorState {
-            acc: v(Register::Acc, &pr.acc),
-            reg: [
-                v(Register::I, &pr.reg[0]),
-                v(Register::DI, &pr.reg[1]),
-                v(Register::DDI, &pr.reg[2]),
-            ],
-            has: pr.has,
-            locked: pr.locked,
-            masked: pr.masked,
-            negative_enabled: self.negative,
-        }
+        fill(&mut s.acc, Register::Acc, &pr.acc);
+        fill(&mut s.reg[0], Register::I, &pr.reg[0]);
+        fill(&mut s.reg[1], Register::DI, &pr.reg[1]);
+        fill(&mut s.reg[2], Register::DDI, &pr.reg[2]);
+        s.has = pr.has;
+        s.locked = pr.locked;
+        s.masked = pr.masked;
+        s.negative_enabled = self.negative;
     }
 
     /// The value operands of `instr` as the stepped engine converts them when its token
@@ -177,10 +204,13 @@ impl<A: Arith> Model<A> {
         let [v0, d0, dd0] = self.operands(instr);
         let c = self.channels;
         // the visits shown, in the order made: processor, state before
-        let mut shown: Vec<(usize, ProcessorState)> = Vec::new();
-        let touched = |m: &Self, p: usize, shown: &mut Vec<(usize, ProcessorState)>| {
+        let mut shown = std::mem::take(&mut self.shown);
+        shown.len = 0;
+        let touched = |m: &Self, p: usize, shown: &mut Shown| {
             if report && m.watched[p] {
-                shown.push((p, m.state(p)));
+                let slot = shown.next();
+                slot.0 = p;
+                m.fill_state(p, &mut slot.1);
             }
         };
         let mut unmask_all = false;
@@ -284,7 +314,7 @@ impl<A: Arith> Model<A> {
             }
             Opcode::Nop => {}
         }
-        let addressed = shown.len();
+        let addressed = shown.len;
         if unmask_all {
             // the token passes every processor and unmasks it: a change where it does
             // not address it
@@ -297,20 +327,40 @@ impl<A: Arith> Model<A> {
             }
             self.masked.clear();
         }
-        if !report {
-            return;
+        if report {
+            self.report(
+                &mut shown,
+                addressed,
+                (index, line, entry, hop),
+                instr,
+                probe,
+            );
         }
+        self.shown = shown;
+    }
+
+    /// Tells `probe` of the visits `shown` (the first `addressed` of them addressed), and
+    /// of a visit to every watched processor holding a `NaN` besides.
+    fn report(
+        &mut self,
+        shown: &mut Shown,
+        addressed: usize,
+        (index, line, entry, hop): (u64, u64, u64, u64),
+        instr: &Instruction,
+        probe: &mut dyn Probe,
+    ) {
         // a processor holding a NaN differs from itself: every token's visit shows
-        if !self.nan.is_empty() {
-            for k in 0..self.nan.len() {
-                let p = self.nan[k];
-                if !shown.iter().any(|s| s.0 == p) {
-                    touched(self, p, &mut shown);
-                }
+        for k in 0..self.nan.len() {
+            let p = self.nan[k];
+            if !shown.items().iter().any(|s| s.0 == p) {
+                let slot = shown.next();
+                slot.0 = p;
+                self.fill_state(p, &mut slot.1);
             }
         }
-        for (k, (p, before)) in shown.iter().enumerate() {
-            let after = self.state(*p);
+        let mut after = std::mem::take(&mut self.after);
+        for (k, (p, before)) in shown.items().iter().enumerate() {
+            self.fill_state(*p, &mut after);
             let is_nan = |s: &ProcessorState| {
                 s.acc
                     .iter()
@@ -327,6 +377,7 @@ impl<A: Arith> Model<A> {
             let cycle = entry + *p as u64 * hop;
             probe.visit(cycle, *p, index, line, instr, k < addressed, before, &after);
         }
+        self.after = after;
     }
 }
 
@@ -358,6 +409,8 @@ fn visits<A: Arith<Out = f64>>(
         watched_list: (0..w).filter(|&p| watched[p]).collect(),
         watched,
         nan: Vec::new(),
+        shown: Shown::default(),
+        after: ProcessorState::default(),
     };
     let hop = timeline.hop;
     let mut fast = Box::new(FastEngine::with_arith(&header, timeline.clone(), arith));
