@@ -373,6 +373,46 @@ fn a_scene_page_has_its_summary_reference_and_is_deterministic() {
     cwisim_ok(&dir, &["inspect", "pot", "--size", "64x48", "-o", "b.html"]);
     let a = std::fs::read(dir.join("a.html")).unwrap();
     assert_eq!(a, std::fs::read(dir.join("b.html")).unwrap(), "same bytes");
+    // and at any thread count, one per core included, A/B too
+    for threads in ["2", "3", "0"] {
+        cwisim_ok(
+            &dir,
+            &[
+                "inspect",
+                "pot",
+                "--size",
+                "64x48",
+                "--threads",
+                threads,
+                "-o",
+                "t.html",
+            ],
+        );
+        let t = std::fs::read(dir.join("t.html")).unwrap();
+        assert!(t == a, "--threads {threads}: not the same bytes");
+    }
+    let ab = |threads: &str, out: &str| {
+        cwisim_ok(
+            &dir,
+            &[
+                "inspect",
+                "pot",
+                "--size",
+                "64x48",
+                "--against",
+                "pot --size 64x48 --numeric f32",
+                "--threads",
+                threads,
+                "-o",
+                out,
+            ],
+        );
+        std::fs::read(dir.join(out)).unwrap()
+    };
+    assert!(
+        ab("1", "ab1.html") == ab("2", "ab2.html"),
+        "A/B at two threads"
+    );
     let data = page(&dir, "a.html");
     let run = &data["runs"][0];
     let summary = run["summary"].as_str().unwrap();
