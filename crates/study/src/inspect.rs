@@ -205,6 +205,13 @@ struct Strings {
 }
 
 impl Strings {
+    fn with_capacity(n: usize) -> Self {
+        Strings {
+            ids: HashMap::with_capacity_and_hasher(n, BuildHasherDefault::default()),
+            buf: String::new(),
+        }
+    }
+
     fn id(&mut self, s: String) -> u32 {
         self.buf = s;
         self.take_buf()
@@ -874,10 +881,15 @@ fn gather(
         frames: plan
             .windows
             .iter()
-            .map(|w| FrameLog {
-                window: *w,
-                pixels: vec![Pixel::default(); w.map_or(0, |w| w.pixels() as usize)],
-                ..FrameLog::default()
+            .map(|w| {
+                let pixels = w.map_or(0, |w| w.pixels() as usize);
+                FrameLog {
+                    window: *w,
+                    pixels: vec![Pixel::default(); pixels],
+                    // about one new state per pixel: room up front, not grown by rehashing
+                    strings: Strings::with_capacity(pixels),
+                    ..FrameLog::default()
+                }
             })
             .collect(),
         fixed: match opts.numeric {
