@@ -1,5 +1,7 @@
 //! The cycle-stepped reference engine: advances every processor of the systolic chain
-//! every cycle, with the instruction bus as an explicit state machine.
+//! cycle by cycle, with the instruction bus as an explicit state machine; the cycles in
+//! which nothing can happen are jumped over (`next_cycle`), so waiting for the display
+//! costs a step, not a step per cycle.
 //!
 //! It shares nothing with the fast engine but the machine parameters and the statistics
 //! bookkeeping: processors are plain structs with one flag per condition, and every
@@ -183,9 +185,8 @@ impl<'p, A: Arith> SteppedEngine<'p, A> {
     /// statistics handed over; the chain starts empty, and the bus idle at the cycle that
     /// last token entered, where the stepped engine starts the next instruction.
     ///
-    /// Its cycles are plain arithmetic, as they are stepped: a hand-over at cycle 2⁶³ or
-    /// later (only at the edges of the machine's ranges) is beyond it, and
-    /// [`crate::replay_probed_from`] refuses one.
+    /// A hand-over at cycle 2⁶³ or later (only at the edges of the machine's ranges) is
+    /// beyond it, and [`crate::replay_probed_from`] refuses one.
     pub fn resume(state: Handover<A>, probe: &'p mut dyn Probe) -> Self {
         let Handover {
             header,
