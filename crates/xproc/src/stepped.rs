@@ -335,7 +335,7 @@ impl<'p, A: Arith> SteppedEngine<'p, A> {
             // it enters once issued and past `free_at` if the first stage is free; if it
             // is not, the token there moves first (counted above)
             let enter = bus.issued_at.max(self.free_at);
-            if enter > t || self.in_flight == 0 {
+            if enter > t || self.stages[0].is_none() {
                 next = next.min(enter.max(after));
             }
         }
