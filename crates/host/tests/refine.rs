@@ -120,6 +120,45 @@ fn a_sweep_prints_one_table_per_value() {
 }
 
 #[test]
+fn a_sweep_is_the_same_at_any_thread_count() {
+    let dir = scratch("refine-sweep-threads");
+    let run = |threads: &str| {
+        let (csv, plot) = (format!("s{threads}.csv"), format!("s{threads}.png"));
+        let out = cwisim_ok(
+            &dir,
+            &[
+                "refine",
+                "--size",
+                "48x40",
+                "--sweep",
+                "aa-threshold=0.05,0.1,0.2,0.4,all",
+                "--threads",
+                threads,
+                "--csv",
+                &csv,
+                "--plot",
+                &plot,
+            ],
+        );
+        (
+            out.replace(&format!("{csv}, {plot}"), "CSV, PLOT"),
+            read(dir.join(&csv)),
+            read(dir.join(&plot)),
+        )
+    };
+    let one = run("1");
+    assert_eq!(
+        one.0.matches("pot (--aa-threshold ").count(),
+        5,
+        "{}",
+        one.0
+    );
+    for threads in ["2", "3", "0"] {
+        assert!(run(threads) == one, "--threads {threads}");
+    }
+}
+
+#[test]
 fn bad_input_is_refused_in_one_line_with_exit_2() {
     let dir = scratch("refine-bad");
     for (args, says) in [

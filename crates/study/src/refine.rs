@@ -360,3 +360,56 @@ pub fn run_refine(
         ids,
     })
 }
+
+/// Runs several refinements — a sweep's runs, `setups` — on `threads` threads (0: one
+/// per core), handing each run to `each` in order as soon as it and every run before it
+/// are done; the runs in order. `progress` is told the scanlines done over every run so
+/// far (from any thread). The runs are the same at any thread count. A trace is written
+/// only of a single run (on the calling thread): with `trace` and several setups, a
+/// usage error.
+pub fn run_refines(
+    setups: &[RefineSetup<'_>],
+    threads: usize,
+    trace: Option<&mut dyn TraceWrite>,
+    progress: &(dyn Fn(u64) + Sync),
+    mut each: impl FnMut(usize, &RefineRun),
+) -> Result<Vec<RefineRun>, StudyError> {
+    if let Some(trace) = trace {
+        let [setup] = setups else {
+            return Err(StudyError::Usage(
+                "a trace is the stream of one run; a sweep makes several".into(),
+            ));
+        };
+        let run = run_refine(setup, Some(trace), Some(&mut |lines| progress(lines)))?;
+        each(0, &run);
+        return Ok(vec![run]);
+    }
+    // scanlines done by each run so far
+    let done: Vec<std::sync::atomic::AtomicU64> = setups
+        .iter()
+        .map(|_| std::sync::atomic::AtomicU64::new(0))
+        .collect();
+    let mut runs = Vec::with_capacity(setups.len());
+    crate::parallel::ordered(
+        setups.len(),
+        threads,
+        |k| {
+            let mut report = |lines: u64| {
+                done[k].store(lines, std::sync::atomic::Ordering::Relaxed);
+                progress(
+                    done.iter()
+                        .map(|d| d.load(std::sync::atomic::Ordering::Relaxed))
+                        .sum(),
+                );
+            };
+            run_refine(&setups[k], None, Some(&mut report))
+        },
+        |event| {
+            if let crate::parallel::Event::Done(k, run) = event {
+                each(k, &run);
+                runs.push(run);
+            }
+        },
+    )?;
+    Ok(runs)
+}
