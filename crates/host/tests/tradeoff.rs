@@ -310,3 +310,28 @@ fn tradeoff_is_the_same_at_any_thread_count_but_for_host_times() {
         assert_eq!(run(threads), one, "--threads {threads}");
     }
 }
+
+#[test]
+fn fit_is_the_same_at_any_thread_count() {
+    let dir = scratch("fit-threads");
+    let run = |threads: &str| {
+        cwisim_ok(
+            &dir,
+            &[
+                "fit",
+                "pot",
+                "--size",
+                "64x48",
+                "--max-error",
+                "1e-4",
+                "--threads",
+                threads,
+            ],
+        )
+    };
+    let one = run("1");
+    assert!(one.contains("replays"), "{one}");
+    for threads in ["2", "3", "0"] {
+        assert_eq!(run(threads), one, "--threads {threads}");
+    }
+}
