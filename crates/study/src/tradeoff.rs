@@ -931,6 +931,91 @@ mod tests {
     }
 
     #[test]
+    fn the_settings_of_one_stream_differ_only_in_the_format() {
+        let entries = [
+            registry::find("vanrij").unwrap(),
+            registry::find("woo-chall").unwrap(),
+        ];
+        let formats = [
+            Numeric::F64,
+            Numeric::F32,
+            "fixed:I=4.8,dI=2.8,ddI=1.8".parse().unwrap(),
+        ];
+        let axes = Axes {
+            world: true,
+            ..Axes::default()
+        };
+        let g = grid(&entries, &axes, &formats);
+        let streams = streams(&g);
+        assert_eq!(streams.len() * formats.len(), g.len());
+        let mut next = 0;
+        for r in &streams {
+            assert_eq!(r.start, next);
+            next = r.end;
+            let first = &g[r.start];
+            for (s, numeric) in g[r.clone()].iter().zip(&formats) {
+                assert_eq!(s.settings, first.settings);
+                assert_eq!(s.renderer.name, first.renderer.name);
+                assert_eq!(&s.numeric, numeric);
+            }
+        }
+        assert_eq!(next, g.len());
+        assert_eq!(
+            describe_stream(&g[streams[0].clone()]),
+            "vanrij phong box exact (3 formats)"
+        );
+    }
+
+    /// A stream drawn once and executed in each format measures what rendering each
+    /// setting through the pipeline does: image, statistics, counters.
+    #[test]
+    fn a_shared_stream_measures_as_each_setting_rendered_alone() {
+        let size = Some(Size {
+            width: 64,
+            height: 48,
+        });
+        for (name, shading) in [("vanrij", Shading::Phong), ("sbuffer", Shading::Gouraud)] {
+            let group: Vec<Setting> = [
+                Numeric::F64,
+                Numeric::F32,
+                "fixed:I=10.10,dI=4.14,ddI=1.20".parse().unwrap(),
+            ]
+            .into_iter()
+            .map(|numeric| Setting {
+                renderer: registry::find(name).unwrap(),
+                settings: Settings {
+                    shading,
+                    size,
+                    samples: 2,
+                    ..Settings::default()
+                },
+                numeric,
+            })
+            .collect();
+            let machine = Machine::default();
+            let shared = measure_stream(None, &group, &machine, 2).unwrap();
+            assert_eq!(shared.len(), group.len());
+            for (setting, (m, times)) in group.iter().zip(&shared) {
+                let alone = measure(None, setting, &machine).unwrap();
+                assert_eq!(times.len(), 2);
+                assert_eq!(m.image, alone.image, "{}", setting.describe());
+                assert_eq!(m.counters, alone.counters, "{}", setting.describe());
+                let figures = |m: &Measured| {
+                    let s = &m.stats;
+                    (
+                        s.totals.instructions,
+                        s.totals.late_lines,
+                        s.totals.overflows,
+                        s.line_period,
+                        s.lines.iter().map(|l| l.busy_cycles).collect::<Vec<_>>(),
+                    )
+                };
+                assert_eq!(figures(m), figures(&alone), "{}", setting.describe());
+            }
+        }
+    }
+
+    #[test]
     fn the_pareto_front_keeps_only_undominated_points() {
         let mut rows = vec![
             row(100, 0.5),
