@@ -175,8 +175,9 @@ list's bytes against a frame buffer's; then the naive sequence, every phase's re
 --plot draws error against cumulative cycles (with the naive sequence) and busy cycles per \
 scanline of each frame against the line period; --cost-image-dir writes each phase's cost image; \
 --frames-png each frame; --ids the polygon-ID view (which polygon owns each pixel: false-colour .png, or the identifiers as .npy); --sweep NAME=V1,V2,… repeats the run per value of one threshold, the runs on --threads N \
-threads (default 0: one per core), each run's table printed in order as it is done, the same at \
-any N. docs/RENDERERS.md (\"refine\") and docs/REPRODUCTION.md have the results.\n\n\
+threads (default 0: one per core), each run's table printed in order as it is done; a single \
+run renders its frames on the N threads (as render --threads). The output is the same at any N. \
+docs/RENDERERS.md (\"refine\") and docs/REPRODUCTION.md have the results.\n\n\
 Example:\n  cwisim refine pot --plot quality.png --cost-image-dir costs/",
         after_help = AFTER_HELP
     )]

@@ -156,6 +156,34 @@ fn a_sweep_is_the_same_at_any_thread_count() {
     for threads in ["2", "3", "0"] {
         assert!(run(threads) == one, "--threads {threads}");
     }
+    // one run: its frames on the threads, the same table, CSV and trace
+    let single = |threads: &str| {
+        let (csv, trace) = (format!("r{threads}.csv"), format!("r{threads}.cwb"));
+        let out = cwisim_ok(
+            &dir,
+            &[
+                "refine",
+                "--size",
+                "48x40",
+                "--threads",
+                threads,
+                "--csv",
+                &csv,
+                "--trace",
+                &trace,
+            ],
+        );
+        (
+            out.replace(&format!("{trace}, {csv}"), "TRACE, CSV"),
+            read(dir.join(&csv)),
+            read(dir.join(&trace)),
+        )
+    };
+    let one = single("1");
+    assert!(one.0.contains("TRACE, CSV"), "{}", one.0);
+    for threads in ["2", "3"] {
+        assert!(single(threads) == one, "one run, --threads {threads}");
+    }
 }
 
 #[test]

@@ -110,6 +110,10 @@ pub struct RefineSetup<'a> {
     pub cost_maps: bool,
     /// Gather the polygon-ID view ([`RefineRun::ids`]).
     pub ids: bool,
+    /// Threads the run's frames are rendered on (the pipeline's bands; the same output
+    /// at any count): [`run_refines`] gives a single run all of its threads, a sweep's
+    /// runs one each.
+    pub threads: usize,
 }
 
 /// A tap on the stream: each frame's cost map and display-list bytes, and the stream
@@ -174,7 +178,7 @@ pub fn full_quality(
         machine: machine.clone(),
         ..ArrayConfig::default()
     };
-    render(&r, &array, 1, &mut sink, Taps::default())?;
+    render(&r, &array, settings.threads, &mut sink, Taps::default())?;
     Ok(sink.finish()?.data)
 }
 
@@ -194,6 +198,10 @@ fn pass(
     trace: Option<&mut dyn TraceWrite>,
     mut progress: Option<&mut dyn FnMut(u64)>,
 ) -> Result<Pass, StudyError> {
+    let settings = &Settings {
+        threads: setup.threads,
+        ..*settings
+    };
     let loaded = Source::resolve(setup.scene)?.load_for(settings)?;
     let refine = Refine::with_phases(loaded, settings, &setup.phases)?;
     let h = refine.header();
@@ -220,7 +228,7 @@ fn pass(
     let done = render(
         &refine,
         &array,
-        1,
+        setup.threads,
         &mut sink,
         Taps {
             also: Some(&mut tap),
@@ -299,7 +307,14 @@ pub fn run_refine(
             source.name()
         )));
     }
-    let reference = full_quality(setup.scene, &setup.settings, &setup.machine)?;
+    let reference = full_quality(
+        setup.scene,
+        &Settings {
+            threads: setup.threads,
+            ..setup.settings
+        },
+        &setup.machine,
+    )?;
     let p = pass(setup, &setup.settings, trace, progress)?;
     let h = p.refine.header();
     let naive = if setup.naive {
@@ -366,7 +381,8 @@ pub fn run_refine(
 /// are done; the runs in order. `progress` is told the scanlines done over every run so
 /// far (from any thread). The runs are the same at any thread count. A trace is written
 /// only of a single run (on the calling thread): with `trace` and several setups, a
-/// usage error.
+/// usage error. A single run is rendered on `threads` threads itself (its bands; the
+/// same output at any count), each run of several on one.
 pub fn run_refines(
     setups: &[RefineSetup<'_>],
     threads: usize,
@@ -380,7 +396,20 @@ pub fn run_refines(
                 "a trace is the stream of one run; a sweep makes several".into(),
             ));
         };
-        let run = run_refine(setup, Some(trace), Some(&mut |lines| progress(lines)))?;
+        let setup = RefineSetup {
+            threads,
+            ..setup.clone()
+        };
+        let run = run_refine(&setup, Some(trace), Some(&mut |lines| progress(lines)))?;
+        each(0, &run);
+        return Ok(vec![run]);
+    }
+    if let [setup] = setups {
+        let setup = RefineSetup {
+            threads,
+            ..setup.clone()
+        };
+        let run = run_refine(&setup, None, Some(&mut |lines| progress(lines)))?;
         each(0, &run);
         return Ok(vec![run]);
     }

@@ -83,8 +83,9 @@ pub struct RefineArgs {
     #[arg(long, value_name = "NAME=V1,V2,…")]
     pub sweep: Option<Sweep>,
     /// Threads: a sweep's runs measured on N threads at once (0: one per core), each
-    /// run's table printed in order as it is done; the tables and CSV are the same at any
-    /// N. One run takes one thread.
+    /// run's table printed in order as it is done; a single run's frames rendered on N
+    /// threads (bands of scanlines, as `render --threads`). The output is the same at
+    /// any N.
     #[arg(long, default_value_t = 0, value_name = "N")]
     pub threads: usize,
     /// The machine model.
@@ -200,6 +201,7 @@ pub fn run(args: &RefineArgs, stdout: &mut dyn Write, progress: bool) -> Result<
             naive: k == 0,
             cost_maps: args.cost_image_dir.is_some(),
             ids: args.ids.is_some(),
+            threads: 1,
         })
         .collect();
     let bar = std::sync::Mutex::new(Progress::scanlines(0, progress));
