@@ -300,6 +300,27 @@ pub fn run_refine(
     trace: Option<&mut dyn TraceWrite>,
     progress: Option<&mut dyn FnMut(u64)>,
 ) -> Result<RefineRun, StudyError> {
+    let reference = || {
+        full_quality(
+            setup.scene,
+            &Settings {
+                threads: setup.threads,
+                ..setup.settings
+            },
+            &setup.machine,
+        )
+        .map(std::sync::Arc::new)
+    };
+    run_refine_against(setup, trace, progress, &reference)
+}
+
+/// [`run_refine`], its full-quality image from `reference`.
+fn run_refine_against(
+    setup: &RefineSetup,
+    trace: Option<&mut dyn TraceWrite>,
+    progress: Option<&mut dyn FnMut(u64)>,
+    reference: &dyn Fn() -> Result<std::sync::Arc<Vec<f64>>, StudyError>,
+) -> Result<RefineRun, StudyError> {
     let source = Source::resolve(setup.scene)?;
     if let cwisim_world::AnyScene::Screen(_) = source.load_for(&setup.settings)?.scene {
         return Err(StudyError::Usage(format!(
@@ -307,14 +328,8 @@ pub fn run_refine(
             source.name()
         )));
     }
-    let reference = full_quality(
-        setup.scene,
-        &Settings {
-            threads: setup.threads,
-            ..setup.settings
-        },
-        &setup.machine,
-    )?;
+    let reference = reference()?;
+    let reference = reference.as_slice();
     let p = pass(setup, &setup.settings, trace, progress)?;
     let h = p.refine.header();
     let naive = if setup.naive {
@@ -329,7 +344,7 @@ pub fn run_refine(
             ids: false,
             ..setup.clone()
         };
-        let mut rows = rows(&pass(&full, &all, None, None)?, &reference);
+        let mut rows = rows(&pass(&full, &all, None, None)?, reference);
         // from scratch each time: a frame's cost is its own, and they add up
         let mut cumulative = 0;
         for r in &mut rows {
@@ -364,7 +379,7 @@ pub fn run_refine(
         channels,
         line_period: p.stats.line_period,
         frame_buffer_bytes: (width * lines * channels) as u64 * FRAME_BUFFER_BYTES_PER_SAMPLE,
-        rows: rows(&p, &reference),
+        rows: rows(&p, reference),
         naive,
         busy_per_line,
         counters: p.counters.clone(),
@@ -418,6 +433,38 @@ pub fn run_refines(
         .iter()
         .map(|_| std::sync::atomic::AtomicU64::new(0))
         .collect();
+    // the full-quality image depends on the drawing, not on the thresholds a sweep
+    // varies: one per drawing, made by the first run that needs it while the others wait
+    let drawing = |s: &Settings| Settings {
+        gouraud_threshold: Threshold::All,
+        phong_angle: Threshold::All,
+        aa_threshold: Threshold::All,
+        threads: 1,
+        ..*s
+    };
+    type Slot = std::sync::Mutex<Option<std::sync::Arc<Vec<f64>>>>;
+    let mut references: Vec<(Settings, Slot)> = Vec::new();
+    for setup in setups {
+        let key = drawing(&setup.settings);
+        if !references.iter().any(|(k, _)| *k == key) {
+            references.push((key, std::sync::Mutex::new(None)));
+        }
+    }
+    let reference_of = |setup: &RefineSetup<'_>| {
+        let key = drawing(&setup.settings);
+        let (_, slot) = references
+            .iter()
+            .find(|(k, _)| *k == key)
+            .expect("every drawing has a slot");
+        let mut slot = slot.lock().expect("no reference panicked");
+        if let Some(image) = &*slot {
+            return Ok(std::sync::Arc::clone(image));
+        }
+        let image =
+            std::sync::Arc::new(full_quality(setup.scene, &setup.settings, &setup.machine)?);
+        *slot = Some(std::sync::Arc::clone(&image));
+        Ok(image)
+    };
     let mut runs = Vec::with_capacity(setups.len());
     crate::parallel::ordered(
         setups.len(),
@@ -431,7 +478,9 @@ pub fn run_refines(
                         .sum(),
                 );
             };
-            run_refine(&setups[k], None, Some(&mut report))
+            run_refine_against(&setups[k], None, Some(&mut report), &|| {
+                reference_of(&setups[k])
+            })
         },
         |event| {
             if let crate::parallel::Event::Done(k, run) = event {
