@@ -148,10 +148,14 @@ the worst scanline against the line period, late scanlines, host wall time (medi
 --repeat runs), and the error against the exact image (the box-filtered Gouraud shading of \
 the visible surfaces, computed independently of the scan converter and the array): max, \
 RMS, PSNR. Settings on the Pareto front of RMS error against bus cycles are marked *.\n\n\
+The settings run on --threads N threads (default 0: one per core), each setting's stream drawn \
+once and executed in every format; rows are printed in the grid's order as they are measured, \
+and the table and CSV are the same at any N but for the host times.\n\n\
 --csv writes the table, --plot a PNG of error against cycles (log-log) with the front drawn. \
 Formats: --numeric f64 --numeric f32 --numeric fixed:I=10.22,dI=4.28,ddI=1.35 … (default: f64, \
 f32 and three fixed-point formats; docs/ACCURACY.md). The results are in docs/TRADEOFF.md.\n\n\
-Example:\n  cwisim tradeoff pot --csv pot.csv --plot pot-tradeoff.png",
+Examples:\n  cwisim tradeoff pot --csv pot.csv --plot pot-tradeoff.png\n  \
+cwisim tradeoff fig25 --renderers vanrij --threads 1",
         after_help = AFTER_HELP
     )]
     Tradeoff(tradeoff::TradeoffArgs),
@@ -170,7 +174,9 @@ list's bytes against a frame buffer's; then the naive sequence, every phase's re
 (the paper's figure 1).\n\n\
 --plot draws error against cumulative cycles (with the naive sequence) and busy cycles per \
 scanline of each frame against the line period; --cost-image-dir writes each phase's cost image; \
---frames-png each frame; --ids the polygon-ID view (which polygon owns each pixel: false-colour .png, or the identifiers as .npy); --sweep NAME=V1,V2,… repeats the run per value of one threshold. \
+--frames-png each frame; --ids the polygon-ID view (which polygon owns each pixel: false-colour .png, or the identifiers as .npy); --sweep NAME=V1,V2,… repeats the run per value of one threshold, the runs on --threads N \
+threads (default 0: one per core), each run's table printed in order as it is done; a single \
+run renders its frames on the N threads (as render --threads). The output is the same at any N. \
 docs/RENDERERS.md (\"refine\") and docs/REPRODUCTION.md have the results.\n\n\
 Example:\n  cwisim refine pot --plot quality.png --cost-image-dir costs/",
         after_help = AFTER_HELP
@@ -186,7 +192,9 @@ and the stream replayed in candidate formats: per register a binary search for t
 bits (no overflow) and the fraction bits, then the registers together, widened a bit at a \
 time where it helps most. Prints the format (ready for --numeric), its error, the f64 \
 array's own error (the floor no format can beat), and per register what one fraction bit \
-fewer would cost — which register needs the bits.\n\n\
+fewer would cost — which register needs the bits. The candidates are replayed on --threads N \
+threads (default 0: one per core; the scene's exact visibility too), tried in the same order \
+at any N: the format, its figures and the count of replays are the same.\n\n\
 Example:\n  cwisim fit pot --max-error 1/512",
         after_help = AFTER_HELP
     )]

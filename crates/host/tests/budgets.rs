@@ -97,8 +97,20 @@ fn an_output_past_the_budget_is_refused_and_not_written() {
 #[test]
 fn threads_are_capped() {
     let dir = scratch("budget-threads");
-    let out = cwisim_env(&dir, &[], &["render", "fig25", "--threads", "1000000"]);
-    refused(&out, "--threads 1000000: at most");
+    for command in [
+        &["render", "fig25"][..],
+        &["tradeoff", "fig25"],
+        &["fit", "fig25", "--max-error", "1/512"],
+        &["refine", "--sweep", "phong-angle=5,10"],
+    ] {
+        let args: Vec<&str> = command
+            .iter()
+            .copied()
+            .chain(["--threads", "1000000"])
+            .collect();
+        let out = cwisim_env(&dir, &[], &args);
+        refused(&out, "--threads 1000000: at most");
+    }
 }
 
 #[test]

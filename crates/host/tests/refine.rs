@@ -120,6 +120,73 @@ fn a_sweep_prints_one_table_per_value() {
 }
 
 #[test]
+fn a_sweep_is_the_same_at_any_thread_count() {
+    let dir = scratch("refine-sweep-threads");
+    let run = |threads: &str| {
+        let (csv, plot) = (format!("s{threads}.csv"), format!("s{threads}.png"));
+        let out = cwisim_ok(
+            &dir,
+            &[
+                "refine",
+                "--size",
+                "48x40",
+                "--sweep",
+                "aa-threshold=0.05,0.1,0.2,0.4,all",
+                "--threads",
+                threads,
+                "--csv",
+                &csv,
+                "--plot",
+                &plot,
+            ],
+        );
+        (
+            out.replace(&format!("{csv}, {plot}"), "CSV, PLOT"),
+            read(dir.join(&csv)),
+            read(dir.join(&plot)),
+        )
+    };
+    let one = run("1");
+    assert_eq!(
+        one.0.matches("pot (--aa-threshold ").count(),
+        5,
+        "{}",
+        one.0
+    );
+    for threads in ["2", "3", "0"] {
+        assert!(run(threads) == one, "--threads {threads}");
+    }
+    // one run: its frames on the threads, the same table, CSV and trace
+    let single = |threads: &str| {
+        let (csv, trace) = (format!("r{threads}.csv"), format!("r{threads}.cwb"));
+        let out = cwisim_ok(
+            &dir,
+            &[
+                "refine",
+                "--size",
+                "48x40",
+                "--threads",
+                threads,
+                "--csv",
+                &csv,
+                "--trace",
+                &trace,
+            ],
+        );
+        (
+            out.replace(&format!("{trace}, {csv}"), "TRACE, CSV"),
+            read(dir.join(&csv)),
+            read(dir.join(&trace)),
+        )
+    };
+    let one = single("1");
+    assert!(one.0.contains("TRACE, CSV"), "{}", one.0);
+    for threads in ["2", "3"] {
+        assert!(single(threads) == one, "one run, --threads {threads}");
+    }
+}
+
+#[test]
 fn bad_input_is_refused_in_one_line_with_exit_2() {
     let dir = scratch("refine-bad");
     for (args, says) in [

@@ -238,3 +238,100 @@ fn a_renderer_that_would_repeat_another_is_skipped_saying_so_and_rows_stream() {
     let streamed = lines[2..].iter().take_while(|l| !l.is_empty()).count();
     assert_eq!(streamed, rows.len(), "{out}");
 }
+
+/// `text` with the CSV's column `host_ms`, or the table's column headed `host ms`,
+/// taken out: the host times, the one thing that differs from run to run.
+fn without_host_times(text: &str, csv: bool) -> String {
+    let mut out = String::new();
+    let mut column = None;
+    for line in text.lines() {
+        let fields: Vec<&str> = if csv {
+            line.split(',').collect()
+        } else {
+            line.split_whitespace().collect()
+        };
+        if column.is_none() {
+            column = if csv {
+                fields.iter().position(|f| *f == "host_ms")
+            } else {
+                // `host ms`: two words of the header, 13th of a row
+                (fields.first() == Some(&"renderer")).then_some(12)
+            };
+        }
+        let keep: Vec<&str> = fields
+            .iter()
+            .enumerate()
+            .filter(|&(k, _)| {
+                let row = csv || fields.len() >= 16;
+                !(row && Some(k) == column)
+            })
+            .map(|(_, f)| *f)
+            .collect();
+        out.push_str(&keep.join(" "));
+        out.push('\n');
+    }
+    out
+}
+
+#[test]
+fn tradeoff_is_the_same_at_any_thread_count_but_for_host_times() {
+    let dir = scratch("tradeoff-threads");
+    let run = |threads: &str| {
+        let csv = format!("t{threads}.csv");
+        let out = cwisim_ok(
+            &dir,
+            &[
+                "tradeoff",
+                "pot",
+                "--size",
+                "48x40",
+                "--repeat",
+                "2",
+                "--numeric",
+                "f64;f32",
+                "--renderers",
+                "vanrij,woo-chall",
+                "--threads",
+                threads,
+                "--csv",
+                &csv,
+            ],
+        );
+        let text = std::fs::read_to_string(dir.join(&csv)).unwrap();
+        (
+            without_host_times(&out.replace(&csv, "t.csv"), false),
+            without_host_times(&text, true),
+        )
+    };
+    let one = run("1");
+    assert!(one.1.lines().count() > 20, "{}", one.1);
+    assert!(one.0.contains("Pareto front"), "{}", one.0);
+    for threads in ["2", "3", "0"] {
+        assert_eq!(run(threads), one, "--threads {threads}");
+    }
+}
+
+#[test]
+fn fit_is_the_same_at_any_thread_count() {
+    let dir = scratch("fit-threads");
+    let run = |threads: &str| {
+        cwisim_ok(
+            &dir,
+            &[
+                "fit",
+                "pot",
+                "--size",
+                "64x48",
+                "--max-error",
+                "1e-4",
+                "--threads",
+                threads,
+            ],
+        )
+    };
+    let one = run("1");
+    assert!(one.contains("replays"), "{one}");
+    for threads in ["2", "3", "0"] {
+        assert_eq!(run(threads), one, "--threads {threads}");
+    }
+}

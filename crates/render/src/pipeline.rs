@@ -119,15 +119,18 @@ pub fn render(
     let mut row_figures = Vec::new();
     for index in 0..renderer.frames() {
         let plan = renderer.frame(index, previous.as_ref())?;
-        counters.merge(&plan.counters());
-        row_figures.push(plan.row_figures().unwrap_or(serde_json::Value::Null));
         let fault = |source| RenderError::of_renderer(renderer.name(), source);
         let band = if threads > 1 {
             feed_parallel(&*plan, header.lines, threads, &mut feed, fault)?
         } else {
             feed_serial_bands(&*plan, header.lines, &mut feed, fault)?
         };
-        counters.merge(&band);
+        // the frame's own counters and figures once its rows are emitted (a renderer may
+        // make them as they are), first, as the frame's
+        let mut frame = plan.counters();
+        frame.merge(&band);
+        counters.merge(&frame);
+        row_figures.push(plan.row_figures().unwrap_or(serde_json::Value::Null));
         // the frame's last scanlines reach the array (and the kept frame) before the
         // next frame is planned
         if let Err(e) = feed.flush() {
@@ -171,9 +174,11 @@ pub fn emit(renderer: &dyn Renderer, sink: &mut dyn TraceWrite) -> Result<Counte
     let mut counters = Counters::default();
     for index in 0..renderer.frames() {
         let plan = renderer.frame(index, None)?;
-        counters.merge(&plan.counters());
         let emitted = plan.emit_rows(0..header.lines, &mut guard);
-        counters.merge(&emitted.map_err(|e| guard.fault(e, &fault))?);
+        let emitted = emitted.map_err(|e| guard.fault(e, &fault))?;
+        let mut frame = plan.counters();
+        frame.merge(&emitted);
+        counters.merge(&frame);
     }
     guard.inner.finish().map_err(fault)?;
     Ok(counters)

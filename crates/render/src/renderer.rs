@@ -83,6 +83,7 @@ pub trait Renderer: Sync {
 /// One frame, made ready: any band of its rows can be emitted, on any thread.
 pub trait FramePlan: Sync {
     /// What belongs to the whole frame rather than to a band (polygons, trapezia, …).
+    /// Asked after the frame's rows are emitted (a renderer may make them as they are).
     fn counters(&self) -> Counters {
         Counters::default()
     }
@@ -94,7 +95,7 @@ pub trait FramePlan: Sync {
 
     /// The renderer's own figures per pixel row of this frame, for `--stats-json`
     /// (`"renderer_rows"`): an array with one object per row, or `None` when it keeps
-    /// none. Deterministic: no times.
+    /// none. Deterministic: no times. Asked after the frame's rows are emitted.
     fn row_figures(&self) -> Option<serde_json::Value> {
         None
     }

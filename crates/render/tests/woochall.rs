@@ -581,3 +581,75 @@ fn the_row_figures_add_up_to_the_frame() {
     assert_eq!(Some(max("max_active")), done.counters.get("max_active"));
     assert_eq!(sum("instructions"), done.stats.totals.instructions);
 }
+
+/// A trace sink that refuses its `n`-th instruction.
+struct RefuseAt {
+    n: usize,
+    seen: usize,
+}
+
+impl cwisim_isa::TraceWrite for RefuseAt {
+    fn write(&mut self, _: &Instruction) -> std::io::Result<()> {
+        self.seen += 1;
+        if self.seen > self.n {
+            return Err(std::io::Error::other("refused"));
+        }
+        Ok(())
+    }
+
+    fn finish(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+#[test]
+fn bands_asked_out_of_turn_or_again_give_the_frame_s_stream() {
+    // the rows are made as they are emitted, the state running from row to row: a band
+    // asked ahead of its turn waits for the bands before it, one asked again (it failed)
+    // is made again from the top of the frame
+    let r =
+        (registry::find("woo-chall").unwrap().build)(embedded_scene("pot", 64), &woo(3)).unwrap();
+    let emitted = |plan: &dyn cwisim_render::FramePlan, rows| {
+        let mut out: Vec<Instruction> = Vec::new();
+        plan.emit_rows(rows, &mut out).unwrap();
+        out
+    };
+    let plan = r.frame(0, None).unwrap();
+    let whole = emitted(&*plan, 0..64);
+    let (counters, figures) = (plan.counters(), plan.row_figures());
+    assert_eq!(figures.as_ref().unwrap().as_array().unwrap().len(), 64);
+    // four bands on four threads, started last first
+    let plan = r.frame(0, None).unwrap();
+    let bands = std::thread::scope(|s| {
+        let threads: Vec<_> = (0..4u32)
+            .rev()
+            .map(|k| {
+                let plan = &*plan;
+                s.spawn(move || (k, emitted(plan, k * 16..k * 16 + 16)))
+            })
+            .collect();
+        let mut bands: Vec<_> = threads.into_iter().map(|t| t.join().unwrap()).collect();
+        bands.sort_by_key(|&(k, _)| k);
+        bands.into_iter().flat_map(|(_, b)| b).collect::<Vec<_>>()
+    });
+    assert!(
+        bands == whole,
+        "bands on threads differ from the frame's stream"
+    );
+    assert_eq!(
+        (plan.counters(), plan.row_figures()),
+        (counters.clone(), figures.clone())
+    );
+    // a band whose sink refuses it part way, asked again
+    let plan = r.frame(0, None).unwrap();
+    let mut again = emitted(&*plan, 0..16);
+    let mut refusing = RefuseAt { n: 10, seen: 0 };
+    assert!(plan.emit_rows(16..32, &mut refusing).is_err());
+    again.extend(emitted(&*plan, 16..32));
+    again.extend(emitted(&*plan, 32..64));
+    assert!(
+        again == whole,
+        "a band made again differs from the frame's stream"
+    );
+    assert_eq!((plan.counters(), plan.row_figures()), (counters, figures));
+}

@@ -61,6 +61,7 @@ pub struct Bench<'a> {
     /// The exact box-filtered image.
     exact: &'a [f64],
     runs: u64,
+    threads: usize,
 }
 
 impl<'a> Bench<'a> {
@@ -79,16 +80,82 @@ impl<'a> Bench<'a> {
             reference: Vec::new(),
             exact,
             runs: 0,
+            threads: 1,
         };
         bench.reference = bench.run(&Numeric::F64)?.0;
         Ok(bench)
     }
 
+    /// The bench replaying candidates on `threads` threads (0: one per core; 1 unless
+    /// told). The search goes the same way, to the same format and the same count of
+    /// replays, at any count: candidates tried one after another until one holds are
+    /// replayed a batch at a time, and those after the first that holds are not counted.
+    pub fn threads(mut self, threads: usize) -> Self {
+        self.threads = crate::parallel::resolve_threads(threads);
+        self
+    }
+
     /// The image's max error and the overflows, in `numeric`.
     fn try_format(&mut self, numeric: &Numeric) -> Result<(f64, u64), StudyError> {
         self.runs += 1;
+        self.error_of(numeric)
+    }
+
+    /// The image's max error and the overflows, in `numeric` (not counted).
+    fn error_of(&self, numeric: &Numeric) -> Result<(f64, u64), StudyError> {
         let (image, stats) = self.run(numeric)?;
         Ok((errors(&image, &self.reference).0, stats.totals.overflows))
+    }
+
+    /// `jobs` done on the bench's threads, their results in order.
+    fn map<T: Sync, R: Send>(
+        &self,
+        jobs: &[T],
+        job: impl Fn(&Bench<'_>, &T) -> Result<R, StudyError> + Sync,
+    ) -> Result<Vec<R>, StudyError> {
+        let mut out = Vec::with_capacity(jobs.len());
+        crate::parallel::ordered(
+            jobs.len(),
+            self.threads,
+            |k| job(self, &jobs[k]),
+            |event| {
+                if let crate::parallel::Event::Done(_, r) = event {
+                    out.push(r);
+                }
+            },
+        )?;
+        Ok(out)
+    }
+
+    /// The errors and overflows of every format of `formats`, each replay counted.
+    fn try_all(&mut self, formats: &[Numeric]) -> Result<Vec<(f64, u64)>, StudyError> {
+        let out = self.map(formats, |bench, numeric| bench.error_of(numeric))?;
+        self.runs += formats.len() as u64;
+        Ok(out)
+    }
+
+    /// The first of `candidates` that fits `budget`, trying them in order as one thread
+    /// would — a batch of as many as the bench has threads at a time —, counting the
+    /// replays up to it.
+    fn first_fit(
+        &mut self,
+        candidates: &[FixedFormat],
+        budget: f64,
+    ) -> Result<Option<FixedFormat>, StudyError> {
+        for batch in candidates.chunks(self.threads.max(1)) {
+            let fits = self.map(batch, |bench, f| {
+                let (e, overflows) = bench.error_of(&Numeric::Fixed(*f))?;
+                Ok(overflows == 0 && e <= budget)
+            })?;
+            match fits.iter().position(|&fits| fits) {
+                Some(k) => {
+                    self.runs += k as u64 + 1;
+                    return Ok(Some(batch[k]));
+                }
+                None => self.runs += batch.len() as u64,
+            }
+        }
+        Ok(None)
     }
 
     fn run(&self, numeric: &Numeric) -> Result<(Vec<f64>, RunStats), StudyError> {
@@ -151,14 +218,13 @@ fn give_back(
     loop {
         let mut changed = false;
         for k in 0..REGISTERS.len() {
-            for (int, frac) in [(0, -1), (-1, 0)] {
-                if let Some(f) = nudged(chosen, k, int, frac) {
-                    if bench.fits(&f, budget)? {
-                        *chosen = f;
-                        changed = true;
-                        break;
-                    }
-                }
+            let candidates: Vec<FixedFormat> = [(0, -1), (-1, 0)]
+                .into_iter()
+                .filter_map(|(int, frac)| nudged(chosen, k, int, frac))
+                .collect();
+            if let Some(f) = bench.first_fit(&candidates, budget)? {
+                *chosen = f;
+                changed = true;
             }
         }
         if !changed {
@@ -172,18 +238,13 @@ fn give_back(
 /// holds where either alone does not), or two bits fewer in one (fraction or integer) for
 /// one fraction bit more in another. `true` if one was made.
 fn trade(bench: &mut Bench<'_>, chosen: &mut FixedFormat, budget: f64) -> Result<bool, StudyError> {
+    let mut candidates = Vec::new();
     for a in 0..REGISTERS.len() {
         for b in a + 1..REGISTERS.len() {
             for (ia, fa) in [(0, -1), (-1, 0)] {
                 for (ib, fb) in [(0, -1), (-1, 0)] {
-                    let Some(f) = nudged(chosen, a, ia, fa).and_then(|f| nudged(&f, b, ib, fb))
-                    else {
-                        continue;
-                    };
-                    if bench.fits(&f, budget)? {
-                        *chosen = f;
-                        return Ok(true);
-                    }
+                    candidates
+                        .extend(nudged(chosen, a, ia, fa).and_then(|f| nudged(&f, b, ib, fb)));
                 }
             }
         }
@@ -194,16 +255,17 @@ fn trade(bench: &mut Bench<'_>, chosen: &mut FixedFormat, budget: f64) -> Result
                 continue;
             };
             for to in (0..REGISTERS.len()).filter(|&to| to != from) {
-                if let Some(f) = nudged(&less, to, 0, 1) {
-                    if bench.fits(&f, budget)? {
-                        *chosen = f;
-                        return Ok(true);
-                    }
-                }
+                candidates.extend(nudged(&less, to, 0, 1));
             }
         }
     }
-    Ok(false)
+    match bench.first_fit(&candidates, budget)? {
+        Some(f) => {
+            *chosen = f;
+            Ok(true)
+        }
+        None => Ok(false),
+    }
 }
 
 /// The result of a fit.
@@ -250,9 +312,16 @@ pub fn fit_format(
             Numeric::Fixed(wide)
         )));
     }
-    let mut chosen = wide;
-    for k in 0..REGISTERS.len() {
-        // the fewest integer bits, then the fewest fraction bits, the others generous
+    // each register alone, the others generous: the fewest integer bits, then the
+    // fewest fraction bits (the four searches on the bench's threads)
+    let registers: Vec<usize> = (0..REGISTERS.len()).collect();
+    let alone = bench.map(&registers, |bench, &k| {
+        let mut runs = 0;
+        let mut fits = |f: &FixedFormat| -> Result<bool, StudyError> {
+            runs += 1;
+            let (e, overflows) = bench.error_of(&Numeric::Fixed(*f))?;
+            Ok(overflows == 0 && e <= budget)
+        };
         let mut lo = 1;
         let mut hi = MAX_INT;
         while lo < hi {
@@ -266,7 +335,7 @@ pub fn fit_format(
                     frac_bits: MAX_FRAC,
                 },
             );
-            if bench.fits(&f, budget)? {
+            if fits(&f)? {
                 hi = mid;
             } else {
                 lo = mid + 1;
@@ -285,20 +354,24 @@ pub fn fit_format(
                     frac_bits: mid,
                 },
             );
-            if bench.fits(&f, budget)? {
+            if fits(&f)? {
                 hi = mid;
             } else {
                 lo = mid + 1;
             }
         }
-        set_q(
-            &mut chosen,
-            k,
+        Ok((
             Q {
                 int_bits,
                 frac_bits: lo,
             },
-        );
+            runs,
+        ))
+    })?;
+    let mut chosen = wide;
+    for (k, (register, runs)) in alone.into_iter().enumerate() {
+        set_q(&mut chosen, k, register);
+        bench.runs += runs;
     }
     // together, the errors add: widen the register whose extra bit helps most
     let mut guard = 0;
@@ -307,22 +380,16 @@ pub fn fit_format(
         if guard > 4 * MAX_FRAC {
             return Err(StudyError::Usage("the fit did not converge".into()));
         }
+        let wider: Vec<(usize, Numeric)> = (0..REGISTERS.len())
+            .filter_map(|k| {
+                let old = q(&chosen, k);
+                let f = nudged(&chosen, k, 0, 1).filter(|_| old.frac_bits < MAX_FRAC)?;
+                Some((k, Numeric::Fixed(f)))
+            })
+            .collect();
+        let formats: Vec<Numeric> = wider.iter().map(|(_, f)| *f).collect();
         let mut best: Option<(f64, usize)> = None;
-        for k in 0..REGISTERS.len() {
-            let mut f = chosen;
-            let old = q(&f, k);
-            if old.frac_bits >= MAX_FRAC {
-                continue;
-            }
-            set_q(
-                &mut f,
-                k,
-                Q {
-                    frac_bits: old.frac_bits + 1,
-                    ..old
-                },
-            );
-            let (e, overflows) = bench.try_format(&Numeric::Fixed(f))?;
+        for (&(k, _), (e, overflows)) in wider.iter().zip(bench.try_all(&formats)?) {
             let e = if overflows > 0 { f64::INFINITY } else { e };
             if best.is_none_or(|(b, _)| e < b) {
                 best = Some((e, k));
@@ -349,27 +416,19 @@ pub fn fit_format(
             break;
         }
     }
-    let (error, _) = bench.try_format(&Numeric::Fixed(chosen))?;
-    let exact_error = errors(&bench.run(&Numeric::Fixed(chosen))?.0, bench.exact).0;
+    bench.runs += 1;
+    let image = bench.run(&Numeric::Fixed(chosen))?.0;
+    let error = errors(&image, &bench.reference).0;
+    let exact_error = errors(&image, bench.exact).0;
     let f64_error = errors(&bench.reference, bench.exact).0;
-    let mut one_bit_less = [0.0; 4];
-    for (k, slot) in one_bit_less.iter_mut().enumerate() {
-        let old = q(&chosen, k);
-        if old.frac_bits == 0 {
-            *slot = f64::NAN;
-            continue;
-        }
-        let mut f = chosen;
-        set_q(
-            &mut f,
-            k,
-            Q {
-                frac_bits: old.frac_bits - 1,
-                ..old
-            },
-        );
-        let (e, overflows) = bench.try_format(&Numeric::Fixed(f))?;
-        *slot = if overflows > 0 { f64::INFINITY } else { e };
+    // each register with one fraction bit fewer
+    let fewer: Vec<(usize, Numeric)> = (0..REGISTERS.len())
+        .filter_map(|k| Some((k, Numeric::Fixed(nudged(&chosen, k, 0, -1)?))))
+        .collect();
+    let formats: Vec<Numeric> = fewer.iter().map(|(_, f)| *f).collect();
+    let mut one_bit_less = [f64::NAN; 4];
+    for (&(k, _), (e, overflows)) in fewer.iter().zip(bench.try_all(&formats)?) {
+        one_bit_less[k] = if overflows > 0 { f64::INFINITY } else { e };
     }
     Ok(Fit {
         format: chosen,
@@ -412,6 +471,16 @@ mod tests {
         };
         let mut bench = Bench::new(header, &instructions, &machine, &reference).unwrap();
         let fit = fit_format(&mut bench, budget, Overflow::Saturate).unwrap();
+        // the same search, format, figures and replays on more threads
+        for threads in [2, 3, 8] {
+            let mut on = Bench::new(header, &instructions, &machine, &reference)
+                .unwrap()
+                .threads(threads);
+            let again = fit_format(&mut on, budget, Overflow::Saturate).unwrap();
+            assert_eq!(again.format, fit.format, "{threads}");
+            assert_eq!(again.runs, fit.runs, "{threads}");
+            assert_eq!(format!("{again:?}"), format!("{fit:?}"), "{threads}");
+        }
         // every I × dI × acc format up to 4.12, ddI at its narrowest (1.0)
         let mut best = u32::MAX;
         let formats = || {

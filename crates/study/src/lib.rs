@@ -29,6 +29,7 @@ pub mod error;
 pub mod fit;
 pub mod history;
 pub mod inspect;
+pub mod parallel;
 pub mod plot;
 pub mod provenance;
 pub mod refine;

@@ -110,6 +110,10 @@ pub struct RefineSetup<'a> {
     pub cost_maps: bool,
     /// Gather the polygon-ID view ([`RefineRun::ids`]).
     pub ids: bool,
+    /// Threads the run's frames are rendered on (the pipeline's bands; the same output
+    /// at any count): [`run_refines`] gives a single run all of its threads, a sweep's
+    /// runs one each.
+    pub threads: usize,
 }
 
 /// A tap on the stream: each frame's cost map and display-list bytes, and the stream
@@ -174,7 +178,7 @@ pub fn full_quality(
         machine: machine.clone(),
         ..ArrayConfig::default()
     };
-    render(&r, &array, 1, &mut sink, Taps::default())?;
+    render(&r, &array, settings.threads, &mut sink, Taps::default())?;
     Ok(sink.finish()?.data)
 }
 
@@ -194,6 +198,10 @@ fn pass(
     trace: Option<&mut dyn TraceWrite>,
     mut progress: Option<&mut dyn FnMut(u64)>,
 ) -> Result<Pass, StudyError> {
+    let settings = &Settings {
+        threads: setup.threads,
+        ..*settings
+    };
     let loaded = Source::resolve(setup.scene)?.load_for(settings)?;
     let refine = Refine::with_phases(loaded, settings, &setup.phases)?;
     let h = refine.header();
@@ -220,7 +228,7 @@ fn pass(
     let done = render(
         &refine,
         &array,
-        1,
+        setup.threads,
         &mut sink,
         Taps {
             also: Some(&mut tap),
@@ -292,6 +300,27 @@ pub fn run_refine(
     trace: Option<&mut dyn TraceWrite>,
     progress: Option<&mut dyn FnMut(u64)>,
 ) -> Result<RefineRun, StudyError> {
+    let reference = || {
+        full_quality(
+            setup.scene,
+            &Settings {
+                threads: setup.threads,
+                ..setup.settings
+            },
+            &setup.machine,
+        )
+        .map(std::sync::Arc::new)
+    };
+    run_refine_against(setup, trace, progress, &reference)
+}
+
+/// [`run_refine`], its full-quality image from `reference`.
+fn run_refine_against(
+    setup: &RefineSetup,
+    trace: Option<&mut dyn TraceWrite>,
+    progress: Option<&mut dyn FnMut(u64)>,
+    reference: &dyn Fn() -> Result<std::sync::Arc<Vec<f64>>, StudyError>,
+) -> Result<RefineRun, StudyError> {
     let source = Source::resolve(setup.scene)?;
     if let cwisim_world::AnyScene::Screen(_) = source.load_for(&setup.settings)?.scene {
         return Err(StudyError::Usage(format!(
@@ -299,7 +328,8 @@ pub fn run_refine(
             source.name()
         )));
     }
-    let reference = full_quality(setup.scene, &setup.settings, &setup.machine)?;
+    let reference = reference()?;
+    let reference = reference.as_slice();
     let p = pass(setup, &setup.settings, trace, progress)?;
     let h = p.refine.header();
     let naive = if setup.naive {
@@ -314,7 +344,7 @@ pub fn run_refine(
             ids: false,
             ..setup.clone()
         };
-        let mut rows = rows(&pass(&full, &all, None, None)?, &reference);
+        let mut rows = rows(&pass(&full, &all, None, None)?, reference);
         // from scratch each time: a frame's cost is its own, and they add up
         let mut cumulative = 0;
         for r in &mut rows {
@@ -349,7 +379,7 @@ pub fn run_refine(
         channels,
         line_period: p.stats.line_period,
         frame_buffer_bytes: (width * lines * channels) as u64 * FRAME_BUFFER_BYTES_PER_SAMPLE,
-        rows: rows(&p, &reference),
+        rows: rows(&p, reference),
         naive,
         busy_per_line,
         counters: p.counters.clone(),
@@ -359,4 +389,105 @@ pub fn run_refine(
         cost_maps: p.maps,
         ids,
     })
+}
+
+/// Runs several refinements — a sweep's runs, `setups` — on `threads` threads (0: one
+/// per core), handing each run to `each` in order as soon as it and every run before it
+/// are done; the runs in order. `progress` is told the scanlines done over every run so
+/// far (from any thread). The runs are the same at any thread count. A trace is written
+/// only of a single run (on the calling thread): with `trace` and several setups, a
+/// usage error. A single run is rendered on `threads` threads itself (its bands; the
+/// same output at any count), each run of several on one.
+pub fn run_refines(
+    setups: &[RefineSetup<'_>],
+    threads: usize,
+    trace: Option<&mut dyn TraceWrite>,
+    progress: &(dyn Fn(u64) + Sync),
+    mut each: impl FnMut(usize, &RefineRun),
+) -> Result<Vec<RefineRun>, StudyError> {
+    if let Some(trace) = trace {
+        let [setup] = setups else {
+            return Err(StudyError::Usage(
+                "a trace is the stream of one run; a sweep makes several".into(),
+            ));
+        };
+        let setup = RefineSetup {
+            threads,
+            ..setup.clone()
+        };
+        let run = run_refine(&setup, Some(trace), Some(&mut |lines| progress(lines)))?;
+        each(0, &run);
+        return Ok(vec![run]);
+    }
+    if let [setup] = setups {
+        let setup = RefineSetup {
+            threads,
+            ..setup.clone()
+        };
+        let run = run_refine(&setup, None, Some(&mut |lines| progress(lines)))?;
+        each(0, &run);
+        return Ok(vec![run]);
+    }
+    // scanlines done by each run so far
+    let done: Vec<std::sync::atomic::AtomicU64> = setups
+        .iter()
+        .map(|_| std::sync::atomic::AtomicU64::new(0))
+        .collect();
+    // the full-quality image depends on the drawing, not on the thresholds a sweep
+    // varies: one per drawing, made by the first run that needs it while the others wait
+    let drawing = |s: &Settings| Settings {
+        gouraud_threshold: Threshold::All,
+        phong_angle: Threshold::All,
+        aa_threshold: Threshold::All,
+        threads: 1,
+        ..*s
+    };
+    type Slot = std::sync::Mutex<Option<std::sync::Arc<Vec<f64>>>>;
+    let mut references: Vec<(Settings, Slot)> = Vec::new();
+    for setup in setups {
+        let key = drawing(&setup.settings);
+        if !references.iter().any(|(k, _)| *k == key) {
+            references.push((key, std::sync::Mutex::new(None)));
+        }
+    }
+    let reference_of = |setup: &RefineSetup<'_>| {
+        let key = drawing(&setup.settings);
+        let (_, slot) = references
+            .iter()
+            .find(|(k, _)| *k == key)
+            .expect("every drawing has a slot");
+        let mut slot = slot.lock().expect("no reference panicked");
+        if let Some(image) = &*slot {
+            return Ok(std::sync::Arc::clone(image));
+        }
+        let image =
+            std::sync::Arc::new(full_quality(setup.scene, &setup.settings, &setup.machine)?);
+        *slot = Some(std::sync::Arc::clone(&image));
+        Ok(image)
+    };
+    let mut runs = Vec::with_capacity(setups.len());
+    crate::parallel::ordered(
+        setups.len(),
+        threads,
+        |k| {
+            let mut report = |lines: u64| {
+                done[k].store(lines, std::sync::atomic::Ordering::Relaxed);
+                progress(
+                    done.iter()
+                        .map(|d| d.load(std::sync::atomic::Ordering::Relaxed))
+                        .sum(),
+                );
+            };
+            run_refine_against(&setups[k], None, Some(&mut report), &|| {
+                reference_of(&setups[k])
+            })
+        },
+        |event| {
+            if let crate::parallel::Event::Done(k, run) = event {
+                each(k, &run);
+                runs.push(run);
+            }
+        },
+    )?;
+    Ok(runs)
 }

@@ -65,7 +65,8 @@ pub struct Row {
     pub worst_line_share: f64,
     /// Scanlines not ready by their deadline.
     pub late_lines: u64,
-    /// Wall time of preparing, scan-converting and executing (median), milliseconds.
+    /// Wall time of preparing and scan-converting (shared by the formats of one stream)
+    /// and executing in this format (median of the repeats), milliseconds.
     pub host_ms: f64,
     /// Largest absolute error of any value against the exact image.
     pub max_error: f64,
@@ -408,13 +409,14 @@ pub enum Step<'a> {
         /// exactly as another.
         skipped: &'a [(&'static str, String)],
     },
-    /// Setting `index` of `total` is being measured.
+    /// The settings of a stream, from `index` on, are being measured (on some thread;
+    /// several can be at once, and rows before `index` may still be to come).
     Measuring {
-        /// Its index.
+        /// The index of its first setting.
         index: usize,
         /// Settings in all.
         total: usize,
-        /// The setting, in words (`vanrij gouraud box f64`).
+        /// The settings, in words (`vanrij gouraud box exact (5 formats)`).
         setting: String,
     },
     /// Setting `index` was measured: its row (not yet marked Pareto: that needs every
@@ -448,7 +450,13 @@ pub fn skipped_renderers(
         .collect()
 }
 
-/// Measures every setting of the grid: `renderers` by name (empty: every registered one).
+/// Measures every setting of the grid: `renderers` by name (empty: every registered one),
+/// on `threads` threads (0: one per core). The settings that share a stream (the same
+/// drawing in several numeric formats, [`streams`]) are measured together: the stream is
+/// drawn once and executed in each format ([`measure_stream`]); each reference image is
+/// made once. Streams are measured in parallel, their rows reported to `progress` in the
+/// grid's order as soon as they and every row before them are measured: the rows (but
+/// their host times) are the same at any thread count.
 #[allow(clippy::too_many_arguments)]
 pub fn tradeoff_rows(
     scene: Option<&Path>,
@@ -458,6 +466,7 @@ pub fn tradeoff_rows(
     formats: &[Numeric],
     machine: &Machine,
     repeat: u32,
+    threads: usize,
     progress: &mut dyn FnMut(Step<'_>),
 ) -> Result<Vec<Row>, StudyError> {
     // a progressive renderer's frames refine one another: one frame against the exact
@@ -496,89 +505,250 @@ pub fn tradeoff_rows(
         total: settings.len(),
         skipped: &skipped_renderers(&entries, &axes),
     });
-    // the references made so far, by (Phong, tessellation)
-    let mut references: BTreeMap<(bool, Option<u32>), Vec<f64>> = BTreeMap::new();
+    let groups = streams(&settings);
+    let references = References::default();
     let mut rows = Vec::with_capacity(settings.len());
-    for (k, setting) in settings.iter().enumerate() {
-        progress(Step::Measuring {
-            index: k,
-            total: settings.len(),
-            setting: setting.describe(),
-        });
-        let measured = measure(scene, setting, machine)?;
-        let mut times = vec![measured.time];
-        for _ in 1..repeat.max(1) {
-            times.push(measure(scene, setting, machine)?.time);
-        }
-        times.sort();
-        let stats = &measured.stats;
-        // patches drawn directly are measured against the finest tessellation: the
-        // closest the exact reference comes to the true surface
-        let patches = setting.renderer.patches && axes.world;
-        let reference_tessellation = if patches {
-            Some(MAX_TESSELLATION)
-        } else {
-            setting.settings.tessellate
-        };
-        let key = (
-            setting.settings.shading == Shading::Phong,
-            reference_tessellation,
-        );
-        let reference = match references.entry(key) {
-            std::collections::btree_map::Entry::Occupied(e) => e.into_mut(),
-            std::collections::btree_map::Entry::Vacant(e) => e.insert(reference_image(
-                scene,
-                &Settings {
-                    tessellate: reference_tessellation,
-                    ..setting.settings
-                },
-            )?),
-        };
-        let (max_error, rms_error, psnr_db) = errors(&measured.image, reference.as_slice());
-        let worst = stats.lines.iter().map(|l| l.busy_cycles).max().unwrap_or(0);
-        let s = &setting.settings;
-        rows.push(Row {
-            renderer: setting.renderer.name,
-            shading: s.shading.name(),
-            aa: if setting.renderer.supersampled {
-                "-"
-            } else {
-                s.aa.name()
-            },
-            samples: setting.renderer.supersampled.then_some(s.samples),
-            visibility: if axes.world && !setting.renderer.supersampled {
-                s.visibility.name()
-            } else {
-                "-"
-            },
-            tessellate: s.tessellate,
-            root_tolerance: patches.then_some(s.root_tolerance),
-            numeric: short_numeric(&setting.numeric),
-            register_bits: register_bits(&setting.numeric),
-            instructions: stats.totals.instructions,
-            busy_cycles: stats.lines.iter().map(|l| l.busy_cycles).sum(),
-            worst_line_share: if stats.line_period > 0 {
-                worst as f64 / stats.line_period as f64
-            } else {
-                0.0
-            },
-            late_lines: stats.totals.late_lines,
-            host_ms: times[times.len() / 2].as_secs_f64() * 1e3,
-            max_error,
-            rms_error,
-            psnr_db,
-            overflows: stats.totals.overflows,
-            counters: measured.counters,
-            pareto: false,
-        });
-        progress(Step::Measured {
-            index: k,
-            total: settings.len(),
-            row: rows.last().expect("just pushed"),
-        });
-    }
+    crate::parallel::ordered(
+        groups.len(),
+        threads,
+        |g| {
+            let group = &settings[groups[g].clone()];
+            let measured = measure_stream(scene, group, machine, repeat)?;
+            group
+                .iter()
+                .zip(measured)
+                .map(|(setting, (measured, times))| {
+                    let reference = references.get(scene, setting, axes.world)?;
+                    Ok(row_of(setting, &measured, &times, &reference, axes.world))
+                })
+                .collect::<Result<Vec<Row>, StudyError>>()
+        },
+        |event| match event {
+            crate::parallel::Event::Started(g) => progress(Step::Measuring {
+                index: groups[g].start,
+                total: settings.len(),
+                setting: describe_stream(&settings[groups[g].clone()]),
+            }),
+            crate::parallel::Event::Done(g, group) => {
+                for (index, row) in groups[g].clone().zip(group) {
+                    rows.push(row);
+                    progress(Step::Measured {
+                        index,
+                        total: settings.len(),
+                        row: rows.last().expect("just pushed"),
+                    });
+                }
+            }
+        },
+    )?;
     mark_pareto(&mut rows);
     Ok(rows)
+}
+
+/// The settings of `settings` that draw one stream — the same renderer and drawing
+/// settings, in consecutive places, differing only in the array's numeric format (which
+/// the stream does not depend on) — as ranges of indices, in order.
+pub fn streams(settings: &[Setting]) -> Vec<std::ops::Range<usize>> {
+    let mut out: Vec<std::ops::Range<usize>> = Vec::new();
+    for (k, s) in settings.iter().enumerate() {
+        match out.last_mut() {
+            Some(last)
+                if std::ptr::eq(settings[last.start].renderer, s.renderer)
+                    && settings[last.start].settings == s.settings =>
+            {
+                last.end = k + 1
+            }
+            _ => out.push(k..k + 1),
+        }
+    }
+    out
+}
+
+/// Settings that share one stream in words, as a progress line shows them: the first
+/// one's, with the count of formats.
+fn describe_stream(group: &[Setting]) -> String {
+    match group {
+        [one] => one.describe(),
+        [first, ..] => {
+            let mut words = first.describe();
+            let numeric = short_numeric(&first.numeric);
+            words.truncate(words.len() - numeric.len());
+            format!("{words}({} formats)", group.len())
+        }
+        [] => String::new(),
+    }
+}
+
+/// The references made so far, by (Phong, tessellation): each made once, by the first
+/// setting that needs it, while the others that need it wait.
+#[derive(Default)]
+struct References {
+    made: std::sync::Mutex<BTreeMap<(bool, Option<u32>), Reference>>,
+}
+
+type Reference = std::sync::Arc<std::sync::Mutex<Option<std::sync::Arc<Vec<f64>>>>>;
+
+impl References {
+    /// The reference `setting` is measured against: its own geometry's, or for patches
+    /// drawn directly (on a world scene) the finest tessellation's — the closest the
+    /// exact reference comes to the true surface.
+    fn get(
+        &self,
+        scene: Option<&Path>,
+        setting: &Setting,
+        world: bool,
+    ) -> Result<std::sync::Arc<Vec<f64>>, StudyError> {
+        let tessellation = reference_tessellation(setting, world);
+        let key = (setting.settings.shading == Shading::Phong, tessellation);
+        let slot = {
+            let mut made = self.made.lock().expect("no reference panicked");
+            std::sync::Arc::clone(made.entry(key).or_default())
+        };
+        let mut slot = slot.lock().expect("no reference panicked");
+        if let Some(image) = &*slot {
+            return Ok(std::sync::Arc::clone(image));
+        }
+        let image = std::sync::Arc::new(reference_image(
+            scene,
+            &Settings {
+                tessellate: tessellation,
+                ..setting.settings
+            },
+        )?);
+        *slot = Some(std::sync::Arc::clone(&image));
+        Ok(image)
+    }
+}
+
+/// The tessellation of the reference a setting is measured against (see
+/// [`References::get`]).
+fn reference_tessellation(setting: &Setting, world: bool) -> Option<u32> {
+    if setting.renderer.patches && world {
+        Some(MAX_TESSELLATION)
+    } else {
+        setting.settings.tessellate
+    }
+}
+
+/// The settings of one stream ([`streams`]) measured: the stream drawn once (read,
+/// prepared, scan-converted) and executed in each setting's numeric format; all of it
+/// `repeat` times for the host times. Each setting's measurement (its image, counters
+/// and statistics from the first time) with its host times: the drawing's, which its
+/// formats share, plus its own execution's.
+pub fn measure_stream(
+    scene: Option<&Path>,
+    group: &[Setting],
+    machine: &Machine,
+    repeat: u32,
+) -> Result<Vec<(Measured, Vec<Duration>)>, StudyError> {
+    let Some(first) = group.first() else {
+        return Ok(Vec::new());
+    };
+    let mut out: Vec<(Measured, Vec<Duration>)> = Vec::with_capacity(group.len());
+    for time in 0..repeat.max(1) {
+        let start = Instant::now();
+        let loaded = Source::resolve(scene)?.load_for(&first.settings)?;
+        let renderer = (first.renderer.build)(loaded, &first.settings)?;
+        let header = renderer.header();
+        let mut instructions: Vec<cwisim_isa::Instruction> = Vec::new();
+        let counters = cwisim_render::emit(&*renderer, &mut instructions)?;
+        let stream = cwisim_isa::CheckedStream::from_vec(&header, instructions)
+            .map_err(|unfit| StudyError::Array(unfit.refusal()))?;
+        let drawing = start.elapsed();
+        for (k, setting) in group.iter().enumerate() {
+            renderer
+                .check_numeric(&setting.numeric)
+                .map_err(cwisim_render::RenderError::Usage)?;
+            let start = Instant::now();
+            let mut sink = ImageSink::new(
+                header.width as usize,
+                header.channel_count(),
+                ImageSink::DEFAULT_LIMIT_BYTES,
+            );
+            let stats = {
+                let mut w = cwisim_xproc::EngineWriter::with_numeric(
+                    &header,
+                    machine,
+                    Timing::Fast,
+                    &setting.numeric,
+                    &mut sink,
+                )?;
+                w.write_checked(&stream).map_err(StudyError::Array)?;
+                cwisim_isa::TraceWrite::finish(&mut w).map_err(StudyError::Array)?;
+                w.into_stats().expect("finished")
+            };
+            let image = sink.finish()?.data;
+            let elapsed = drawing + start.elapsed();
+            if time == 0 {
+                out.push((
+                    Measured {
+                        image,
+                        counters: counters.clone(),
+                        stats,
+                        time: elapsed,
+                    },
+                    vec![elapsed],
+                ));
+            } else {
+                out[k].1.push(elapsed);
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// The row of `setting`, measured (its host times, `repeat` of them) against
+/// `reference`; not yet marked Pareto.
+fn row_of(
+    setting: &Setting,
+    measured: &Measured,
+    times: &[Duration],
+    reference: &[f64],
+    world: bool,
+) -> Row {
+    let mut times = times.to_vec();
+    times.sort();
+    let stats = &measured.stats;
+    let patches = setting.renderer.patches && world;
+    let (max_error, rms_error, psnr_db) = errors(&measured.image, reference);
+    let worst = stats.lines.iter().map(|l| l.busy_cycles).max().unwrap_or(0);
+    let s = &setting.settings;
+    Row {
+        renderer: setting.renderer.name,
+        shading: s.shading.name(),
+        aa: if setting.renderer.supersampled {
+            "-"
+        } else {
+            s.aa.name()
+        },
+        samples: setting.renderer.supersampled.then_some(s.samples),
+        visibility: if world && !setting.renderer.supersampled {
+            s.visibility.name()
+        } else {
+            "-"
+        },
+        tessellate: s.tessellate,
+        root_tolerance: patches.then_some(s.root_tolerance),
+        numeric: short_numeric(&setting.numeric),
+        register_bits: register_bits(&setting.numeric),
+        instructions: stats.totals.instructions,
+        busy_cycles: stats.lines.iter().map(|l| l.busy_cycles).sum(),
+        worst_line_share: if stats.line_period > 0 {
+            worst as f64 / stats.line_period as f64
+        } else {
+            0.0
+        },
+        late_lines: stats.totals.late_lines,
+        host_ms: times
+            .get(times.len() / 2)
+            .map_or(0.0, |t| t.as_secs_f64() * 1e3),
+        max_error,
+        rms_error,
+        psnr_db,
+        overflows: stats.totals.overflows,
+        counters: measured.counters.clone(),
+        pareto: false,
+    }
 }
 
 /// The table, as `tradeoff` prints it.
@@ -758,6 +928,91 @@ mod tests {
         assert!(g
             .iter()
             .all(|s| s.settings.shading != Shading::Phong && s.settings.tessellate.is_none()));
+    }
+
+    #[test]
+    fn the_settings_of_one_stream_differ_only_in_the_format() {
+        let entries = [
+            registry::find("vanrij").unwrap(),
+            registry::find("woo-chall").unwrap(),
+        ];
+        let formats = [
+            Numeric::F64,
+            Numeric::F32,
+            "fixed:I=4.8,dI=2.8,ddI=1.8".parse().unwrap(),
+        ];
+        let axes = Axes {
+            world: true,
+            ..Axes::default()
+        };
+        let g = grid(&entries, &axes, &formats);
+        let streams = streams(&g);
+        assert_eq!(streams.len() * formats.len(), g.len());
+        let mut next = 0;
+        for r in &streams {
+            assert_eq!(r.start, next);
+            next = r.end;
+            let first = &g[r.start];
+            for (s, numeric) in g[r.clone()].iter().zip(&formats) {
+                assert_eq!(s.settings, first.settings);
+                assert_eq!(s.renderer.name, first.renderer.name);
+                assert_eq!(&s.numeric, numeric);
+            }
+        }
+        assert_eq!(next, g.len());
+        assert_eq!(
+            describe_stream(&g[streams[0].clone()]),
+            "vanrij phong box exact (3 formats)"
+        );
+    }
+
+    /// A stream drawn once and executed in each format measures what rendering each
+    /// setting through the pipeline does: image, statistics, counters.
+    #[test]
+    fn a_shared_stream_measures_as_each_setting_rendered_alone() {
+        let size = Some(Size {
+            width: 64,
+            height: 48,
+        });
+        for (name, shading) in [("vanrij", Shading::Phong), ("sbuffer", Shading::Gouraud)] {
+            let group: Vec<Setting> = [
+                Numeric::F64,
+                Numeric::F32,
+                "fixed:I=10.10,dI=4.14,ddI=1.20".parse().unwrap(),
+            ]
+            .into_iter()
+            .map(|numeric| Setting {
+                renderer: registry::find(name).unwrap(),
+                settings: Settings {
+                    shading,
+                    size,
+                    samples: 2,
+                    ..Settings::default()
+                },
+                numeric,
+            })
+            .collect();
+            let machine = Machine::default();
+            let shared = measure_stream(None, &group, &machine, 2).unwrap();
+            assert_eq!(shared.len(), group.len());
+            for (setting, (m, times)) in group.iter().zip(&shared) {
+                let alone = measure(None, setting, &machine).unwrap();
+                assert_eq!(times.len(), 2);
+                assert_eq!(m.image, alone.image, "{}", setting.describe());
+                assert_eq!(m.counters, alone.counters, "{}", setting.describe());
+                let figures = |m: &Measured| {
+                    let s = &m.stats;
+                    (
+                        s.totals.instructions,
+                        s.totals.late_lines,
+                        s.totals.overflows,
+                        s.line_period,
+                        s.lines.iter().map(|l| l.busy_cycles).collect::<Vec<_>>(),
+                    )
+                };
+                assert_eq!(figures(m), figures(&alone), "{}", setting.describe());
+            }
+        }
     }
 
     #[test]

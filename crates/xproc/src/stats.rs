@@ -319,11 +319,12 @@ impl Recorder {
     /// An instruction of scanline `line` started issuing at `begin` and entered the first
     /// processor at `entry` after `cost` bus cycles.
     ///
-    /// Plain arithmetic: the stepped engine calls this per instruction, with cycles it
-    /// reached one step at a time — far below 2⁶⁴ — and costs below 2²⁰.
+    /// The stepped engine calls this per instruction; it jumps over idle cycles, so its
+    /// entries can reach `u64::MAX` (where they saturate): the sums saturate.
     #[inline]
     pub(crate) fn issue(&mut self, line: u64, op: Opcode, begin: u64, entry: u64, cost: u64) {
-        let stall = entry - self.last_entry - cost;
+        // saturating, as [`Self::issued`]: past `u64::MAX` entries all saturate there
+        let stall = (entry - self.last_entry).saturating_sub(cost);
         self.last_entry = entry;
         let l = self.line_mut(line);
         if l.instructions == 0 {
@@ -331,8 +332,8 @@ impl Recorder {
         }
         l.instructions += 1;
         l.opcodes.0[op.index()] += 1;
-        l.busy_cycles += cost;
-        l.stall_cycles += stall;
+        l.busy_cycles = l.busy_cycles.saturating_add(cost);
+        l.stall_cycles = l.stall_cycles.saturating_add(stall);
     }
 
     /// The instructions of scanline `line`, tallied by the engine ([`IssueTally`]) and

@@ -1,5 +1,7 @@
 //! The cycle-stepped reference engine: advances every processor of the systolic chain
-//! every cycle, with the instruction bus as an explicit state machine.
+//! cycle by cycle, with the instruction bus as an explicit state machine; the cycles in
+//! which nothing can happen are jumped over (`next_cycle`), so waiting for the display
+//! costs a step, not a step per cycle.
 //!
 //! It shares nothing with the fast engine but the machine parameters and the statistics
 //! bookkeeping: processors are plain structs with one flag per condition, and every
@@ -66,6 +68,8 @@ struct Bus {
     index: u64,
     line: u64,
     begin: u64,
+    /// Its bus cycles.
+    cost: u64,
     /// The cycle its issue is complete.
     issued_at: u64,
 }
@@ -85,6 +89,12 @@ pub struct SteppedEngine<'p, A: Arith> {
     t: u64,
     /// Whether the token moves and bus entry of cycle `t` are done.
     moved: bool,
+    /// Tokens in the chain.
+    in_flight: usize,
+    /// Cycles stepped through (each visited once, whether or not anything happened in
+    /// it): idle cycles are jumped over ([`Self::next_cycle`]), so this is at most a few
+    /// per event, not the cycle count.
+    steps: u64,
     /// `Refresh` instructions that have started to issue.
     refreshes_issued: u64,
     /// Scanlines that have left the array.
@@ -148,6 +158,8 @@ impl<'p, A: Arith> SteppedEngine<'p, A> {
             bus: None,
             t: 0,
             moved: false,
+            in_flight: 0,
+            steps: 0,
             refreshes_issued: 0,
             lines_out: 0,
             last_exit: 0,
@@ -173,9 +185,8 @@ impl<'p, A: Arith> SteppedEngine<'p, A> {
     /// statistics handed over; the chain starts empty, and the bus idle at the cycle that
     /// last token entered, where the stepped engine starts the next instruction.
     ///
-    /// Its cycles are plain arithmetic, as they are stepped: a hand-over at cycle 2⁶³ or
-    /// later (only at the edges of the machine's ranges) is beyond it, and
-    /// [`crate::replay_probed_from`] refuses one.
+    /// A hand-over at cycle 2⁶³ or later (only at the edges of the machine's ranges) is
+    /// beyond it, and [`crate::replay_probed_from`] refuses one.
     pub fn resume(state: Handover<A>, probe: &'p mut dyn Probe) -> Self {
         let Handover {
             header,
@@ -230,11 +241,12 @@ impl<'p, A: Arith> SteppedEngine<'p, A> {
             end = p;
             let mut tok = self.stages[p].take().expect("checked");
             if p + 1 == w {
+                self.in_flight -= 1;
                 self.exit(*tok, sink);
             } else {
                 assert!(self.stages[p + 1].is_none(), "two tokens in one processor");
                 self.apply(p + 1, &mut tok);
-                tok.leave_at = t + self.timeline.hop;
+                tok.leave_at = t.saturating_add(self.timeline.hop);
                 self.stages[p + 1] = Some(tok);
             }
         }
@@ -244,7 +256,8 @@ impl<'p, A: Arith> SteppedEngine<'p, A> {
         {
             let bus = self.bus.take().expect("checked");
             self.probe.enter(t, bus.index);
-            let cost = bus.issued_at - bus.begin;
+            // the opcode's cost, also where `issued_at` saturated
+            let cost = bus.cost;
             self.recorder
                 .issue(bus.line, bus.instr.op, bus.begin, t, cost);
             let mut work = Work::default();
@@ -261,11 +274,12 @@ impl<'p, A: Arith> SteppedEngine<'p, A> {
                 instr: bus.instr,
                 index: bus.index,
                 line: bus.line,
-                leave_at: t + self.timeline.hop,
+                leave_at: t.saturating_add(self.timeline.hop),
                 work,
             });
             self.apply(0, &mut tok);
             self.stages[0] = Some(tok);
+            self.in_flight += 1;
         }
         self.moved = true;
     }
@@ -293,12 +307,50 @@ impl<'p, A: Arith> SteppedEngine<'p, A> {
         out
     }
 
-    /// The clock advances one cycle per step (from 0, or from a hand-over's cycle, below
-    /// 2⁶³: `crate::window`), so `t` stays far below 2⁶⁴, and the plain additions to it (a cost below 2²⁰, a hop at most 2¹⁶:
-    /// `crate::machine`) cannot overflow.
-    fn next_cycle(&mut self) {
-        self.t += 1;
+    /// The clock advances to the next cycle at which anything can happen: the earliest
+    /// of a token's move, the bus's instruction entering the chain, and (`issue`, when
+    /// the bus is free) the cycle the next instruction may start to issue. Nothing
+    /// happens in the cycles jumped over — no token moves, the bus neither takes nor
+    /// hands on an instruction, and no [`Probe`] call is made in them —, so every event,
+    /// statistic and scanline is the same as when each cycle is stepped; a machine whose
+    /// line period is 10⁷ cycles costs a few steps per instruction, not 10⁷ per line.
+    ///
+    /// Cycles saturate at `u64::MAX` (a gate there is the deadline of a scanline beyond
+    /// it: `Timeline::deadline`); the additions to `t` (a cost below 2²⁰, a hop at most
+    /// 2¹⁶: `crate::machine`) saturate too, and events then all happen at `u64::MAX`.
+    fn next_cycle(&mut self, issue: Option<u64>) {
+        let t = self.t;
+        let after = t.saturating_add(1);
+        let mut next = u64::MAX;
+        if self.in_flight > 0 {
+            if self.timeline.hop == 1 {
+                // some token moves every cycle
+                next = after;
+            } else {
+                let soonest = self.stages.iter().flatten().map(|tok| tok.leave_at).min();
+                next = soonest.unwrap_or(after).max(after);
+            }
+        }
+        if let Some(bus) = &self.bus {
+            // it enters once issued and past `free_at` if the first stage is free; if it
+            // is not, the token there moves first (counted above)
+            let enter = bus.issued_at.max(self.free_at);
+            if enter > t || self.stages[0].is_none() {
+                next = next.min(enter.max(after));
+            }
+        }
+        if let Some(gate) = issue.filter(|_| self.bus.is_none()) {
+            next = next.min(gate.max(after));
+        }
+        self.t = next;
+        self.steps += 1;
         self.moved = false;
+    }
+
+    /// Cycles stepped through so far: the cycles at which something could happen, not
+    /// every cycle of the run (see [`Self::next_cycle`]).
+    pub fn steps(&self) -> u64 {
+        self.steps
     }
 
     fn exit(&mut self, tok: Token<A::Reg, A::Out>, sink: &mut dyn LineSink<A::Out>) {
@@ -481,7 +533,8 @@ impl<A: Arith> Engine<A::Out> for SteppedEngine<'_, A> {
                     index: self.issued,
                     line,
                     begin: self.t,
-                    issued_at: self.t + cost,
+                    cost,
+                    issued_at: self.t.saturating_add(cost),
                 });
                 if instr.op == Opcode::Refresh {
                     self.refreshes_issued += 1;
@@ -489,7 +542,7 @@ impl<A: Arith> Engine<A::Out> for SteppedEngine<'_, A> {
                 self.issued += 1;
                 return;
             }
-            self.next_cycle();
+            self.next_cycle(Some(gate));
         }
     }
 
@@ -501,7 +554,7 @@ impl<A: Arith> Engine<A::Out> for SteppedEngine<'_, A> {
             if self.bus.is_none() && self.stages.iter().all(Option::is_none) {
                 break;
             }
-            self.next_cycle();
+            self.next_cycle(None);
         }
         // Instructions after the last Refresh never leave as a scanline, but their work
         // was counted when their tokens left the chain.

@@ -88,6 +88,47 @@ proptest! {
     }
 }
 
+/// Machines whose line periods are long (up to 2⁴⁰ cycles, the limit) and hops slow: the
+/// stepped engine jumps over the waiting, which must not change a cycle.
+fn sparse_case() -> impl Strategy<Value = (TraceHeader, Machine, Vec<Instruction>)> {
+    (
+        1u32..24,
+        1u32..5,
+        prop_oneof![Just(1u8), Just(3u8)],
+        prop_oneof![Just(1u32), 2u32..70, Just(65_536)],
+        prop_oneof![1u64..2_000, 2_000u64..1_000_000_000, Just(1u64 << 40)],
+        0u32..4,
+    )
+        .prop_flat_map(|(width, lines, channels, hop, period, vblank)| {
+            let header = TraceHeader::new(width, lines, channels).unwrap();
+            let m = Machine {
+                hop_cycles: hop,
+                line_period_cycles: Some(period),
+                vblank_lines: vblank,
+                ..Machine::default()
+            };
+            (
+                Just(header),
+                Just(m),
+                proptest::collection::vec(instruction(width, usize::from(channels)), 0..40),
+            )
+        })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(200))]
+
+    #[test]
+    fn fast_equals_stepped_over_long_line_periods((header, machine, trace) in sparse_case()) {
+        let (fi, fs) = run::<f64>(&header, &trace, &machine, Timing::Fast).unwrap();
+        let (si, ss) = run::<f64>(&header, &trace, &machine, Timing::Stepped).unwrap();
+        let fb: Vec<u64> = fi.data.iter().map(|v| v.to_bits()).collect();
+        let sb: Vec<u64> = si.data.iter().map(|v| v.to_bits()).collect();
+        prop_assert_eq!(fb, sb);
+        prop_assert_eq!(fs, ss);
+    }
+}
+
 fn numeric_case() -> impl Strategy<Value = (Numeric, TraceHeader, Machine, Vec<Instruction>)> {
     (
         common::numeric(),

@@ -2,7 +2,8 @@
 //! both engines.
 
 use cwisim_isa::{Instruction as In, Intensity, TraceHeader};
-use cwisim_xproc::{run, Machine, RunStats, Timing};
+use cwisim_xproc::stepped::SteppedEngine;
+use cwisim_xproc::{run, Engine, Machine, Native, NullSink, RunStats, Timing};
 
 fn g(v: f64) -> Intensity {
     Intensity::grey(v)
@@ -119,4 +120,84 @@ fn default_machine_is_in_time_for_a_light_1024_wide_line() {
     assert_eq!(s.line_period, 1559);
     assert_eq!(s.lines[0].ready, 1028);
     assert_eq!(s.lines[0].slack, 1559 - 1028);
+}
+
+/// A few instructions per scanline on a machine whose line period is `period` cycles,
+/// with `hop` cycles per hop: mostly idle cycles, waiting for the display.
+fn sparse_trace(lines: u32) -> (TraceHeader, Vec<In>) {
+    let h = TraceHeader::new(6, lines, 1).unwrap();
+    let mut trace = Vec::new();
+    for l in 0..lines {
+        let v = f64::from(l + 1) / 8.0;
+        trace.push(In::eval1(1, 4, g(v)));
+        trace.push(In::eval2(0, 6, g(v), g(0.25)));
+        trace.push(In::refresh());
+    }
+    (h, trace)
+}
+
+#[test]
+fn the_stepped_engine_jumps_over_idle_cycles() {
+    // line period 10⁶ cycles, hop 3: stepping every cycle takes 3 × 10⁶ steps before the
+    // last Refresh issues; stepping from event to event a handful per instruction
+    let (h, trace) = sparse_trace(4);
+    let m = Machine::default()
+        .with_overrides(&["line_period_cycles=1000000".into(), "hop_cycles=3".into()])
+        .unwrap();
+    let mut eng = SteppedEngine::<Native<f64>>::new(&h, m.timeline(&h).unwrap());
+    let mut sink = NullSink;
+    for i in &trace {
+        eng.execute(i, &mut sink);
+    }
+    // every token visits 6 processors: 7 moves each, each at a cycle of its own at most,
+    // plus the issue and the bus entry of each instruction
+    let bound = trace.len() as u64 * (7 + 2);
+    assert!(
+        eng.steps() <= bound,
+        "{} cycles stepped, more than {bound}: idle cycles are not jumped over",
+        eng.steps()
+    );
+    let stepped = Box::new(eng).finish(&mut sink);
+    assert_eq!(stepped.lines[3].deadline, 4_000_000);
+    // the same statistics as the fast engine's (`stats` compares the images too)
+    assert_eq!(stats(h, &m, &trace), stepped);
+}
+
+#[test]
+fn a_terahertz_clock_replays_on_the_stepped_engine_as_on_the_fast_one() {
+    // clock 1e12 Hz (the limit) at 60 Hz over 4 + 10 lines: a line period of about
+    // 1.2 × 10⁹ cycles, which only jumping over idle cycles makes steppable
+    let (h, trace) = sparse_trace(4);
+    for hop in ["hop_cycles=1", "hop_cycles=65536"] {
+        let m = Machine::default()
+            .with_overrides(&["clock_hz=1e12".into(), "vblank_lines=10".into(), hop.into()])
+            .unwrap();
+        let period = m.timeline(&h).unwrap().line_period;
+        assert!(period > 1_000_000_000, "{period}");
+        let s = stats(h, &m, &trace);
+        assert_eq!(s.lines[3].deadline, 4 * period);
+        assert_eq!(s.totals.late_lines, 0);
+    }
+}
+
+#[test]
+fn the_stepped_engine_reaches_and_saturates_at_the_longest_line_periods() {
+    // one scanline per frame, the longest line period and the most blanking: deadlines pass
+    // u64::MAX at scanline 256, which the stepped engine reaches by jumping over the
+    // waiting; both engines saturate there alike
+    let m = Machine::default()
+        .with_overrides(&[
+            "line_period_cycles=1099511627776".into(),
+            "vblank_lines=65536".into(),
+            "hop_cycles=65536".into(),
+        ])
+        .unwrap();
+    let h = TraceHeader::new(2, 1, 1).unwrap();
+    let trace: Vec<In> = (0..300)
+        .flat_map(|_| [In::eval1(0, 2, g(0.5)), In::refresh()])
+        .collect();
+    let s = stats(h, &m, &trace);
+    assert_eq!(s.lines[256].deadline, u64::MAX);
+    assert_eq!(s.totals.saturated_lines, 44);
+    assert_eq!(s.totals.cycles, u64::MAX);
 }

@@ -33,6 +33,11 @@ pub struct FitArgs {
     /// The machine model (timing only; the formats do not change cycles).
     #[command(flatten)]
     pub machine: MachineArgs,
+    /// Threads: the scene's exact visibility, then the candidate formats, replayed on N
+    /// threads at once (0: one per core); the format found, its figures and the count of
+    /// replays are the same at any N.
+    #[arg(long, default_value_t = 0, value_name = "N")]
+    pub threads: usize,
 }
 
 /// `--overflow`.
@@ -73,14 +78,15 @@ fn parse_error_budget(s: &str) -> Result<f64, String> {
 
 /// Runs `cwisim fit`.
 pub fn run(args: &FitArgs, stdout: &mut dyn Write, progress: bool) -> Result<(), CliError> {
+    cwisim_scene::budget::check_threads(args.threads).map_err(CliError::Usage)?;
     let machine = args.machine.load()?;
     let stage = crate::progress::Stage::new(progress, "fit: drawing the scene");
-    let drawn = args.draw.draw(args.scene.as_deref())?;
+    let drawn = args.draw.draw_on(args.scene.as_deref(), args.threads)?;
     let exact = exact_image(args.scene.as_deref(), args.draw.size)?;
     let header = drawn.renderer.header();
     let mut instructions: Vec<Instruction> = Vec::new();
     cwisim_render::emit(&*drawn.renderer, &mut instructions)?;
-    let mut bench = Bench::new(header, &instructions, &machine, &exact)?;
+    let mut bench = Bench::new(header, &instructions, &machine, &exact)?.threads(args.threads);
     let overflow = match args.overflow {
         OverflowArg::Wrap => Overflow::Wrap,
         OverflowArg::Saturate => Overflow::Saturate,

@@ -17,7 +17,7 @@ use cwisim_render::settings::{
 };
 use cwisim_render::{Settings, Size, Source};
 use cwisim_study::cost::render_cost_image;
-use cwisim_study::refine::{run_refine, RefineRun, RefineSetup};
+use cwisim_study::refine::{run_refines, RefineRun, RefineSetup};
 use cwisim_study::refine_ids::{encode_id_npy, id_rgb};
 use cwisim_study::refine_plot::render_refine_plot;
 use cwisim_study::refine_report::{csv, write_table, Sweep};
@@ -82,6 +82,12 @@ pub struct RefineArgs {
     /// phong-angle, aa-threshold).
     #[arg(long, value_name = "NAME=V1,V2,…")]
     pub sweep: Option<Sweep>,
+    /// Threads: a sweep's runs measured on N threads at once (0: one per core), each
+    /// run's table printed in order as it is done; a single run's frames rendered on N
+    /// threads (bands of scanlines, as `render --threads`). The output is the same at
+    /// any N.
+    #[arg(long, default_value_t = 0, value_name = "N")]
+    pub threads: usize,
     /// The machine model.
     #[command(flatten)]
     pub machine: MachineArgs,
@@ -166,6 +172,7 @@ pub fn run(args: &RefineArgs, stdout: &mut dyn Write, progress: bool) -> Result<
         ..Settings::default()
     };
     settings.check().map_err(CliError::Usage)?;
+    cwisim_scene::budget::check_threads(args.threads).map_err(CliError::Usage)?;
     let machine = args.machine.load()?;
     let runs: Vec<(Option<String>, Settings)> = match &args.sweep {
         Some(sweep) => sweep
@@ -183,12 +190,10 @@ pub fn run(args: &RefineArgs, stdout: &mut dyn Write, progress: bool) -> Result<
     for (_, s) in &runs {
         s.check().map_err(CliError::Usage)?;
     }
-    let mut bar = Progress::scanlines(0, progress);
-    let mut done_before = 0u64;
-    let mut results: Vec<(Option<String>, RefineRun)> = Vec::new();
-    let mut stream: Vec<Instruction> = Vec::new();
-    for (k, (label, s)) in runs.iter().enumerate() {
-        let setup = RefineSetup {
+    let setups: Vec<RefineSetup> = runs
+        .iter()
+        .enumerate()
+        .map(|(k, (_, s))| RefineSetup {
             scene: args.scene.as_deref(),
             settings: *s,
             phases: phases.clone(),
@@ -196,22 +201,50 @@ pub fn run(args: &RefineArgs, stdout: &mut dyn Write, progress: bool) -> Result<
             naive: k == 0,
             cost_maps: args.cost_image_dir.is_some(),
             ids: args.ids.is_some(),
-        };
-        let mut report = |lines: u64| bar.update(done_before + lines);
-        let trace = encoding
-            .is_some()
-            .then_some(&mut stream as &mut dyn TraceWrite);
-        let run = run_refine(&setup, trace, Some(&mut report))?;
-        done_before += (run.lines * run.rows.len()) as u64;
-        results.push((label.clone(), run));
-    }
-    drop(bar);
-    for (k, (label, run)) in results.iter().enumerate() {
-        if k > 0 {
-            writeln!(stdout).map_err(CliError::Stdout)?;
+            threads: 1,
+        })
+        .collect();
+    let bar = std::sync::Mutex::new(Progress::scanlines(0, progress));
+    let report = |lines: u64| {
+        if let Ok(mut bar) = bar.lock() {
+            bar.update(lines);
         }
-        write_table(stdout, run, label.as_deref()).map_err(CliError::Stdout)?;
+    };
+    let mut stream: Vec<Instruction> = Vec::new();
+    let trace = encoding
+        .is_some()
+        .then_some(&mut stream as &mut dyn TraceWrite);
+    // each run's table printed as it is done, in order
+    let mut failed: Option<std::io::Error> = None;
+    let done = run_refines(&setups, args.threads, trace, &report, |k, run| {
+        if failed.is_some() {
+            return;
+        }
+        let label = runs[k].0.as_deref();
+        let write = |out: &mut dyn Write| {
+            if k > 0 {
+                writeln!(out)?;
+            }
+            write_table(out, run, label)?;
+            out.flush()
+        };
+        let written = match bar.lock() {
+            Ok(bar) => bar.suspend(|| write(stdout)),
+            Err(_) => write(stdout),
+        };
+        if let Err(e) = written {
+            failed = Some(e);
+        }
+    })?;
+    drop(bar);
+    if let Some(e) = failed {
+        return Err(CliError::Stdout(e));
     }
+    let results: Vec<(Option<String>, RefineRun)> = runs
+        .iter()
+        .map(|(label, _)| label.clone())
+        .zip(done)
+        .collect();
     let Some((_, first)) = results.first() else {
         return Err(CliError::Usage("nothing to run".into()));
     };

@@ -30,9 +30,10 @@ use cwisim_xproc::{Image, RunStats};
 use emit::{emit_row, EmitCounts, EmitRule, Subline};
 use lists::{Layers, ListStats, Lists};
 use prepare::Triangles;
-use shade::{RowShader, ShadeRule, ShadeStats};
+use shade::{RowShader, ShadeRule};
 use std::io;
 use std::ops::Range;
+use std::sync::{Condvar, Mutex, MutexGuard};
 use std::time::Duration;
 
 /// The registry's one line about it.
@@ -91,101 +92,141 @@ impl WooChall {
         &self.sampler
     }
 
-    /// Runs the whole frame, in scan order (the shading state runs from row to row).
-    fn run(&self) -> io::Result<WooFrame> {
-        let t = &self.triangles;
-        let s = &self.sampler;
-        let channels = usize::from(t.channels);
-        let mut lists = Lists::new(&t.tris, *s);
-        let mut shader = RowShader::new(self.rule, *s, channels);
-        let mut list_stats = ListStats::default();
-        let rule = EmitRule {
+    /// How a row's pixels are sent.
+    fn emit_rule(&self) -> EmitRule {
+        EmitRule {
             merge: self.merge,
             tolerance: (self.shading == Shading::Phong).then_some(self.shade_tolerance),
-            channels,
-        };
-        let l = s.l as usize;
-        let mut rows = Vec::with_capacity(t.height as usize);
-        let mut row_counts = Vec::with_capacity(t.height as usize);
-        // the row's sub-scanlines; on the corner grid the first is the previous row's last
-        let mut sublines: Vec<Subline> = vec![Subline::default(); l];
-        let mut carried = false;
-        // the winners of the sub-scanline above (hidden-line drawing)
-        let mut above: Vec<u32> = Vec::new();
-        let mut layers = Layers::default();
-        let mut figures = Vec::with_capacity(t.height as usize);
-        for row in 0..t.height {
-            let (first, _) = s.of_pixel(row);
-            let mut row_lists = ListStats::default();
-            let shaded_before = shader.stats;
-            let start = if carried {
-                sublines.swap(0, l - 1);
-                1
-            } else {
-                0
-            };
-            for (o, sub) in sublines.iter_mut().enumerate().skip(start) {
-                let j = first + o;
-                lists.subline(j as u32, &mut sub.winners, &mut layers, &mut row_lists);
-                if self.shading == Shading::Hidden {
-                    shade::hidden_subline(&sub.winners, &above, channels, &mut sub.rgb);
-                } else {
-                    let y = s.subline_y(j);
-                    shader.subline(
-                        y,
-                        &sub.winners,
-                        &layers,
-                        &t.tris,
-                        &mut sub.rgb,
-                        |tri, x, y| t.shade(tri, x, y),
-                    );
-                }
-                above.clone_from(&sub.winners);
-            }
-            shader.end_row();
-            carried = s.grid == crate::subsample::Grid::Corner;
-            let refs: Vec<&Subline> = sublines.iter().collect();
-            let mut out = Vec::new();
-            let counts =
-                emit_row(s, &refs, &rule, &mut out).map_err(|e| NonFinite::at_row(e, row))?;
-            list_stats.merge(&row_lists);
-            let shaded = &shader.stats;
-            figures.push(serde_json::json!({
-                "row": row,
-                "max_active": row_lists.max_active,
-                "max_visible_spans": row_lists.max_visible_spans,
-                "geometry": row_lists.geometry,
-                "shading": shaded.calls - shaded_before.calls,
-                "forced_pixels": shaded.forced_pixels - shaded_before.forced_pixels,
-                "instructions": counts.instructions,
-                "eval1": counts.edge_pixels + counts.runs.eval1,
-                "passes": counts.passes,
-            }));
-            rows.push(out);
-            row_counts.push(counts);
+            channels: usize::from(self.triangles.channels),
         }
-        Ok(WooFrame {
-            figures: serde_json::Value::from(figures),
-            rows,
-            row_counts,
-            list_stats,
-            shade_stats: shader.stats,
-            sorted: lists.sorted() as u64,
-            triangles: t.tris.len() as u64,
-        })
     }
 }
 
-/// One frame, shaded: its rows' instructions, ready to send.
-struct WooFrame {
-    /// Per pixel row: the lists', the shading's and the emitter's figures.
-    figures: serde_json::Value,
-    rows: Vec<Vec<Instruction>>,
-    row_counts: Vec<EmitCounts>,
+/// The state of a frame's scan that runs from row to row (the lists, `keepObj` and the
+/// stochastic draws, the corner grid's shared sub-scanline), and what the rows made so
+/// far counted.
+struct Scan<'a> {
+    /// The next row to make.
+    next_row: u32,
+    /// A band stopped part way (an error): the state is that of no row boundary.
+    broken: bool,
+    /// Times the frame was started again from the top.
+    epoch: u64,
+    lists: Lists<'a>,
+    shader: RowShader,
     list_stats: ListStats,
-    shade_stats: ShadeStats,
-    sorted: u64,
-    triangles: u64,
+    /// The row's sub-scanlines; on the corner grid the first is the previous row's last.
+    sublines: Vec<Subline>,
+    carried: bool,
+    /// The winners of the sub-scanline above (hidden-line drawing).
+    above: Vec<u32>,
+    layers: Layers,
+    /// Per pixel row made: the lists', the shading's and the emitter's figures.
+    figures: Vec<serde_json::Value>,
+}
+
+impl<'a> Scan<'a> {
+    /// The state at the top of the frame.
+    fn new(w: &'a WooChall) -> Scan<'a> {
+        let t = &w.triangles;
+        let s = w.sampler;
+        let channels = usize::from(t.channels);
+        Scan {
+            next_row: 0,
+            broken: false,
+            epoch: 0,
+            lists: Lists::new(&t.tris, s),
+            shader: RowShader::new(w.rule, s, channels),
+            list_stats: ListStats::default(),
+            sublines: vec![Subline::default(); s.l as usize],
+            carried: false,
+            above: Vec::new(),
+            layers: Layers::default(),
+            figures: Vec::new(),
+        }
+    }
+
+    /// Makes row `next_row` into `out` (cleared first), in scan order: its sub-scanlines
+    /// sampled and shaded, its instructions ending with `Refresh`.
+    fn row(
+        &mut self,
+        w: &WooChall,
+        rule: &EmitRule,
+        out: &mut Vec<Instruction>,
+    ) -> io::Result<EmitCounts> {
+        let (t, s) = (&w.triangles, &w.sampler);
+        let channels = usize::from(t.channels);
+        let l = s.l as usize;
+        let row = self.next_row;
+        let (first, _) = s.of_pixel(row);
+        let mut row_lists = ListStats::default();
+        let shaded_before = self.shader.stats;
+        let start = if self.carried {
+            self.sublines.swap(0, l - 1);
+            1
+        } else {
+            0
+        };
+        for (o, sub) in self.sublines.iter_mut().enumerate().skip(start) {
+            let j = first + o;
+            self.lists
+                .subline(j as u32, &mut sub.winners, &mut self.layers, &mut row_lists);
+            if w.shading == Shading::Hidden {
+                shade::hidden_subline(&sub.winners, &self.above, channels, &mut sub.rgb);
+            } else {
+                let y = s.subline_y(j);
+                self.shader.subline(
+                    y,
+                    &sub.winners,
+                    &self.layers,
+                    &t.tris,
+                    &mut sub.rgb,
+                    |tri, x, y| t.shade(tri, x, y),
+                );
+            }
+            self.above.clone_from(&sub.winners);
+        }
+        self.shader.end_row();
+        self.carried = s.grid == crate::subsample::Grid::Corner;
+        let refs: Vec<&Subline> = self.sublines.iter().collect();
+        out.clear();
+        let counts = emit_row(s, &refs, rule, out).map_err(|e| NonFinite::at_row(e, row))?;
+        self.list_stats.merge(&row_lists);
+        let shaded = &self.shader.stats;
+        self.figures.push(serde_json::json!({
+            "row": row,
+            "max_active": row_lists.max_active,
+            "max_visible_spans": row_lists.max_visible_spans,
+            "geometry": row_lists.geometry,
+            "shading": shaded.calls - shaded_before.calls,
+            "forced_pixels": shaded.forced_pixels - shaded_before.forced_pixels,
+            "instructions": counts.instructions,
+            "eval1": counts.edge_pixels + counts.runs.eval1,
+            "passes": counts.passes,
+        }));
+        self.next_row += 1;
+        Ok(counts)
+    }
+}
+
+/// Instructions a band's thread makes before it sends them (at least one row's): enough
+/// that the next band's rows are made while these are executed on another thread, few
+/// enough (a few MB) that memory does not grow with the frame.
+const CHUNK_INSTRUCTIONS: usize = 1 << 16;
+
+/// One frame, made as it is emitted: the shading state runs from row to row, so bands of
+/// rows are made in order (a band asked for ahead of its turn waits for the bands before
+/// it), the instructions sent in chunks of about [`CHUNK_INSTRUCTIONS`]. Only the
+/// scan's state and a chunk per thread are held, however large the frame. A band asked for again
+/// (one that failed, to be emitted again where its error is told) is made again from the
+/// top of the frame: the stream is the same.
+struct WooFrame<'a> {
+    renderer: &'a WooChall,
+    rule: EmitRule,
+    scan: Mutex<Scan<'a>>,
+    /// Signalled when a band ends (or stops).
+    turn: Condvar,
+    sorted_triangles: u64,
 }
 
 fn emit_counters(c: &EmitCounts) -> Counters {
@@ -199,12 +240,38 @@ fn emit_counters(c: &EmitCounts) -> Counters {
         .with("instructions", c.instructions)
 }
 
-impl FramePlan for WooFrame {
+/// A band's thread panicked holding the scan.
+fn poisoned<T>(_: T) -> io::Error {
+    io::Error::other("woo-chall: the thread making an earlier band panicked")
+}
+
+impl WooFrame<'_> {
+    /// `e`, with the scan marked stopped part way (its state is no row boundary) and the
+    /// bands waiting for their turn told.
+    fn stop(&self, mut scan: MutexGuard<'_, Scan<'_>>, e: io::Error) -> io::Error {
+        scan.broken = true;
+        drop(scan);
+        self.turn.notify_all();
+        e
+    }
+}
+
+/// Sends `instructions` to `sink`.
+fn send(instructions: &[Instruction], sink: &mut dyn TraceWrite) -> io::Result<()> {
+    instructions.iter().try_for_each(|i| sink.write(i))
+}
+
+impl FramePlan for WooFrame<'_> {
+    /// Asked after the frame's rows are emitted: the lists' and the shading's figures of
+    /// the whole frame.
     fn counters(&self) -> Counters {
-        let (l, s) = (&self.list_stats, &self.shade_stats);
+        let Ok(scan) = self.scan.lock() else {
+            return Counters::default();
+        };
+        let (l, s) = (&scan.list_stats, &scan.shader.stats);
         Counters::default()
-            .with("triangles", self.triangles)
-            .with("triangles_sorted", self.sorted)
+            .with("triangles", self.renderer.triangles.tris.len() as u64)
+            .with("triangles_sorted", self.sorted_triangles)
             .with("max_active", l.max_active)
             .with("max_visible_spans", l.max_visible_spans)
             .with("geometry", l.geometry)
@@ -219,17 +286,65 @@ impl FramePlan for WooFrame {
     }
 
     fn row_figures(&self) -> Option<serde_json::Value> {
-        Some(self.figures.clone())
+        let scan = self.scan.lock().ok()?;
+        Some(serde_json::Value::from(scan.figures.clone()))
     }
 
     fn emit_rows(&self, rows: Range<u32>, sink: &mut dyn TraceWrite) -> io::Result<Counters> {
-        let mut total = EmitCounts::default();
-        for r in rows {
-            for i in &self.rows[r as usize] {
-                sink.write(i)?;
+        let mut scan = self.scan.lock().map_err(poisoned)?;
+        loop {
+            if scan.next_row > rows.start || (scan.broken && scan.next_row >= rows.start) {
+                // asked again (it failed): from the top of the frame
+                let epoch = scan.epoch + 1;
+                *scan = Scan::new(self.renderer);
+                scan.epoch = epoch;
+                break;
             }
-            total.add(&self.row_counts[r as usize]);
+            if scan.broken {
+                return Err(io::Error::other(
+                    "woo-chall: an earlier band stopped part way; this one is made again after it",
+                ));
+            }
+            if scan.next_row == rows.start {
+                break;
+            }
+            scan = self.turn.wait(scan).map_err(poisoned)?;
         }
+        let epoch = scan.epoch;
+        let (mut out, mut chunk) = (Vec::new(), Vec::new());
+        while scan.next_row < rows.start {
+            if let Err(e) = scan.row(self.renderer, &self.rule, &mut out) {
+                return Err(self.stop(scan, e));
+            }
+        }
+        let mut total = EmitCounts::default();
+        for r in rows.clone() {
+            match scan.row(self.renderer, &self.rule, &mut out) {
+                Ok(counts) => total.add(&counts),
+                Err(e) => return Err(self.stop(scan, e)),
+            }
+            chunk.append(&mut out);
+            if chunk.len() >= CHUNK_INSTRUCTIONS && r + 1 < rows.end {
+                // sent with the scan free: the turn stays this band's (no band starts
+                // within it), unless a band before it is made again meanwhile
+                drop(scan);
+                let sent = send(&chunk, sink);
+                chunk.clear();
+                scan = self.scan.lock().map_err(poisoned)?;
+                if scan.epoch != epoch {
+                    return Err(io::Error::other(
+                        "woo-chall: the frame was started again while this band was sent; it is made again after",
+                    ));
+                }
+                if let Err(e) = sent {
+                    return Err(self.stop(scan, e));
+                }
+            }
+        }
+        // the next band's rows can be made while these are sent
+        drop(scan);
+        self.turn.notify_all();
+        send(&chunk, sink)?;
         Ok(emit_counters(&total))
     }
 }
@@ -248,10 +363,15 @@ impl Renderer for WooChall {
         _index: u32,
         _previous: Option<&'a Image>,
     ) -> Result<Box<dyn FramePlan + 'a>, RenderError> {
-        let frame = self
-            .run()
-            .map_err(|source| RenderError::of_renderer("woo-chall", source))?;
-        Ok(Box::new(frame))
+        let scan = Scan::new(self);
+        let sorted_triangles = scan.lists.sorted() as u64;
+        Ok(Box::new(WooFrame {
+            renderer: self,
+            rule: self.emit_rule(),
+            scan: Mutex::new(scan),
+            turn: Condvar::new(),
+            sorted_triangles,
+        }))
     }
 
     fn settings_phrase(&self) -> String {

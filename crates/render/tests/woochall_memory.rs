@@ -1,0 +1,83 @@
+//! `woo-chall` makes its rows as they are emitted, holding one row's instructions at a
+//! time rather than the frame's: the heap a frame needs grows with the image's side (the
+//! rows' state, the bands of scanlines), not with its area. (One test in this binary: the
+//! counting allocator sees every thread's allocations.)
+
+use cwisim_render::{registry, render, ArrayConfig, LoadedScene, Settings, Taps};
+use cwisim_world::embedded::embedded;
+use cwisim_world::parse_any;
+use cwisim_xproc::NullSink;
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// The system allocator, counting the bytes live and their peak.
+struct Counting;
+
+static LIVE: AtomicUsize = AtomicUsize::new(0);
+static PEAK: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        // SAFETY: forwarded to the system allocator with the caller's layout.
+        let p = unsafe { System.alloc(layout) };
+        if !p.is_null() {
+            let now = LIVE.fetch_add(layout.size(), Ordering::Relaxed) + layout.size();
+            PEAK.fetch_max(now, Ordering::Relaxed);
+        }
+        p
+    }
+
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: `ptr` came from `alloc` with this layout.
+        unsafe { System.dealloc(ptr, layout) };
+        LIVE.fetch_sub(layout.size(), Ordering::Relaxed);
+    }
+}
+
+#[global_allocator]
+static ALLOCATOR: Counting = Counting;
+
+/// The most heap rendering the pot at `side × side` on one thread (bands of 16 rows)
+/// held at once, beyond the renderer built (bytes), and the instructions it emitted.
+fn peak_heap(side: u32) -> (usize, u64) {
+    let scene = parse_any(embedded("pot").unwrap().text, None)
+        .unwrap()
+        .with_size(side, side)
+        .unwrap();
+    let settings = Settings {
+        samples: 2,
+        ..Settings::default()
+    };
+    let r =
+        (registry::find("woo-chall").unwrap().build)(LoadedScene::built("pot", scene), &settings)
+            .unwrap();
+    let base = LIVE.load(Ordering::Relaxed);
+    PEAK.store(base, Ordering::Relaxed);
+    let done = render(
+        &*r,
+        &ArrayConfig::default(),
+        1,
+        &mut NullSink,
+        Taps::default(),
+    )
+    .unwrap();
+    let peak = PEAK.load(Ordering::Relaxed).saturating_sub(base);
+    (peak, done.counters.get("instructions").unwrap())
+}
+
+#[test]
+fn a_frame_s_heap_grows_with_its_side_not_its_area() {
+    let (small, small_instructions) = peak_heap(128);
+    let (large, large_instructions) = peak_heap(1024);
+    // 64 times the area, and (the pot scaled) more than 16 times the instructions; 8
+    // times the side. (Holding the frame's instructions, as it once did: 0.7 MB → 17 MB,
+    // 24 times; one row's: 0.33 MB → 2.2 MB, 6.7 times.)
+    assert!(
+        large_instructions > 16 * small_instructions,
+        "{small_instructions} → {large_instructions} instructions"
+    );
+    assert!(
+        large < 12 * small,
+        "peak heap {small} B at 128², {large} B at 1024²: it grows with the area"
+    );
+}
