@@ -41,6 +41,7 @@
 
 pub mod arith;
 pub mod band;
+mod cell;
 mod clock;
 pub mod engine;
 pub mod fast;

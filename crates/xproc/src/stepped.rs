@@ -6,38 +6,22 @@
 //! It shares nothing with the fast engine but the machine parameters and the statistics
 //! bookkeeping: processors are plain structs with one flag per condition, and every
 //! token (an instruction with its running forward-differencing state) visits every
-//! processor, one hop at a time. Obviously right, and slow: the property tests hold the
-//! fast engine to it. It can also go on from the fast engine's state between scanlines
+//! processor, one hop at a time. What a token does in one processor is
+//! `Processor::act` (`cell.rs`), the one per-processor statement of the semantics,
+//! which [`crate::visits`] calls too. Obviously right, and slow: the property tests hold
+//! the fast engine to it. It can also go on from the fast engine's state between scanlines
 //! ([`SteppedEngine::resume`]), to step only the scanlines a study tool shows.
 
-use crate::arith::{vector, Arith, Native};
+use crate::arith::{Arith, Native};
+use crate::cell::{operands, Processor, Wave};
 use crate::engine::Engine;
 use crate::machine::Timeline;
-use crate::numeric::Register;
 use crate::output::{LineOut, LineSink};
 use crate::probe::{NoProbe, Probe, ProcessorState};
 use crate::sample::Sample;
 use crate::stats::{LineRecords, Recorder, RunStats, Work};
 use crate::window::Handover;
-use cwisim_isa::{Instruction, Opcode, TraceHeader, MAX_CHANNELS};
-
-type Vector<T> = [T; MAX_CHANNELS];
-
-/// One X-processor's registers and flags.
-#[derive(Clone)]
-struct Processor<T> {
-    acc: Vector<T>,
-    /// Preload registers `I`, `dI`, `ddI`.
-    reg: [Vector<T>; 3],
-    /// Whether each preload register holds a value not yet consumed.
-    has: [bool; 3],
-    /// Claimed by `Eval0` until `Refresh`.
-    locked: bool,
-    /// Masked by `Dis` for the next Eval.
-    masked: bool,
-    /// This processor's copy of the `Acc_mode` flag.
-    negative_enabled: bool,
-}
+use cwisim_isa::{Instruction, Opcode, TraceHeader};
 
 /// An instruction travelling along the chain.
 struct Token<T, O> {
@@ -46,12 +30,9 @@ struct Token<T, O> {
     index: u64,
     /// The scanline it belongs to.
     line: u64,
-    /// Its value operands, converted when it entered the chain: `I` (for `Eval0` in the
-    /// accumulator's format), `dI`, `ddI`. An Eval's wave runs in them: running value,
-    /// first and second difference.
-    v: Vector<T>,
-    d: Vector<T>,
-    dd: Vector<T>,
+    /// Its value operands, converted when it entered the chain; an Eval's wave runs in
+    /// them.
+    wave: Wave<T>,
     /// The cycle it moves on to the next processor.
     leave_at: u64,
     /// What a `Refresh` collects as it passes.
@@ -140,14 +121,7 @@ impl<'p, A: Arith> SteppedEngine<'p, A> {
         probe: &'p mut dyn Probe,
     ) -> Self {
         let w = header.width as usize;
-        let blank = Processor {
-            acc: [A::ZERO; MAX_CHANNELS],
-            reg: [[A::ZERO; MAX_CHANNELS]; 3],
-            has: [false; 3],
-            locked: false,
-            masked: false,
-            negative_enabled: false,
-        };
+        let blank = Processor::blank(A::ZERO);
         SteppedEngine {
             arith,
             channels: header.channel_count(),
@@ -261,11 +235,9 @@ impl<'p, A: Arith> SteppedEngine<'p, A> {
             self.recorder
                 .issue(bus.line, bus.instr.op, bus.begin, t, cost);
             let mut work = Work::default();
-            let [v, d, dd] = self.operands(&bus.instr, &mut work.overflows);
+            let wave = operands(&self.arith, self.channels, &bus.instr, &mut work.overflows);
             let mut tok = Box::new(Token {
-                v,
-                d,
-                dd,
+                wave,
                 out: if bus.instr.op == Opcode::Refresh {
                     vec![<A::Out as Sample>::ZERO; w * self.channels]
                 } else {
@@ -282,29 +254,6 @@ impl<'p, A: Arith> SteppedEngine<'p, A> {
             self.in_flight += 1;
         }
         self.moved = true;
-    }
-
-    /// The value operands of `instr`, converted into the registers they are written to;
-    /// operands the opcode does not have are zero.
-    fn operands(&self, instr: &Instruction, overflows: &mut u64) -> [Vector<A::Reg>; 3] {
-        let mut out = [[A::ZERO; MAX_CHANNELS]; 3];
-        for kind in instr.op.operands() {
-            if let Some(slot) = kind.value_slot() {
-                let reg = if instr.op == Opcode::Eval0 {
-                    Register::Acc
-                } else {
-                    Register::of_slot(slot)
-                };
-                out[slot] = vector(
-                    &self.arith,
-                    reg,
-                    instr.value(slot),
-                    self.channels,
-                    overflows,
-                );
-            }
-        }
-        out
     }
 
     /// The clock advances to the next cycle at which anything can happen: the earliest
@@ -388,122 +337,21 @@ impl<'p, A: Arith> SteppedEngine<'p, A> {
 
     /// Processor `p`'s registers as `f64`.
     fn state(&self, p: usize) -> ProcessorState {
-        let pr = &self.procs[p];
-        let c = self.channels;
-        let v = |reg: Register, x: &Vector<A::Reg>| {
-            x[..c]
-                .iter()
-                .map(|s| self.arith.value(reg, *s))
-                .collect::<Vec<f64>>()
-        };
-        ProcessorState {
-            acc: v(Register::Acc, &pr.acc),
-            reg: [
-                v(Register::I, &pr.reg[0]),
-                v(Register::DI, &pr.reg[1]),
-                v(Register::DDI, &pr.reg[2]),
-            ],
-            has: pr.has,
-            locked: pr.locked,
-            masked: pr.masked,
-            negative_enabled: pr.negative_enabled,
-        }
+        self.procs[p].state(&self.arith, self.channels)
     }
 
-    /// The token's effect in processor `p`.
+    /// The token's effect in processor `p` ([`Processor::act`]).
+    #[inline]
     fn act(&mut self, p: usize, tok: &mut Token<A::Reg, A::Out>) {
-        let c = self.channels;
-        let i = &tok.instr;
-        let (x, dx) = (i.x as usize, i.dx as usize);
-        let in_range = p >= x && p < x + dx;
-        let ar = &self.arith;
-        let pr = &mut self.procs[p];
-        let work = &mut tok.work;
-        match i.op {
-            Opcode::SetI | Opcode::SetdI | Opcode::SetddI => {
-                if p == x {
-                    let slot = i.op as usize - Opcode::SetI as usize;
-                    pr.reg[slot] = [tok.v, tok.d, tok.dd][slot];
-                    pr.has[slot] = true;
-                    work.updates += 1;
-                }
-            }
-            Opcode::SetPI | Opcode::SetPdI | Opcode::SetPddI => {
-                if p >= x && (p - x).is_multiple_of(dx) {
-                    let slot = i.op as usize - Opcode::SetPI as usize;
-                    pr.reg[slot] = [tok.v, tok.d, tok.dd][slot];
-                    pr.has[slot] = true;
-                    work.updates += 1;
-                }
-            }
-            Opcode::Eval0 => {
-                if in_range {
-                    work.updates += 1;
-                    if pr.locked || pr.masked {
-                        work.suppressed += 1;
-                    } else {
-                        pr.acc = tok.v;
-                        pr.locked = true;
-                    }
-                }
-                pr.masked = false;
-            }
-            Opcode::Eval1 | Opcode::Eval2 | Opcode::Eval3 => {
-                let order = 1 + i.op as usize - Opcode::Eval1 as usize;
-                if in_range {
-                    work.updates += 1;
-                    if pr.has[0] {
-                        tok.v = pr.reg[0];
-                        pr.has[0] = false;
-                    }
-                    if order >= 2 && pr.has[1] {
-                        tok.d = pr.reg[1];
-                        pr.has[1] = false;
-                    }
-                    if order >= 3 && pr.has[2] {
-                        tok.dd = pr.reg[2];
-                        pr.has[2] = false;
-                    }
-                    let blocked = pr.locked || pr.masked;
-                    if blocked {
-                        work.suppressed += 1;
-                    }
-                    for k in 0..c {
-                        if !blocked {
-                            if pr.negative_enabled || !ar.is_negative(tok.v[k]) {
-                                pr.acc[k] = ar.accumulate(pr.acc[k], tok.v[k], &mut work.overflows);
-                            } else {
-                                work.dropped += 1;
-                            }
-                        }
-                        if order >= 2 {
-                            tok.v[k] = ar.advance_v(tok.v[k], tok.d[k], &mut work.overflows);
-                        }
-                        if order >= 3 {
-                            tok.d[k] = ar.advance_d(tok.d[k], tok.dd[k], &mut work.overflows);
-                        }
-                    }
-                }
-                pr.masked = false;
-            }
-            Opcode::Dis => {
-                if in_range {
-                    pr.masked = true;
-                    work.updates += 1;
-                }
-            }
-            Opcode::AccMode => pr.negative_enabled = !pr.negative_enabled,
-            Opcode::Refresh => {
-                for k in 0..c {
-                    tok.out[p * c + k] = ar.out(pr.acc[k]);
-                }
-                pr.acc = [A::ZERO; MAX_CHANNELS];
-                pr.has = [false; 3];
-                pr.locked = false;
-                pr.masked = false;
-            }
-            Opcode::Nop => {}
-        }
+        self.procs[p].act(
+            &self.arith,
+            self.channels,
+            p,
+            &tok.instr,
+            &mut tok.wave,
+            &mut tok.work,
+            &mut tok.out,
+        );
     }
 }
 

@@ -1,8 +1,10 @@
 //! The visits a history shows, without stepping: the fast engine runs the trace (its
-//! scanlines, its statistics), and beside it a model of the processors executes each
-//! instruction over the processors it reaches, in trace order, reporting to a [`Probe`]
-//! the events of the scanlines asked for with their cycles in closed form
-//! ([`replay_visits_numeric`]).
+//! scanlines, its statistics), and beside it the stepped engine's processors
+//! (`Processor` of `cell.rs`) take each instruction's token, in trace order, over the
+//! processors it reaches (and the masked ones a passing Eval unmasks), reporting to a
+//! [`Probe`] the events of the scanlines asked for with their cycles in closed form
+//! ([`replay_visits_numeric`]). What a token does in a processor is not restated here:
+//! it is `Processor::act` (`cell.rs`), the one the stepped engine calls.
 //!
 //! It rests on what makes the stepped engine's hand-over sound
 //! ([`crate::stepped::SteppedEngine::resume`]): tokens never overtake, each enters the
@@ -13,15 +15,16 @@
 //! those of executing the instructions in order. `tests/visits.rs` holds every event to the
 //! stepped engine's, cycle for cycle and bit for bit.
 
-use crate::arith::{vector, Arith, F32Arith, FixedArith, Native};
+use crate::arith::{Arith, F32Arith, FixedArith, Native};
+use crate::cell::{operands, Processor, Wave};
 use crate::engine::{Engine, ReplayError};
 use crate::fast::FastEngine;
 use crate::machine::{Machine, MachineError, Timeline};
-use crate::numeric::{Numeric, Register};
+use crate::numeric::Numeric;
 use crate::output::LineSink;
 use crate::probe::{Probe, ProcessorState};
-use crate::stats::RunStats;
-use cwisim_isa::{Instruction, Opcode, TraceRead, MAX_CHANNELS};
+use crate::stats::{RunStats, Work};
+use cwisim_isa::{Instruction, Opcode, TraceRead};
 
 /// Instructions between progress reports.
 const PROGRESS_EVERY: u64 = 4096;
@@ -85,23 +88,11 @@ pub fn replay_visits_numeric(
     }
 }
 
-/// One processor's registers and flags, as the stepped engine keeps them.
-#[derive(Clone, Copy)]
-struct Proc<R> {
-    acc: [R; MAX_CHANNELS],
-    reg: [[R; MAX_CHANNELS]; 3],
-    has: [bool; 3],
-    locked: bool,
-    masked: bool,
-}
-
 /// The processors, executed one instruction at a time over what it reaches.
 struct Model<A: Arith> {
     arith: A,
     channels: usize,
-    procs: Vec<Proc<A::Reg>>,
-    /// `Acc_mode`: every processor's copy toggles at once, so one flag is all of them.
-    negative: bool,
+    procs: Vec<Processor<A::Reg>>,
     /// Processors masked by a `Dis` since the last `Eval` (which unmasks every one).
     masked: Vec<usize>,
     watched: Vec<bool>,
@@ -138,51 +129,19 @@ impl Shown {
 
 impl<A: Arith> Model<A> {
     fn state(&self, p: usize) -> ProcessorState {
-        let mut s = ProcessorState::default();
-        self.fill_state(p, &mut s);
-        s
+        self.procs[p].state(&self.arith, self.channels)
     }
 
     /// Processor `p`'s registers as `f64`, into `s` (in the room it has).
     fn fill_state(&self, p: usize, s: &mut ProcessorState) {
-        let pr = &self.procs[p];
-        let c = self.channels;
-        let fill = |out: &mut Vec<f64>, reg: Register, x: &[A::Reg; MAX_CHANNELS]| {
-            out.clear();
-            out.extend(x[..c].iter().map(|r| self.arith.value(reg, *r)));
-        };
-        fill(&mut s.acc, Register::Acc, &pr.acc);
-        fill(&mut s.reg[0], Register::I, &pr.reg[0]);
-        fill(&mut s.reg[1], Register::DI, &pr.reg[1]);
-        fill(&mut s.reg[2], Register::DDI, &pr.reg[2]);
-        s.has = pr.has;
-        s.locked = pr.locked;
-        s.masked = pr.masked;
-        s.negative_enabled = self.negative;
+        self.procs[p].fill_state(&self.arith, self.channels, s);
     }
 
-    /// The value operands of `instr` as the stepped engine converts them when its token
-    /// enters the chain: `I` (for `Eval0` in the accumulator's format), `dI`, `ddI`.
-    fn operands(&self, instr: &Instruction) -> [[A::Reg; MAX_CHANNELS]; 3] {
-        let mut out = [[A::ZERO; MAX_CHANNELS]; 3];
-        let mut overflows = 0;
-        for kind in instr.op.operands() {
-            if let Some(slot) = kind.value_slot() {
-                let reg = if instr.op == Opcode::Eval0 {
-                    Register::Acc
-                } else {
-                    Register::of_slot(slot)
-                };
-                out[slot] = vector(
-                    &self.arith,
-                    reg,
-                    instr.value(slot),
-                    self.channels,
-                    &mut overflows,
-                );
-            }
-        }
-        out
+    /// What the token of `instr`, with running values `wave`, does in processor `p`
+    /// ([`Processor::act`]; its work is not counted here, the fast engine counts it).
+    #[inline]
+    fn act(&mut self, p: usize, instr: &Instruction, wave: &mut Wave<A::Reg>, work: &mut Work) {
+        self.procs[p].act(&self.arith, self.channels, p, instr, wave, work, &mut []);
     }
 
     /// Executes `instr` on every processor; with `report`, tells `probe` of each shown
@@ -201,8 +160,10 @@ impl<A: Arith> Model<A> {
         let w = self.procs.len();
         let (x, dx) = (instr.x as usize, instr.dx as usize);
         let range = x.min(w)..x.saturating_add(dx).min(w);
-        let [v0, d0, dd0] = self.operands(instr);
-        let c = self.channels;
+        // the token's running values as it enters the chain; conversion overflows and
+        // work are the fast engine's to count
+        let mut wave = operands(&self.arith, self.channels, instr, &mut 0);
+        let mut work = Work::default();
         // the visits shown, in the order made: processor, state before
         let mut shown = std::mem::take(&mut self.shown);
         shown.len = 0;
@@ -213,104 +174,54 @@ impl<A: Arith> Model<A> {
                 m.fill_state(p, &mut slot.1);
             }
         };
+        // Each processor the token can change is given it (`Processor::act`), in chain
+        // order, once `touched` has noted its state before; the processors left out are
+        // those it leaves as they are.
         let mut unmask_all = false;
         match instr.op {
             Opcode::SetI | Opcode::SetdI | Opcode::SetddI => {
                 if x < w {
-                    let slot = instr.op as usize - Opcode::SetI as usize;
                     touched(self, x, &mut shown);
-                    let pr = &mut self.procs[x];
-                    pr.reg[slot] = [v0, d0, dd0][slot];
-                    pr.has[slot] = true;
+                    self.act(x, instr, &mut wave, &mut work);
                 }
             }
             Opcode::SetPI | Opcode::SetPdI | Opcode::SetPddI => {
-                let slot = instr.op as usize - Opcode::SetPI as usize;
                 let step = dx.max(1);
                 let mut p = x;
                 while p < w && (p == x || dx > 0) {
                     touched(self, p, &mut shown);
-                    let pr = &mut self.procs[p];
-                    pr.reg[slot] = [v0, d0, dd0][slot];
-                    pr.has[slot] = true;
+                    self.act(p, instr, &mut wave, &mut work);
                     p += step;
                 }
             }
-            Opcode::Eval0 => {
+            Opcode::Eval0 | Opcode::Eval1 | Opcode::Eval2 | Opcode::Eval3 => {
                 for p in range.clone() {
                     touched(self, p, &mut shown);
-                    let pr = &mut self.procs[p];
-                    if !(pr.locked || pr.masked) {
-                        pr.acc = v0;
-                        pr.locked = true;
-                    }
-                    pr.masked = false;
-                }
-                unmask_all = true;
-            }
-            Opcode::Eval1 | Opcode::Eval2 | Opcode::Eval3 => {
-                let order = 1 + instr.op as usize - Opcode::Eval1 as usize;
-                let (mut v, mut d, mut dd) = (v0, d0, dd0);
-                let mut ovf = 0;
-                for p in range.clone() {
-                    touched(self, p, &mut shown);
-                    let ar = &self.arith;
-                    let negative = self.negative;
-                    let pr = &mut self.procs[p];
-                    if pr.has[0] {
-                        v = pr.reg[0];
-                        pr.has[0] = false;
-                    }
-                    if order >= 2 && pr.has[1] {
-                        d = pr.reg[1];
-                        pr.has[1] = false;
-                    }
-                    if order >= 3 && pr.has[2] {
-                        dd = pr.reg[2];
-                        pr.has[2] = false;
-                    }
-                    let blocked = pr.locked || pr.masked;
-                    for k in 0..c {
-                        if !blocked && (negative || !ar.is_negative(v[k])) {
-                            pr.acc[k] = ar.accumulate(pr.acc[k], v[k], &mut ovf);
-                        }
-                        if order >= 2 {
-                            v[k] = ar.advance_v(v[k], d[k], &mut ovf);
-                        }
-                        if order >= 3 {
-                            d[k] = ar.advance_d(d[k], dd[k], &mut ovf);
-                        }
-                    }
-                    pr.masked = false;
+                    self.act(p, instr, &mut wave, &mut work);
                 }
                 unmask_all = true;
             }
             Opcode::Dis => {
                 for p in range.clone() {
                     touched(self, p, &mut shown);
-                    if !self.procs[p].masked {
-                        self.procs[p].masked = true;
+                    let was = self.procs[p].masked;
+                    self.act(p, instr, &mut wave, &mut work);
+                    if !was {
                         self.masked.push(p);
                     }
                 }
             }
-            Opcode::AccMode => {
+            Opcode::AccMode | Opcode::Refresh => {
+                // addresses every processor: the watched ones shown
                 for k in 0..self.watched_list.len() {
                     touched(self, self.watched_list[k], &mut shown);
                 }
-                self.negative = !self.negative;
-            }
-            Opcode::Refresh => {
-                for k in 0..self.watched_list.len() {
-                    touched(self, self.watched_list[k], &mut shown);
+                for p in 0..w {
+                    self.act(p, instr, &mut wave, &mut work);
                 }
-                for pr in &mut self.procs {
-                    pr.acc = [A::ZERO; MAX_CHANNELS];
-                    pr.has = [false; 3];
-                    pr.locked = false;
-                    pr.masked = false;
+                if instr.op == Opcode::Refresh {
+                    self.masked.clear();
                 }
-                self.masked.clear();
             }
             Opcode::Nop => {}
         }
@@ -322,7 +233,7 @@ impl<A: Arith> Model<A> {
                 let p = self.masked[k];
                 if self.procs[p].masked {
                     touched(self, p, &mut shown);
-                    self.procs[p].masked = false;
+                    self.act(p, instr, &mut wave, &mut work);
                 }
             }
             self.masked.clear();
@@ -393,18 +304,11 @@ fn visits<A: Arith<Out = f64>>(
     let header = *reader.header();
     let w = header.width as usize;
     let watched: Vec<bool> = (0..w).map(|p| probe.watches(p)).collect();
-    let blank = Proc {
-        acc: [A::ZERO; MAX_CHANNELS],
-        reg: [[A::ZERO; MAX_CHANNELS]; 3],
-        has: [false; 3],
-        locked: false,
-        masked: false,
-    };
+    let blank = Processor::blank(A::ZERO);
     let mut model = Model {
         arith: arith.clone(),
         channels: header.channel_count(),
         procs: vec![blank; w],
-        negative: false,
         masked: Vec::new(),
         watched_list: (0..w).filter(|&p| watched[p]).collect(),
         watched,
