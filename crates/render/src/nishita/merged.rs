@@ -1,0 +1,237 @@
+//! A patch's row as one span: the visible fragments of one patch on one pixel row are
+//! box-filtered exactly on the host (van Rij's DO_FILL for each of their trapezia, its
+//! instructions added up here as the array would add them), and the row's values over
+//! the patch are sent through the [span fitter](crate::span) as the fewest
+//! `Eval1`/`Eval2`/`Eval3` pieces within a tolerance
+//! ([`super::Nishita::span_tolerance`]) — not one instruction run
+//! per piece. The pieces of a patch meet along their shared edges, where each side's
+//! DO_FILL would send a single-pixel `Eval1`; summed first, those pixels join the span.
+//!
+//! Each value the array accumulates is within the tolerance of the exact box-filtered
+//! value of the patch there (the fitter checks every piece with the array's own adder
+//! chain), so a pixel that `m` patches reach is within `m ×` the tolerance of the exact
+//! image; tolerance 0 sends every pixel's exact value (one `Eval1` per pixel).
+//!
+//! Rows are emitted in order, the patches of a row by mesh and patch number: the stream
+//! is the same for any split of the rows into bands.
+
+use crate::renderer::{Counters, FramePlan};
+use crate::span::{fit_span, SpanStats};
+use cwisim_isa::{Instruction, Opcode, TraceWrite};
+use cwisim_scene::ScreenScene;
+use cwisim_ypipe::dofill::{box_slice_to, BoxValue, Procedure, RowOut, Shade};
+use cwisim_ypipe::scan::{edge_list, scan_slices_of, EdgeNode, SliceVisit};
+use cwisim_ypipe::scene_trapezia;
+use cwisim_ypipe::trapezoid::Trapezium;
+use cwisim_ypipe::Claim;
+use std::io;
+use std::ops::Range;
+
+/// One frame: the fragments' trapezia and edge list, built once.
+pub struct MergedFrame<'a> {
+    screen: &'a ScreenScene,
+    /// For each polygon: its patch (`mesh << 32 | patch`).
+    groups: &'a [u64],
+    value: BoxValue,
+    tolerance: f64,
+    trapezia: Vec<Trapezium>,
+    edges: Vec<EdgeNode>,
+}
+
+impl<'a> MergedFrame<'a> {
+    /// The plan of `screen`, whose polygon `k` is part of patch `groups[k]`.
+    pub fn new(
+        screen: &'a ScreenScene,
+        groups: &'a [u64],
+        value: BoxValue,
+        tolerance: f64,
+    ) -> MergedFrame<'a> {
+        let trapezia = scene_trapezia(screen);
+        MergedFrame {
+            screen,
+            groups,
+            value,
+            tolerance,
+            edges: edge_list(&trapezia, screen.channel_count()),
+            trapezia,
+        }
+    }
+}
+
+/// One patch's values on the row being scanned.
+struct Slot {
+    group: u64,
+    /// Pixel-major, `channels` values per pixel, the whole width.
+    values: Vec<f64>,
+    /// Pixels some instruction reached.
+    touched: Vec<bool>,
+    /// The range touched: `lo ..= hi`.
+    lo: usize,
+    hi: usize,
+}
+
+/// Adds DO_FILL's instructions into a slot, as the array's adder chain would (in
+/// `f64`; a negative contribution dropped, as the array does without `Acc_mode`).
+struct Adder<'s> {
+    slot: &'s mut Slot,
+    channels: usize,
+    width: usize,
+}
+
+impl RowOut for Adder<'_> {
+    fn put(&mut self, _proc: Procedure, instr: &Instruction) {
+        let order = match instr.op {
+            Opcode::Eval1 => 1,
+            Opcode::Eval2 => 2,
+            Opcode::Eval3 => 3,
+            _ => return,
+        };
+        let ch = self.channels;
+        let (x, n) = (instr.x as usize, instr.dx as usize);
+        let end = (x + n).min(self.width);
+        if end <= x {
+            return;
+        }
+        let slot = &mut *self.slot;
+        for c in 0..ch {
+            let get = |s: usize| instr.value(s).get(c).copied().unwrap_or(0.0);
+            let (mut v, mut d) = (get(0), if order >= 2 { get(1) } else { 0.0 });
+            let dd = if order == 3 { get(2) } else { 0.0 };
+            for p in x..end {
+                if v >= 0.0 {
+                    slot.values[p * ch + c] += v;
+                }
+                if order >= 2 {
+                    v += d;
+                }
+                if order == 3 {
+                    d += dd;
+                }
+            }
+        }
+        for t in &mut slot.touched[x..end] {
+            *t = true;
+        }
+        slot.lo = slot.lo.min(x);
+        slot.hi = slot.hi.max(end - 1);
+    }
+}
+
+/// What a frame's rows did.
+#[derive(Default)]
+struct Tally {
+    rows_filled: u64,
+    spans: u64,
+    fit: SpanStats,
+    instructions: u64,
+}
+
+fn counters(t: &Tally) -> Counters {
+    Counters::default()
+        .with("rows filled", t.rows_filled)
+        .with("patch spans", t.spans)
+        .with("pixels fitted", t.fit.pixels)
+        .with("span Eval1", t.fit.eval1)
+        .with("span Eval2", t.fit.eval2)
+        .with("span Eval3", t.fit.eval3)
+        .with("span candidates", t.fit.candidates)
+        .with("instructions", t.instructions)
+}
+
+impl FramePlan for MergedFrame<'_> {
+    fn counters(&self) -> Counters {
+        Counters::default()
+            .with("polygons", self.screen.polygons.len() as u64)
+            .with("trapezia", self.trapezia.len() as u64)
+    }
+
+    fn emit_rows(&self, rows: Range<u32>, sink: &mut dyn TraceWrite) -> io::Result<Counters> {
+        let channels = self.screen.channel_count();
+        let width = self.screen.width as usize;
+        let mut tally = Tally::default();
+        let mut result = Ok(());
+        // the row's slots (active: the first `active`), reused from row to row
+        let mut slots: Vec<Slot> = Vec::new();
+        let mut active = 0;
+        scan_slices_of(&self.trapezia, &self.edges, rows, |visit| {
+            if result.is_err() {
+                return;
+            }
+            match visit {
+                SliceVisit::Fill(slice, t) => {
+                    let group = self.groups[t.polygon as usize];
+                    let k = match slots[..active].iter().position(|s| s.group == group) {
+                        Some(k) => k,
+                        None => {
+                            if active == slots.len() {
+                                slots.push(Slot {
+                                    group,
+                                    values: vec![0.0; width * channels],
+                                    touched: vec![false; width],
+                                    lo: usize::MAX,
+                                    hi: 0,
+                                });
+                            }
+                            let s = &mut slots[active];
+                            s.group = group;
+                            s.lo = usize::MAX;
+                            s.hi = 0;
+                            active += 1;
+                            active - 1
+                        }
+                    };
+                    let mut adder = Adder {
+                        slot: &mut slots[k],
+                        channels,
+                        width,
+                    };
+                    box_slice_to(
+                        t,
+                        slice,
+                        self.screen.width,
+                        &Shade::Gouraud,
+                        channels,
+                        Claim::Accumulate,
+                        self.value,
+                        None,
+                        &mut adder,
+                    );
+                    tally.rows_filled += 1;
+                }
+                SliceVisit::EndOfRow(_) => {
+                    slots[..active].sort_by_key(|s| s.group);
+                    for s in &mut slots[..active] {
+                        if s.lo > s.hi {
+                            continue;
+                        }
+                        let mut p = s.lo;
+                        while p <= s.hi && result.is_ok() {
+                            if !s.touched[p] {
+                                p += 1;
+                                continue;
+                            }
+                            let q = p + s.touched[p..=s.hi].iter().take_while(|&&t| t).count();
+                            let targets = &s.values[p * channels..q * channels];
+                            result = fit_span(p as u32, targets, channels, self.tolerance, sink)
+                                .map(|f| {
+                                    tally.instructions += f.pieces();
+                                    tally.fit.add(&f);
+                                    tally.spans += 1;
+                                });
+                            p = q;
+                        }
+                        s.values[s.lo * channels..(s.hi + 1) * channels].fill(0.0);
+                        s.touched[s.lo..=s.hi].fill(false);
+                    }
+                    active = 0;
+                    if result.is_ok() {
+                        tally.instructions += 1;
+                        result = sink.write(&Instruction::refresh());
+                    }
+                }
+            }
+        });
+        result?;
+        Ok(counters(&tally))
+    }
+}
