@@ -12,9 +12,16 @@
 //! chain), so a pixel that `m` patches reach is within `m ×` the tolerance of the exact
 //! image; tolerance 0 sends every pixel's exact value (one `Eval1` per pixel).
 //!
+//! With Phong shading (`--shading phong`, box filter) each pixel of a fragment's row
+//! adds its coverage × the Phong shade at the point of the fragment's source triangle
+//! nearest the pixel centre, as [`crate::phong`] computes it per trapezium; the patch's
+//! row is then fitted within `--shade-tolerance` itself.
+//!
 //! Rows are emitted in order, the patches of a row by mesh and patch number: the stream
 //! is the same for any split of the rows into bands.
 
+use crate::phong::nearest_in;
+use crate::prepare::PhongSurfaces;
 use crate::renderer::{Counters, FramePlan};
 use crate::span::{fit_span, SpanStats};
 use cwisim_isa::{Instruction, Opcode, TraceWrite};
@@ -34,17 +41,21 @@ pub struct MergedFrame<'a> {
     groups: &'a [u64],
     value: BoxValue,
     tolerance: f64,
+    /// Phong: the triangles, each fragment's source, the lighting.
+    phong: Option<&'a PhongSurfaces>,
     trapezia: Vec<Trapezium>,
     edges: Vec<EdgeNode>,
 }
 
 impl<'a> MergedFrame<'a> {
-    /// The plan of `screen`, whose polygon `k` is part of patch `groups[k]`.
+    /// The plan of `screen`, whose polygon `k` is part of patch `groups[k]`; Gouraud, or
+    /// Phong lit from `phong`.
     pub fn new(
         screen: &'a ScreenScene,
         groups: &'a [u64],
         value: BoxValue,
         tolerance: f64,
+        phong: Option<&'a PhongSurfaces>,
     ) -> MergedFrame<'a> {
         let trapezia = scene_trapezia(screen);
         MergedFrame {
@@ -52,6 +63,7 @@ impl<'a> MergedFrame<'a> {
             groups,
             value,
             tolerance,
+            phong,
             edges: edge_list(&trapezia, screen.channel_count()),
             trapezia,
         }
@@ -180,22 +192,52 @@ impl FramePlan for MergedFrame<'_> {
                             active - 1
                         }
                     };
-                    let mut adder = Adder {
-                        slot: &mut slots[k],
-                        channels,
-                        width,
-                    };
-                    box_slice_to(
-                        t,
-                        slice,
-                        self.screen.width,
-                        &Shade::Gouraud,
-                        channels,
-                        Claim::Accumulate,
-                        self.value,
-                        None,
-                        &mut adder,
-                    );
+                    match self.phong {
+                        None => {
+                            let mut adder = Adder {
+                                slot: &mut slots[k],
+                                channels,
+                                width,
+                            };
+                            box_slice_to(
+                                t,
+                                slice,
+                                self.screen.width,
+                                &Shade::Gouraud,
+                                channels,
+                                Claim::Accumulate,
+                                self.value,
+                                None,
+                                &mut adder,
+                            );
+                        }
+                        Some(surfaces) => {
+                            let triangle =
+                                &surfaces.triangles[surfaces.sources[t.polygon as usize]];
+                            let slot = &mut slots[k];
+                            let (l0, _, _, r1) = slice.edge_pixels();
+                            let (first, last) = (l0.max(0), r1.min(width as i64 - 1));
+                            for i in first..=last {
+                                let c = slice.coverage(i);
+                                if c == 0.0 {
+                                    continue;
+                                }
+                                let centre = [i as f64 + 0.5, f64::from(slice.row) + 0.5];
+                                let p = nearest_in(triangle, centre);
+                                let shade = surfaces.shader.at(triangle, p).unwrap_or_default();
+                                let i = i as usize;
+                                for (v, s) in slot.values[i * channels..(i + 1) * channels]
+                                    .iter_mut()
+                                    .zip(&shade[..channels])
+                                {
+                                    *v += c * s.max(0.0);
+                                }
+                                slot.touched[i] = true;
+                                slot.lo = slot.lo.min(i);
+                                slot.hi = slot.hi.max(i);
+                            }
+                        }
+                    }
                     tally.rows_filled += 1;
                 }
                 SliceVisit::EndOfRow(_) => {

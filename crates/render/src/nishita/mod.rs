@@ -330,7 +330,7 @@ pub struct Nishita {
     /// Host time of the visibility pass.
     visibility_time: Duration,
     /// Each polygon's patch (`mesh << 32 | patch`) when a patch's row goes through the
-    /// span fitter as one span ([`merged`]: Gouraud, box filter, band by band); `None`
+    /// span fitter as one span ([`merged`]: box filter, band by band); `None`
     /// when the polygons are drawn as `vanrij` draws them.
     groups: Option<Vec<u64>>,
 }
@@ -386,7 +386,7 @@ impl Nishita {
             let scene = PatchScene::new(&w, settings)?;
             let r = resolve::resolve(&scene, settings, phong)?;
             let total = start.elapsed();
-            if !phong && settings.aa.is_box() {
+            if settings.aa.is_box() {
                 groups = Some(r.groups);
             }
             let surfaces = phong.then(|| PhongSurfaces {
@@ -495,8 +495,12 @@ impl Nishita {
     /// of `--shade-tolerance` (1/4096 at the default), so that the fitter adds little to
     /// the error against the reference (RMS 1.054e-3 to 1.06e-3 on the teapot; at the
     /// whole 1/512 it was 1.18e-3).
+    /// With Phong shading, `--shade-tolerance` itself.
     pub fn span_tolerance(&self) -> f64 {
-        self.settings.shade_tolerance / 8.0
+        match self.settings.shading {
+            Shading::Phong => self.settings.shade_tolerance,
+            _ => self.settings.shade_tolerance / 8.0,
+        }
     }
 
     /// For the registry.
@@ -591,6 +595,7 @@ impl Renderer for Nishita {
                     cwisim_ypipe::dofill::BoxValue::Exact
                 },
                 self.span_tolerance(),
+                self.inner.polygons().phong.as_ref(),
             )),
             None => self.inner.frame(index, previous)?,
         };

@@ -15,7 +15,7 @@ use crate::settings::Settings;
 use cwisim_scene::Polygon;
 use cwisim_world::face::ScreenTriangle;
 use cwisim_world::visibility::{exact_fragments, VisibilityStats};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
@@ -28,7 +28,7 @@ struct Band {
     sources: Vec<usize>,
     /// Each fragment's patch: `mesh << 32 | patch`.
     groups: Vec<u64>,
-    /// The band's triangles (Phong only; empty otherwise).
+    /// The band's triangles that some fragment is part of (Phong only; empty otherwise).
     triangles: Vec<ScreenTriangle>,
     /// How many triangles the band had.
     count: usize,
@@ -48,7 +48,7 @@ pub struct Resolved {
     pub sources: Vec<usize>,
     /// Each fragment's patch: `mesh << 32 | patch`.
     pub groups: Vec<u64>,
-    /// Phong: every band's triangles, in order.
+    /// Phong: every band's triangles that some fragment is part of, in order.
     pub triangles: Vec<ScreenTriangle>,
     /// All triangles.
     pub count: u64,
@@ -73,24 +73,23 @@ fn merge(s: &mut VisibilityStats, o: &VisibilityStats) {
     s.dropped_area += o.dropped_area;
 }
 
+/// One band made and resolved. `made` counts the pieces of every band made so far (on
+/// any thread): the frame's fragments grow with them, so the memory budget is checked
+/// against that count, as when the frame's pieces were all held at once.
 fn one_band(
     scene: &PatchScene,
     top: u32,
     rows: u32,
     settings: &Settings,
     keep: bool,
+    made: &AtomicUsize,
 ) -> Result<Band, RenderError> {
     let mut pieces = Pieces::default();
     scene.band(top, rows, &mut pieces)?;
     let budget = cwisim_scene::budget::Budget::current();
-    // one band's pieces per thread at a time
-    let threads = settings.threads.max(1);
-    check_budget(
-        &budget,
-        pieces.triangles.len() * threads,
-        top + rows,
-        settings,
-    )?;
+    let n = pieces.triangles.len();
+    let so_far = made.fetch_add(n, Ordering::Relaxed) + n;
+    check_budget(&budget, so_far, top + rows, settings)?;
     let start = Instant::now();
     // strip by strip, each strip's pieces in the order they were made (a stable sort)
     let mut keyed: Vec<(u32, ScreenTriangle)> = std::mem::take(&mut pieces.strip)
@@ -121,7 +120,16 @@ fn one_band(
     }
     band.time = start.elapsed();
     if keep {
-        band.triangles = triangles;
+        // only the triangles some fragment is part of (the others are wholly hidden:
+        // more than half of them on the teapot), the sources renumbered in order
+        let mut index = vec![usize::MAX; triangles.len()];
+        for s in &mut band.sources {
+            if index[*s] == usize::MAX {
+                index[*s] = band.triangles.len();
+                band.triangles.push(triangles[*s]);
+            }
+            *s = index[*s];
+        }
     }
     pieces.facing = Vec::new();
     pieces.origin = Vec::new();
@@ -142,29 +150,39 @@ pub fn resolve(
         n => n,
     }
     .clamp(1, bands.len().max(1));
+    let made = AtomicUsize::new(0);
     let done: Vec<Result<Band, RenderError>> = if threads == 1 {
-        bands
-            .iter()
-            .map(|&(top, rows)| one_band(scene, top, rows, settings, keep))
-            .collect()
+        let mut out = Vec::with_capacity(bands.len());
+        for &(top, rows) in &bands {
+            let r = one_band(scene, top, rows, settings, keep, &made);
+            let failed = r.is_err();
+            out.push(r);
+            if failed {
+                break;
+            }
+        }
+        out
     } else {
         let next = AtomicUsize::new(0);
+        let failed = AtomicBool::new(false);
         let slots: Vec<Mutex<Option<Result<Band, RenderError>>>> =
             bands.iter().map(|_| Mutex::new(None)).collect();
         std::thread::scope(|s| {
             for _ in 0..threads {
                 s.spawn(|| loop {
+                    if failed.load(Ordering::Relaxed) {
+                        break;
+                    }
                     let b = next.fetch_add(1, Ordering::Relaxed);
                     let Some(&(top, rows)) = bands.get(b) else {
                         break;
                     };
-                    let r = one_band(scene, top, rows, settings, keep);
-                    let failed = r.is_err();
-                    *slots[b].lock().unwrap_or_else(|e| e.into_inner()) = Some(r);
-                    if failed {
+                    let r = one_band(scene, top, rows, settings, keep, &made);
+                    if r.is_err() {
                         // later bands are not needed: the first error in band order wins
-                        break;
+                        failed.store(true, Ordering::Relaxed);
                     }
+                    *slots[b].lock().unwrap_or_else(|e| e.into_inner()) = Some(r);
                 });
             }
         });
