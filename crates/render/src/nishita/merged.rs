@@ -27,14 +27,14 @@ use crate::span::{fit_span, SpanStats};
 use cwisim_isa::{Instruction, Opcode, TraceWrite};
 use cwisim_scene::ScreenScene;
 use cwisim_ypipe::dofill::{box_slice_to, BoxValue, Procedure, RowOut, Shade};
-use cwisim_ypipe::scan::{edge_list, scan_slices_of, EdgeNode, SliceVisit};
+use cwisim_ypipe::scan::{edge_list, scan_slices_of, SliceVisit};
 use cwisim_ypipe::scene_trapezia;
-use cwisim_ypipe::trapezoid::Trapezium;
 use cwisim_ypipe::Claim;
 use std::io;
 use std::ops::Range;
 
-/// One frame: the fragments' trapezia and edge list, built once.
+/// One frame: the fragments, their patches and the rows each reaches; each band of
+/// rows builds the trapezia of its own polygons.
 pub struct MergedFrame<'a> {
     screen: &'a ScreenScene,
     /// For each polygon: its patch (`mesh << 32 | patch`).
@@ -43,29 +43,42 @@ pub struct MergedFrame<'a> {
     tolerance: f64,
     /// Phong: the triangles, each fragment's source, the lighting.
     phong: Option<&'a PhongSurfaces>,
-    trapezia: Vec<Trapezium>,
-    edges: Vec<EdgeNode>,
+    /// For each polygon: the first and last pixel row it may reach (both non-decreasing
+    /// along the polygons, which come band by band and strip by strip), or `None` when
+    /// they are not ordered so (then every band takes every polygon).
+    rows: Option<Vec<(i64, i64)>>,
 }
 
 impl<'a> MergedFrame<'a> {
-    /// The plan of `screen`, whose polygon `k` is part of patch `groups[k]`; Gouraud, or
-    /// Phong lit from `phong`.
+    /// The plan of `screen`, whose polygon `k` is part of patch `groups[k]` and lies in
+    /// pixel row `rows[k]` (within rounding); Gouraud, or Phong lit from `phong`.
     pub fn new(
         screen: &'a ScreenScene,
         groups: &'a [u64],
+        rows: &[u32],
         value: BoxValue,
         tolerance: f64,
         phong: Option<&'a PhongSurfaces>,
     ) -> MergedFrame<'a> {
-        let trapezia = scene_trapezia(screen);
+        // a fragment's vertices may stray from its strip by rounding: one row either side
+        let mut rows: Vec<(i64, i64)> = rows
+            .iter()
+            .map(|&r| (i64::from(r) - 1, i64::from(r) + 1))
+            .collect();
+        let ordered = rows
+            .windows(2)
+            .all(|w| w[0].0 <= w[1].0 && w[0].1 <= w[1].1)
+            && rows.len() == screen.polygons.len();
+        if !ordered {
+            rows = Vec::new();
+        }
         MergedFrame {
             screen,
             groups,
             value,
             tolerance,
             phong,
-            edges: edge_list(&trapezia, screen.channel_count()),
-            trapezia,
+            rows: ordered.then_some(rows),
         }
     }
 }
@@ -132,6 +145,7 @@ impl RowOut for Adder<'_> {
 /// What a frame's rows did.
 #[derive(Default)]
 struct Tally {
+    trapezia: u64,
     rows_filled: u64,
     spans: u64,
     fit: SpanStats,
@@ -140,6 +154,7 @@ struct Tally {
 
 fn counters(t: &Tally) -> Counters {
     Counters::default()
+        .with("trapezia", t.trapezia)
         .with("rows filled", t.rows_filled)
         .with("patch spans", t.spans)
         .with("pixels fitted", t.fit.pixels)
@@ -152,26 +167,74 @@ fn counters(t: &Tally) -> Counters {
 
 impl FramePlan for MergedFrame<'_> {
     fn counters(&self) -> Counters {
-        Counters::default()
-            .with("polygons", self.screen.polygons.len() as u64)
-            .with("trapezia", self.trapezia.len() as u64)
+        Counters::default().with("polygons", self.screen.polygons.len() as u64)
     }
 
     fn emit_rows(&self, rows: Range<u32>, sink: &mut dyn TraceWrite) -> io::Result<Counters> {
+        let mut tally = Tally::default();
+        // the row's slots, reused from row to row
+        let mut slots: Vec<Slot> = Vec::new();
+        // a few rows at a time (each row's stream does not depend on the split)
+        let step = match self.rows {
+            Some(_) => CHUNK_ROWS,
+            None => rows.len().max(1) as u32,
+        };
+        let mut start = rows.start;
+        while start < rows.end {
+            let end = start.saturating_add(step).min(rows.end);
+            self.emit_chunk(start..end, sink, &mut slots, &mut tally)?;
+            start = end;
+        }
+        Ok(counters(&tally))
+    }
+}
+
+/// Rows emitted at a time: their fragments' trapezia are built for them alone.
+const CHUNK_ROWS: u32 = 8;
+
+impl MergedFrame<'_> {
+    fn emit_chunk(
+        &self,
+        rows: Range<u32>,
+        sink: &mut dyn TraceWrite,
+        slots: &mut Vec<Slot>,
+        tally: &mut Tally,
+    ) -> io::Result<()> {
         let channels = self.screen.channel_count();
         let width = self.screen.width as usize;
-        let mut tally = Tally::default();
         let mut result = Ok(());
-        // the row's slots (active: the first `active`), reused from row to row
-        let mut slots: Vec<Slot> = Vec::new();
+        // the active slots: the first `active`
         let mut active = 0;
-        scan_slices_of(&self.trapezia, &self.edges, rows, |visit| {
+        // the trapezia of the polygons reaching these rows only: memory bounded by the
+        // band, not the frame (a polygon keeps its order among them, so a row's
+        // trapezia are visited as they would be among the frame's)
+        let polygons = match &self.rows {
+            Some(r) => {
+                let (start, end) = (i64::from(rows.start), i64::from(rows.end));
+                let first = r.partition_point(|&(_, hi)| hi < start);
+                let last = r.partition_point(|&(lo, _)| lo < end);
+                first..last.max(first)
+            }
+            None => 0..self.screen.polygons.len(),
+        };
+        let base = polygons.start;
+        let band = ScreenScene {
+            width: self.screen.width,
+            height: self.screen.height,
+            channels: self.screen.channels,
+            polygons: self.screen.polygons[polygons].to_vec(),
+        };
+        let trapezia = scene_trapezia(&band);
+        drop(band);
+        let edges = edge_list(&trapezia, channels);
+        tally.trapezia += trapezia.len() as u64;
+        scan_slices_of(&trapezia, &edges, rows, |visit| {
             if result.is_err() {
                 return;
             }
             match visit {
                 SliceVisit::Fill(slice, t) => {
-                    let group = self.groups[t.polygon as usize];
+                    let group = self.groups[base + t.polygon as usize];
                     let k = match slots[..active].iter().position(|s| s.group == group) {
                         Some(k) => k,
                         None => {
@@ -213,7 +276,7 @@ impl FramePlan for MergedFrame<'_> {
                         }
                         Some(surfaces) => {
                             let triangle =
-                                &surfaces.triangles[surfaces.sources[t.polygon as usize]];
+                                &surfaces.triangles[surfaces.sources[base + t.polygon as usize]];
                             let slot = &mut slots[k];
                             let (l0, _, _, r1) = slice.edge_pixels();
                             let (first, last) = (l0.max(0), r1.min(width as i64 - 1));
@@ -273,7 +336,6 @@ impl FramePlan for MergedFrame<'_> {
                 }
             }
         });
-        result?;
-        Ok(counters(&tally))
+        result
     }
 }

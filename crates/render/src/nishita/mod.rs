@@ -332,7 +332,8 @@ pub struct Nishita {
     /// Each polygon's patch (`mesh << 32 | patch`) when a patch's row goes through the
     /// span fitter as one span ([`merged`]: box filter, band by band); `None`
     /// when the polygons are drawn as `vanrij` draws them.
-    groups: Option<Vec<u64>>,
+    /// With each polygon's pixel row.
+    groups: Option<(Vec<u64>, Vec<u32>)>,
 }
 
 impl Nishita {
@@ -387,7 +388,7 @@ impl Nishita {
             let r = resolve::resolve(&scene, settings, phong)?;
             let total = start.elapsed();
             if settings.aa.is_box() {
-                groups = Some(r.groups);
+                groups = Some((r.groups, r.rows));
             }
             let surfaces = phong.then(|| PhongSurfaces {
                 triangles: r.triangles,
@@ -586,9 +587,10 @@ impl Renderer for Nishita {
         previous: Option<&'a Image>,
     ) -> Result<Box<dyn FramePlan + 'a>, RenderError> {
         let inner: Box<dyn FramePlan + 'a> = match &self.groups {
-            Some(groups) => Box::new(merged::MergedFrame::new(
+            Some((groups, rows)) => Box::new(merged::MergedFrame::new(
                 &self.inner.polygons().screen,
                 groups,
+                rows,
                 if self.settings.aa == cwisim_scene::Antialias::BoxCentre {
                     cwisim_ypipe::dofill::BoxValue::Centre
                 } else {

@@ -28,6 +28,8 @@ struct Band {
     sources: Vec<usize>,
     /// Each fragment's patch: `mesh << 32 | patch`.
     groups: Vec<u64>,
+    /// Each fragment's pixel row (its strip's).
+    rows: Vec<u32>,
     /// The band's triangles that some fragment is part of (Phong only; empty otherwise).
     triangles: Vec<ScreenTriangle>,
     /// How many triangles the band had.
@@ -48,6 +50,8 @@ pub struct Resolved {
     pub sources: Vec<usize>,
     /// Each fragment's patch: `mesh << 32 | patch`.
     pub groups: Vec<u64>,
+    /// Each fragment's pixel row (its strip's): it lies in that row, within rounding.
+    pub rows: Vec<u32>,
     /// Phong: every band's triangles that some fragment is part of, in order.
     pub triangles: Vec<ScreenTriangle>,
     /// All triangles.
@@ -111,6 +115,7 @@ fn one_band(
             let t = &triangles[a + f.source];
             band.groups
                 .push(u64::from(t.mesh) << 32 | u64::from(t.face));
+            band.rows.push(top + strips[a] / settings.subscan);
             if keep {
                 band.sources.push(a + f.source);
             }
@@ -200,6 +205,7 @@ pub fn resolve(
         polygons: Vec::new(),
         sources: Vec::new(),
         groups: Vec::new(),
+        rows: Vec::new(),
         triangles: Vec::new(),
         count: 0,
         pieces: Pieces {
@@ -215,6 +221,7 @@ pub fn resolve(
         out.polygons.extend(band.polygons);
         out.sources.extend(band.sources.iter().map(|s| s + base));
         out.groups.extend(band.groups);
+        out.rows.extend(band.rows);
         out.triangles.extend(band.triangles);
         out.count += band.count as u64;
         out.pieces.stats.merge(&band.pieces.stats);
