@@ -227,7 +227,17 @@ impl MergedFrame<'_> {
         let trapezia = scene_trapezia(&band);
         drop(band);
         let edges = edge_list(&trapezia, channels);
-        tally.trapezia += trapezia.len() as u64;
+        // each trapezium counted once, in the chunk of its fragment's own row
+        tally.trapezia += match &self.rows {
+            Some(r) => trapezia
+                .iter()
+                .filter(|t| {
+                    let row = r[base + t.polygon as usize].0 + 1;
+                    (i64::from(rows.start)..i64::from(rows.end)).contains(&row)
+                })
+                .count() as u64,
+            None => trapezia.len() as u64,
+        };
         scan_slices_of(&trapezia, &edges, rows, |visit| {
             if result.is_err() {
                 return;
