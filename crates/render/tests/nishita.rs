@@ -365,3 +365,50 @@ fn bad_settings_and_flat_shading_are_refused() {
     .unwrap_err();
     assert!(e.to_string().contains("--root-tolerance"), "{e}");
 }
+
+fn run(name: &str, loaded: LoadedScene, settings: &Settings) -> (Vec<f64>, u64, u64) {
+    let r = (registry::find(name).unwrap().build)(loaded, settings).unwrap();
+    let h = r.header();
+    let mut sink = ImageSink::new(h.width as usize, h.channel_count(), 1 << 30);
+    let out = render(&*r, &ArrayConfig::default(), 1, &mut sink, Taps::default()).unwrap();
+    let instructions = out.counters.get("instructions").unwrap_or(0);
+    (
+        sink.finish().unwrap().data,
+        instructions,
+        out.stats.totals.late_lines,
+    )
+}
+
+#[test]
+fn a_patchs_row_is_one_span_within_its_tolerance_and_no_scanline_is_late() {
+    let size = 160;
+    let lit = || LoadedScene::built("teapot", AnyScene::World(teapot(size)));
+    let settings = Settings::default();
+    let (fitted, instructions, late) = run("nishita", lit(), &settings);
+    // tolerance 0: every pixel's exact box-filtered value, one Eval1 each
+    let exact = Settings {
+        shade_tolerance: 0.0,
+        ..settings
+    };
+    let (values, pixels, _) = run("nishita", lit(), &exact);
+    // the same teapot tessellated 8 × 8 and drawn by vanrij, as a tessellated teapot is
+    let coarse = teapot(size).with_tessellation(8).unwrap();
+    let (_, vanrij, vanrij_late) = run(
+        "vanrij",
+        LoadedScene::built("teapot-8", AnyScene::World(coarse)),
+        &settings,
+    );
+    eprintln!(
+        "instructions: nishita {instructions} (tolerance 0: {pixels}), vanrij at 8 × 8 {vanrij}; late {late}, vanrij {vanrij_late}"
+    );
+    assert!(instructions < vanrij, "{instructions} ≥ {vanrij}");
+    assert_eq!((late, vanrij_late), (0, 0));
+    // a pixel is reached by the spans of a few patches, each within the tolerance
+    let bound = 4.0 * settings.shade_tolerance / 8.0;
+    let worst = fitted
+        .iter()
+        .zip(&values)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    assert!(worst <= bound, "{worst} > {bound}");
+}

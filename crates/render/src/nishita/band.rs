@@ -71,6 +71,9 @@ pub struct Piece {
     pub facing: Facing,
     /// The pixel row it lies in.
     pub row: u32,
+    /// The strip it lies in: `k` for the strip between the band's row lines `k` and
+    /// `k + 1` (the pixel row with one sub-scanline).
+    pub strip: u32,
 }
 
 /// What a band did.
@@ -553,7 +556,15 @@ pub fn band_pieces(
                 if part.len() < 3 {
                     continue;
                 }
-                emit_part(part, c, patch, *f, top + k / params.subscan, out, stats);
+                emit_part(
+                    part,
+                    c,
+                    patch,
+                    *f,
+                    (top + k / params.subscan, k),
+                    out,
+                    stats,
+                );
             }
         }
     }
@@ -566,7 +577,7 @@ fn emit_part(
     c: &Cell,
     patch: &Patch,
     facing: Facing,
-    row: u32,
+    (row, strip): (u32, u32),
     out: &mut Vec<Piece>,
     stats: &mut BandStats,
 ) {
@@ -585,6 +596,7 @@ fn emit_part(
                     patch: c.patch,
                     facing,
                     row,
+                    strip,
                 });
                 stats.triangles += 1;
             }

@@ -1,0 +1,233 @@
+//! Visibility band by band: a piece lies within one row strip of its band, so pieces of
+//! different bands can hide nothing of one another (their overlaps have no area), and
+//! the exact visible fragments of the frame are those of each band's pieces resolved
+//! alone — and, within a band, those of each strip between two row lines alone. Each
+//! band's pieces are made, resolved strip by strip with
+//! [`cwisim_world::visibility::exact_fragments`] and dropped before the next: memory
+//! holds one band's pieces per thread (the paper's active subpatches), not the frame's.
+//!
+//! Bands are taken by `threads` workers, one at a time, and joined in band order: the
+//! fragments, counts and statistics are the same bit for bit at any thread count.
+
+use super::{check_budget, PatchScene, Pieces};
+use crate::error::RenderError;
+use crate::settings::Settings;
+use cwisim_scene::Polygon;
+use cwisim_world::face::ScreenTriangle;
+use cwisim_world::visibility::{exact_fragments, VisibilityStats};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+
+/// What resolving one band made.
+#[derive(Default)]
+struct Band {
+    /// Its visible fragments, in order.
+    polygons: Vec<Polygon>,
+    /// Each fragment's source, an index into `triangles` (kept for Phong only).
+    sources: Vec<usize>,
+    /// Each fragment's patch: `mesh << 32 | patch`.
+    groups: Vec<u64>,
+    /// Each fragment's pixel row (its strip's).
+    rows: Vec<u32>,
+    /// The band's triangles that some fragment is part of (Phong only; empty otherwise).
+    triangles: Vec<ScreenTriangle>,
+    /// How many triangles the band had.
+    count: usize,
+    /// Its pieces' figures (the triangles dropped unless kept).
+    pieces: Pieces,
+    /// What visibility did.
+    stats: VisibilityStats,
+    /// Host time of its visibility.
+    time: Duration,
+}
+
+/// The frame, resolved band by band.
+pub struct Resolved {
+    /// The visible fragments, band by band.
+    pub polygons: Vec<Polygon>,
+    /// Phong: each fragment's source in `triangles`.
+    pub sources: Vec<usize>,
+    /// Each fragment's patch: `mesh << 32 | patch`.
+    pub groups: Vec<u64>,
+    /// Each fragment's pixel row (its strip's): it lies in that row, within rounding.
+    pub rows: Vec<u32>,
+    /// Phong: every band's triangles that some fragment is part of, in order.
+    pub triangles: Vec<ScreenTriangle>,
+    /// All triangles.
+    pub count: u64,
+    /// The pieces' figures (without the triangles).
+    pub pieces: Pieces,
+    /// What visibility did, summed band by band.
+    pub stats: VisibilityStats,
+    /// Host time of visibility, summed over the bands (over threads).
+    pub time: Duration,
+}
+
+/// Adds `o` to `s`.
+fn merge(s: &mut VisibilityStats, o: &VisibilityStats) {
+    s.triangles += o.triangles;
+    s.occluding_pairs += o.occluding_pairs;
+    s.hidden += o.hidden;
+    s.fragments += o.fragments;
+    s.copies_hidden += o.copies_hidden;
+    s.candidates_skipped += o.candidates_skipped;
+    s.hole_cuts += o.hole_cuts;
+    s.dropped_slivers += o.dropped_slivers;
+    s.dropped_area += o.dropped_area;
+}
+
+/// One band made and resolved. `made` counts the pieces of every band made so far (on
+/// any thread): the frame's fragments grow with them, so the memory budget is checked
+/// against that count, as when the frame's pieces were all held at once.
+fn one_band(
+    scene: &PatchScene,
+    top: u32,
+    rows: u32,
+    settings: &Settings,
+    keep: bool,
+    made: &AtomicUsize,
+) -> Result<Band, RenderError> {
+    let mut pieces = Pieces::default();
+    scene.band(top, rows, &mut pieces)?;
+    let budget = cwisim_scene::budget::Budget::current();
+    let n = pieces.triangles.len();
+    let so_far = made.fetch_add(n, Ordering::Relaxed) + n;
+    check_budget(&budget, so_far, top + rows, settings)?;
+    let start = Instant::now();
+    // strip by strip, each strip's pieces in the order they were made (a stable sort)
+    let mut keyed: Vec<(u32, ScreenTriangle)> = std::mem::take(&mut pieces.strip)
+        .into_iter()
+        .zip(std::mem::take(&mut pieces.triangles))
+        .collect();
+    keyed.sort_by_key(|(k, _)| *k);
+    let (strips, triangles): (Vec<u32>, Vec<ScreenTriangle>) = keyed.into_iter().unzip();
+    let mut band = Band {
+        count: triangles.len(),
+        ..Band::default()
+    };
+    let mut a = 0;
+    while a < triangles.len() {
+        let b = a + strips[a..].partition_point(|&k| k == strips[a]);
+        let (fragments, stats) = exact_fragments(&triangles[a..b], scene.channels());
+        merge(&mut band.stats, &stats);
+        for f in fragments {
+            let t = &triangles[a + f.source];
+            band.groups
+                .push(u64::from(t.mesh) << 32 | u64::from(t.face));
+            band.rows.push(top + strips[a] / settings.subscan);
+            if keep {
+                band.sources.push(a + f.source);
+            }
+            band.polygons.push(f.polygon);
+        }
+        a = b;
+    }
+    band.time = start.elapsed();
+    if keep {
+        // only the triangles some fragment is part of (the others are wholly hidden:
+        // more than half of them on the teapot), the sources renumbered in order
+        let mut index = vec![usize::MAX; triangles.len()];
+        for s in &mut band.sources {
+            if index[*s] == usize::MAX {
+                index[*s] = band.triangles.len();
+                band.triangles.push(triangles[*s]);
+            }
+            *s = index[*s];
+        }
+    }
+    pieces.facing = Vec::new();
+    pieces.origin = Vec::new();
+    band.pieces = pieces;
+    Ok(band)
+}
+
+/// Every band of `scene` made and resolved, on `settings.threads` threads (0: one per
+/// core); `keep`: keep the triangles and each fragment's source (Phong).
+pub fn resolve(
+    scene: &PatchScene,
+    settings: &Settings,
+    keep: bool,
+) -> Result<Resolved, RenderError> {
+    let bands = scene.bands(settings.band);
+    let threads = match settings.threads {
+        0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
+        n => n,
+    }
+    .clamp(1, bands.len().max(1));
+    let made = AtomicUsize::new(0);
+    let done: Vec<Result<Band, RenderError>> = if threads == 1 {
+        let mut out = Vec::with_capacity(bands.len());
+        for &(top, rows) in &bands {
+            let r = one_band(scene, top, rows, settings, keep, &made);
+            let failed = r.is_err();
+            out.push(r);
+            if failed {
+                break;
+            }
+        }
+        out
+    } else {
+        let next = AtomicUsize::new(0);
+        let failed = AtomicBool::new(false);
+        let slots: Vec<Mutex<Option<Result<Band, RenderError>>>> =
+            bands.iter().map(|_| Mutex::new(None)).collect();
+        std::thread::scope(|s| {
+            for _ in 0..threads {
+                s.spawn(|| loop {
+                    if failed.load(Ordering::Relaxed) {
+                        break;
+                    }
+                    let b = next.fetch_add(1, Ordering::Relaxed);
+                    let Some(&(top, rows)) = bands.get(b) else {
+                        break;
+                    };
+                    let r = one_band(scene, top, rows, settings, keep, &made);
+                    if r.is_err() {
+                        // later bands are not needed: the first error in band order wins
+                        failed.store(true, Ordering::Relaxed);
+                    }
+                    *slots[b].lock().unwrap_or_else(|e| e.into_inner()) = Some(r);
+                });
+            }
+        });
+        let mut out = Vec::with_capacity(bands.len());
+        for slot in slots {
+            match slot.into_inner().unwrap_or_else(|e| e.into_inner()) {
+                Some(r) => out.push(r),
+                // a band no worker reached: an earlier one failed
+                None => break,
+            }
+        }
+        out
+    };
+    let mut out = Resolved {
+        polygons: Vec::new(),
+        sources: Vec::new(),
+        groups: Vec::new(),
+        rows: Vec::new(),
+        triangles: Vec::new(),
+        count: 0,
+        pieces: Pieces {
+            patches: scene.patches(),
+            ..Pieces::default()
+        },
+        stats: VisibilityStats::default(),
+        time: Duration::ZERO,
+    };
+    for band in done {
+        let band = band?;
+        let base = out.triangles.len();
+        out.polygons.extend(band.polygons);
+        out.sources.extend(band.sources.iter().map(|s| s + base));
+        out.groups.extend(band.groups);
+        out.rows.extend(band.rows);
+        out.triangles.extend(band.triangles);
+        out.count += band.count as u64;
+        out.pieces.stats.merge(&band.pieces.stats);
+        out.pieces.bands += band.pieces.bands;
+        merge(&mut out.stats, &band.stats);
+        out.time += band.time;
+    }
+    Ok(out)
+}
