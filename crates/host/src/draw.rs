@@ -233,6 +233,8 @@ pub struct DrawArgs {
     pub size: Option<Size>,
     /// With --shading phong: how far (in intensity) the span fitter's Eval1/Eval2/Eval3
     /// pieces may stray from the per-pixel Phong value. 0 sends one Eval1 per pixel.
+    /// nishita under the box filter fits a patch's row as one span with either shading:
+    /// within this with Phong, within an eighth of it with Gouraud.
     #[arg(long, value_name = "E", default_value_t = 1.0 / 512.0)]
     pub shade_tolerance: f64,
     /// Tessellate the scene's Bézier meshes N×N quads per patch (1 to 64) instead of as

@@ -164,8 +164,9 @@ fn a_flag_the_other_flags_or_the_scene_leave_idle_is_refused() {
     for (args, message) in [
         (
             &["--shade-tolerance", "0"][..],
-            "--shade-tolerance is the span fitter's, used with --shading phong only",
+            "--shade-tolerance is the span fitter's, used with --shading phong only (and by nishita under the box filter)",
         ),
+
         (
             &["--eval0-tolerance", "0"],
             "--eval0-tolerance is used with --visibility eval0 and --shading gouraud only (a flat claim is one value)",
@@ -210,7 +211,37 @@ fn a_flag_the_other_flags_or_the_scene_leave_idle_is_refused() {
             ),
         );
     }
+    // nishita fits a patch's row as one span under the box filter, whatever the
+    // shading: --shade-tolerance is refused only under point sampling
+    let nishita = [
+        "render",
+        "teapot",
+        "-o",
+        "x.png",
+        "--renderer",
+        "nishita",
+        "--size",
+        "24x24",
+    ];
+    refused(
+        &dir,
+        &[&nishita[..], &["--aa", "none", "--shade-tolerance", "0"]].concat(),
+        "--shade-tolerance is the span fitter's, used with --shading phong only (and by nishita under the box filter)",
+    );
     assert!(!dir.join("x.png").exists());
+    let coarse = cwisim_ok(
+        &dir,
+        &[&nishita[..], &["--shade-tolerance", "0.05"]].concat(),
+    );
+    let exact = cwisim_ok(&dir, &[&nishita[..], &["--shade-tolerance", "0"]].concat());
+    let count = |out: &str| -> u64 {
+        let line = out
+            .lines()
+            .find(|l| l.starts_with("instructions"))
+            .expect(out);
+        line.split_whitespace().nth(1).unwrap().parse().unwrap()
+    };
+    assert!(count(&coarse) < count(&exact), "{coarse}\n{exact}");
 }
 
 #[test]

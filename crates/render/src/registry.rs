@@ -28,6 +28,10 @@ pub struct Entry {
     /// It draws several frames, each refining the previous one's output (`refine`):
     /// `tradeoff`, which measures one frame against the exact image, leaves it out.
     pub progressive: bool,
+    /// Under the box filter it sends every row through the span fitter whatever the
+    /// shading (`nishita`: a patch's row as one span), so `--shade-tolerance` applies to
+    /// Gouraud and flat shading too, not to Phong alone.
+    pub fits_rows: bool,
     /// The settings it reads (its module reads them in `build`); the command line
     /// refuses a flag given for any other.
     pub uses: &'static [Setting],
@@ -57,8 +61,9 @@ impl Entry {
                     flag = s.flag()
                 ));
             }
+            let fitted = s == Setting::ShadeTolerance && self.fits_rows && settings.aa.is_box();
             match s.idle_under(settings) {
-                Some((by, why)) if self.uses.contains(&by) => return Err(why),
+                Some((by, why)) if self.uses.contains(&by) && !fitted => return Err(why),
                 _ => {}
             }
         }
@@ -110,6 +115,7 @@ pub const REGISTRY: &[Entry] = &[
         supersampled: false,
         patches: false,
         progressive: false,
+        fits_rows: false,
         uses: &[
             Setting::Shading,
             Setting::Aa,
@@ -128,6 +134,7 @@ pub const REGISTRY: &[Entry] = &[
         supersampled: true,
         patches: false,
         progressive: false,
+        fits_rows: false,
         uses: &[
             Setting::Shading,
             Setting::Size,
@@ -149,6 +156,7 @@ pub const REGISTRY: &[Entry] = &[
         supersampled: true,
         patches: false,
         progressive: false,
+        fits_rows: false,
         uses: &[
             Setting::Shading,
             Setting::Size,
@@ -169,6 +177,7 @@ pub const REGISTRY: &[Entry] = &[
         supersampled: true,
         patches: false,
         progressive: false,
+        fits_rows: false,
         uses: &[
             Setting::Shading,
             Setting::Size,
@@ -190,6 +199,7 @@ pub const REGISTRY: &[Entry] = &[
         supersampled: false,
         patches: true,
         progressive: false,
+        fits_rows: true,
         uses: &[
             Setting::Shading,
             Setting::Aa,
@@ -209,6 +219,7 @@ pub const REGISTRY: &[Entry] = &[
         supersampled: false,
         patches: false,
         progressive: true,
+        fits_rows: false,
         uses: &[
             Setting::Size,
             Setting::ShadeTolerance,
@@ -286,6 +297,14 @@ mod tests {
             find("refine").unwrap().check_given(&gouraud, &settings),
             Ok(())
         );
+        // nishita fits a patch's row as one span under the box filter, whatever the shading
+        let nishita = find("nishita").unwrap();
+        assert_eq!(nishita.check_given(&gouraud, &settings), Ok(()));
+        let point = Settings {
+            aa: cwisim_scene::Antialias::None,
+            ..Settings::default()
+        };
+        assert!(nishita.check_given(&gouraud, &point).is_err());
         let pot = crate::Source::resolve(None)
             .unwrap()
             .load(None)

@@ -249,7 +249,7 @@ impl Setting {
         match self {
             Setting::ShadeTolerance if s.shading != Shading::Phong => why(
                 Setting::Shading,
-                "--shade-tolerance is the span fitter's, used with --shading phong only",
+                "--shade-tolerance is the span fitter's, used with --shading phong only (and by nishita under the box filter)",
             ),
             Setting::Eval0Tolerance
                 if !(s.visibility == Visibility::Eval0 && s.shading == Shading::Gouraud) =>
