@@ -412,3 +412,44 @@ fn a_patchs_row_is_one_span_within_its_tolerance_and_no_scanline_is_late() {
         .fold(0.0, f64::max);
     assert!(worst <= bound, "{worst} > {bound}");
 }
+
+/// `nishita` does not read `--visibility` (its registry entry does not list it): a
+/// library user's `Visibility::Eval0` draws exactly what `Exact` draws — the same stream,
+/// the same image — with either shading, rather than a whole-frame pass of Eval0 claims
+/// over pieces at most a row high.
+#[test]
+fn visibility_is_not_read() {
+    use cwisim_world::Visibility;
+    assert!(!registry::find("nishita")
+        .unwrap()
+        .uses
+        .contains(&cwisim_render::settings::Setting::Visibility));
+    let lit = || LoadedScene::built("teapot", AnyScene::World(teapot(32)));
+    for shading in [Shading::Gouraud, Shading::Phong] {
+        let drawn = |visibility| {
+            let settings = Settings {
+                shading,
+                visibility,
+                ..Settings::default()
+            };
+            let r = (registry::find("nishita").unwrap().build)(lit(), &settings).unwrap();
+            let mut stream: Vec<cwisim_isa::Instruction> = Vec::new();
+            cwisim_render::emit(&*r, &mut stream).unwrap();
+            (stream, image_of("nishita", lit(), &settings, 1))
+        };
+        let (exact_stream, exact_image) = drawn(Visibility::Exact);
+        let (eval0_stream, eval0_image) = drawn(Visibility::Eval0);
+        assert!(!exact_stream.is_empty());
+        assert!(
+            eval0_stream == exact_stream,
+            "{shading:?}: {} instructions with eval0, {} with exact",
+            eval0_stream.len(),
+            exact_stream.len()
+        );
+        assert_eq!(
+            eval0_image.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+            exact_image.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+            "{shading:?}"
+        );
+    }
+}

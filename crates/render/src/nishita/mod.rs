@@ -338,7 +338,14 @@ pub struct Nishita {
 
 impl Nishita {
     /// The renderer of `loaded` under `settings`.
+    /// `settings.visibility` is not read (the registry's entry does not list it): the
+    /// pieces are at most a row high, so no `Eval0` claim could cover a pixel, and
+    /// visibility is always exact.
     pub fn new(loaded: LoadedScene, settings: &Settings) -> Result<Nishita, RenderError> {
+        let settings = &Settings {
+            visibility: Visibility::Exact,
+            ..*settings
+        };
         let loaded = loaded.drawn_as(settings)?;
         settings.check().map_err(RenderError::Usage)?;
         let AnyScene::World(w) = &loaded.scene else {
@@ -364,12 +371,6 @@ impl Nishita {
             }
         }
         let phong = settings.shading == Shading::Phong;
-        if phong && settings.visibility != Visibility::Exact {
-            return Err(RenderError::Usage(
-                "Phong shading is drawn on exact visible surfaces only: use --visibility exact"
-                    .into(),
-            ));
-        }
         let w = w.clone();
         // meshes that are not patches: projected as vanrij projects them
         let others: Vec<usize> = (0..w.spec.meshes.len())
@@ -380,7 +381,6 @@ impl Nishita {
         let mut groups = None;
         let (made, count, polygons, vis, surfaces, geometry_time, visibility_time) = if others
             .is_empty()
-            && settings.visibility == Visibility::Exact
         {
             // only patches, exact visibility: band by band (`resolve`)
             let start = Instant::now();
