@@ -11,6 +11,7 @@
 //! the array.
 
 use crate::error::StudyError;
+use cwisim_render::settings::Setting as Flag;
 use cwisim_render::{
     registry, render, ArrayConfig, PolygonScene, Renderer, Settings, Size, Source, Taps,
 };
@@ -41,12 +42,13 @@ pub struct Row {
     pub renderer: &'static str,
     /// `flat`, `gouraud` or `phong`.
     pub shading: &'static str,
-    /// `none`, `box` (exact) or `box-centre` (the report's coverage × centre value);
-    /// `-` for a supersampling renderer.
+    /// `none`, `box` (exact) or `box-centre` (the report's coverage × centre value, Phong's
+    /// box filter); `-` for a renderer that does not read `--aa` (a supersampling one).
     pub aa: &'static str,
     /// Samples per pixel side of a supersampling renderer (its grid is `l × l`).
     pub samples: Option<u32>,
-    /// `exact`, `eval0`, or `-` (screen scenes).
+    /// `exact`, `eval0`, or `-` (screen scenes, and renderers that do not read
+    /// `--visibility`: the supersampling ones and `nishita`, which resolve it themselves).
     pub visibility: &'static str,
     /// Quads per Bézier patch side (scenes with Bézier meshes, when the grid varies it).
     pub tessellate: Option<u32>,
@@ -102,10 +104,12 @@ impl Setting {
         let mut words = vec![self.renderer.name.to_string(), s.shading.name().to_string()];
         if self.renderer.supersampled {
             words.push(format!("{}×{} samples", s.samples, s.samples));
-        } else {
+        } else if reads(self, Flag::Aa) {
             words.push(s.aa.name().to_string());
         }
-        words.push(s.visibility.name().to_string());
+        if reads(self, Flag::Visibility) {
+            words.push(s.visibility.name().to_string());
+        }
         if let Some(n) = s.tessellate {
             words.push(format!("tessellate {n}"));
         }
@@ -138,9 +142,11 @@ pub const ROOT_TOLERANCE_AXIS: [f64; 3] = [1e-3, 1e-5, 1e-7];
 
 /// The settings of the grid, in order: renderer, tessellation (scenes with Bézier
 /// meshes), visibility (world scenes), shading (Phong on world scenes with exact
-/// visibility), anti-aliasing (`box`, `box-centre` with Gouraud shading, `none`) and numeric
-/// format. A supersampling renderer resolves visibility itself and samples instead of
-/// filtering: its axis is [`SAMPLES_AXIS`].
+/// visibility), anti-aliasing (`box`, `box-centre` with Gouraud shading, `none`; Phong's
+/// box filter is `box-centre` alone, [`box_filter`]) and numeric format. A supersampling
+/// renderer resolves visibility itself and samples instead of filtering: its axis is
+/// [`SAMPLES_AXIS`]. Each setting is what `cwisim render` accepts with the flags its row
+/// prints.
 pub fn grid(
     renderers: &[&'static registry::Entry],
     axes: &Axes,
@@ -163,8 +169,9 @@ pub fn grid(
             continue;
         }
         if renderer.patches {
-            // patches drawn directly: no tessellation, exact visibility, smooth shading;
-            // the root tolerance is its axis
+            // patches drawn directly: no tessellation, exact visibility (it reads no
+            // other), smooth shading, the box filter (Phong's: `box-centre`); the root
+            // tolerance is its axis
             for tolerance in ROOT_TOLERANCE_AXIS {
                 for shading in [Shading::Phong, Shading::Gouraud] {
                     for numeric in formats {
@@ -172,6 +179,7 @@ pub fn grid(
                             renderer,
                             settings: Settings {
                                 shading,
+                                aa: box_filter(shading),
                                 size: axes.size,
                                 root_tolerance: tolerance,
                                 ..Settings::default()
@@ -215,12 +223,14 @@ pub fn grid(
                     {
                         continue;
                     }
-                    for aa in [Antialias::Box, Antialias::BoxCentre, Antialias::None] {
-                        // the report's box filter differs from the exact one only where
-                        // the intensity varies over a polygon: Gouraud
-                        if aa == Antialias::BoxCentre && shading != Shading::Gouraud {
-                            continue;
-                        }
+                    // the report's box filter differs from the exact one only where
+                    // the intensity varies over a polygon: Gouraud; Phong's box filter is
+                    // the report's alone (`--aa box` is refused with Phong)
+                    let filters: &[Antialias] = match shading {
+                        Shading::Gouraud => &[Antialias::Box, Antialias::BoxCentre],
+                        _ => &[box_filter(shading)],
+                    };
+                    for &aa in filters.iter().chain(&[Antialias::None]) {
                         for numeric in formats {
                             out.push(Setting {
                                 renderer,
@@ -241,6 +251,16 @@ pub fn grid(
         }
     }
     out
+}
+
+/// The box filter a shading is drawn with in the grid, as `cwisim render --aa` names
+/// it: Phong's is the report's, coverage × the shade at the pixel centre (`box-centre`;
+/// `--aa box` is refused with Phong), any other shading's the exact one (`box`).
+pub fn box_filter(shading: Shading) -> Antialias {
+    match shading {
+        Shading::Phong => Antialias::BoxCentre,
+        _ => Antialias::Box,
+    }
 }
 
 /// A format as the table shows it: the canonical form without the defaults (an
@@ -317,14 +337,14 @@ pub fn exact_image(scene: Option<&Path>, size: Option<Size>) -> Result<Vec<f64>,
 /// The reference a setting is measured against, for its geometry (size, tessellation):
 /// for flat and Gouraud shading the exact box-filtered Gouraud image of the exact visible
 /// surfaces (`cwisim_ypipe::exact`, independent of the renderers and the array); for
-/// Phong, Phong's own best image — box filter, span tolerance 0 (the per-pixel value at
-/// every centre a triangle covers whole), `f64` registers — so that a Phong row's error
-/// is what its span tolerance, point sampling and register format add.
+/// Phong, Phong's own best image — its box filter (`box-centre`), span tolerance 0 (the
+/// per-pixel value at every centre a triangle covers whole), `f64` registers — so that a
+/// Phong row's error is what its span tolerance, point sampling and register format add.
 pub fn reference_image(scene: Option<&Path>, setting: &Settings) -> Result<Vec<f64>, StudyError> {
     let loaded = Source::resolve(scene)?.load_for(setting)?;
     if setting.shading == Shading::Phong {
         let best = Settings {
-            aa: Antialias::Box,
+            aa: box_filter(Shading::Phong),
             visibility: Visibility::Exact,
             shade_tolerance: 0.0,
             ..*setting
@@ -697,6 +717,13 @@ pub fn measure_stream(
     Ok(out)
 }
 
+/// Whether the renderer of `setting` reads `flag`'s setting (the registry's
+/// [`registry::Entry::uses`]): a row shows only those, so that its flags are what
+/// `cwisim render` accepts for it.
+fn reads(setting: &Setting, flag: Flag) -> bool {
+    setting.renderer.uses.contains(&flag)
+}
+
 /// The row of `setting`, measured (its host times, `repeat` of them) against
 /// `reference`; not yet marked Pareto.
 fn row_of(
@@ -716,13 +743,13 @@ fn row_of(
     Row {
         renderer: setting.renderer.name,
         shading: s.shading.name(),
-        aa: if setting.renderer.supersampled {
-            "-"
-        } else {
+        aa: if reads(setting, Flag::Aa) {
             s.aa.name()
+        } else {
+            "-"
         },
         samples: setting.renderer.supersampled.then_some(s.samples),
-        visibility: if world && !setting.renderer.supersampled {
+        visibility: if world && reads(setting, Flag::Visibility) {
             s.visibility.name()
         } else {
             "-"
@@ -906,16 +933,27 @@ mod tests {
         };
         let g = grid(&[vanrij], &world, &f64_only);
         // 2 tessellations × (exact: phong, gouraud, flat; eval0: gouraud, flat) × 2 aa,
-        // and the report's box filter with Gouraud (exact and eval0)
+        // and the report's box filter with Gouraud (exact and eval0); Phong's box filter
+        // is the report's (`box-centre`), its only one
         assert_eq!(g.len(), 2 * (5 * 2 + 2));
         let centre = g.iter().filter(|s| s.settings.aa == Antialias::BoxCentre);
-        assert!(centre
-            .clone()
-            .all(|s| s.settings.shading == Shading::Gouraud));
-        assert_eq!(centre.count(), 2 * 2);
+        assert_eq!(
+            centre
+                .clone()
+                .filter(|s| s.settings.shading == Shading::Gouraud)
+                .count(),
+            2 * 2
+        );
+        assert_eq!(
+            centre
+                .filter(|s| s.settings.shading == Shading::Phong)
+                .count(),
+            2
+        );
         for s in &g {
             let st = &s.settings;
             assert!(st.shading != Shading::Phong || st.visibility == Visibility::Exact);
+            assert!(st.shading != Shading::Phong || st.aa != Antialias::Box);
             assert!(matches!(st.tessellate, Some(4) | Some(8)));
         }
         let screen = Axes::default();
@@ -928,6 +966,151 @@ mod tests {
         assert!(g
             .iter()
             .all(|s| s.settings.shading != Shading::Phong && s.settings.tessellate.is_none()));
+    }
+
+    /// A row of the grid is what `cwisim render` draws with the flags it prints: every
+    /// setting shown (shading, aa, visibility, samples, tessellation, root tolerance) is
+    /// one its renderer reads and the command line accepts for it (`check_given`,
+    /// `check_scene`), and parsed back it is the setting measured. (Phong's box filter
+    /// is printed `box-centre`: `--aa box` is refused with Phong; `nishita` reads no
+    /// `--visibility`.)
+    #[test]
+    fn every_row_is_reproducible_with_the_flags_it_prints() {
+        let entries: Vec<&'static registry::Entry> = registry::REGISTRY
+            .iter()
+            .filter(|e| !e.progressive)
+            .collect();
+        let teapot = Source::resolve(Some("teapot".as_ref()))
+            .unwrap()
+            .load(None)
+            .unwrap()
+            .scene;
+        let pot = Source::resolve(None).unwrap().load(None).unwrap().scene;
+        let fig25 = Source::resolve(Some("fig25".as_ref()))
+            .unwrap()
+            .load(None)
+            .unwrap()
+            .scene;
+        let size = Some(Size {
+            width: 32,
+            height: 24,
+        });
+        let cases = [
+            (
+                "teapot",
+                &teapot,
+                Axes {
+                    world: true,
+                    size,
+                    tessellations: vec![4, 8],
+                    patches: true,
+                },
+            ),
+            (
+                "pot",
+                &pot,
+                Axes {
+                    world: true,
+                    size,
+                    ..Axes::default()
+                },
+            ),
+            (
+                "fig25",
+                &fig25,
+                Axes {
+                    size,
+                    ..Axes::default()
+                },
+            ),
+        ];
+        let measured = Measured {
+            image: Vec::new(),
+            counters: Default::default(),
+            stats: Default::default(),
+            time: Duration::ZERO,
+        };
+        let mut phong = 0;
+        for (name, scene, axes) in cases {
+            let g = grid(&entries, &axes, &[Numeric::F64]);
+            assert!(!g.is_empty(), "{name}");
+            for setting in &g {
+                let row = row_of(setting, &measured, &[], &[], axes.world);
+                let entry = setting.renderer;
+                let what = format!("{name}: {}", setting.describe());
+                // the flags the row prints, parsed back over the defaults
+                let mut given = vec![Flag::Shading, Flag::Size];
+                let mut parsed = Settings {
+                    shading: row.shading.parse().unwrap(),
+                    size: axes.size,
+                    ..Settings::default()
+                };
+                if row.aa != "-" {
+                    given.push(Flag::Aa);
+                    parsed.aa = row.aa.parse().unwrap();
+                }
+                if row.visibility != "-" {
+                    given.push(Flag::Visibility);
+                    parsed.visibility = row.visibility.parse().unwrap();
+                }
+                if let Some(l) = row.samples {
+                    given.push(Flag::Samples);
+                    parsed.samples = l;
+                }
+                if let Some(n) = row.tessellate {
+                    given.push(Flag::Tessellate);
+                    parsed.tessellate = Some(n);
+                }
+                if let Some(t) = row.root_tolerance {
+                    given.push(Flag::RootTolerance);
+                    parsed.root_tolerance = t;
+                }
+                assert_eq!(entry.check_given(&given, &parsed), Ok(()), "{what}");
+                assert_eq!(entry.check_scene(&given, scene, name), Ok(()), "{what}");
+                assert_eq!(parsed, setting.settings, "{what}");
+                if row.shading == "phong" {
+                    phong += 1;
+                    assert_ne!(row.aa, "box", "{what}");
+                }
+            }
+        }
+        assert!(phong > 0);
+    }
+
+    /// Phong's box filter is coverage × the centre's shade whether asked as `box` or
+    /// `box-centre`: the grid's `box-centre` rows draw what its `box` rows drew.
+    #[test]
+    fn phong_draws_box_and_box_centre_alike() {
+        let size = Some(Size {
+            width: 48,
+            height: 40,
+        });
+        let machine = Machine::default();
+        for name in ["vanrij", "nishita"] {
+            let scene = (name == "nishita").then_some(Path::new("teapot"));
+            let measured = |aa| {
+                let setting = Setting {
+                    renderer: registry::find(name).unwrap(),
+                    settings: Settings {
+                        shading: Shading::Phong,
+                        aa,
+                        size,
+                        ..Settings::default()
+                    },
+                    numeric: Numeric::F64,
+                };
+                let m = measure(scene, &setting, &machine).unwrap();
+                (
+                    m.image.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+                    m.counters,
+                    m.stats,
+                )
+            };
+            assert!(
+                measured(Antialias::Box) == measured(Antialias::BoxCentre),
+                "{name}"
+            );
+        }
     }
 
     #[test]
@@ -962,7 +1145,7 @@ mod tests {
         assert_eq!(next, g.len());
         assert_eq!(
             describe_stream(&g[streams[0].clone()]),
-            "vanrij phong box exact (3 formats)"
+            "vanrij phong box-centre exact (3 formats)"
         );
     }
 
