@@ -453,3 +453,42 @@ fn visibility_is_not_read() {
         );
     }
 }
+
+/// The frame's fragments, joined band by band, are held without spare room (each band
+/// joined as soon as it is resolved on one thread, the joined vectors made at their final
+/// size on several), and are the same at any thread count, Gouraud and Phong.
+#[test]
+fn resolved_fragments_are_held_without_spare_room() {
+    use cwisim_render::nishita::resolve::resolve;
+    use cwisim_render::nishita::PatchScene;
+    let w = teapot(64);
+    for keep in [false, true] {
+        let mut polygons = Vec::new();
+        for threads in [1, 3] {
+            let settings = Settings {
+                threads,
+                ..Settings::default()
+            };
+            let scene = PatchScene::new(&w, &settings).unwrap();
+            let r = resolve(&scene, &settings, keep).unwrap();
+            assert!(r.polygons.len() > 100, "{} fragments", r.polygons.len());
+            let room = [
+                ("polygons", r.polygons.capacity() - r.polygons.len()),
+                ("groups", r.groups.capacity() - r.groups.len()),
+                ("rows", r.rows.capacity() - r.rows.len()),
+                ("sources", r.sources.capacity() - r.sources.len()),
+                ("triangles", r.triangles.capacity() - r.triangles.len()),
+            ];
+            assert!(
+                room.iter().all(|(_, n)| *n == 0),
+                "threads {threads}, keep {keep}: spare room {room:?}"
+            );
+            assert_eq!(r.sources.len(), if keep { r.polygons.len() } else { 0 });
+            polygons.push((r.polygons, r.groups, r.rows, r.sources));
+        }
+        assert!(
+            polygons[0] == polygons[1],
+            "keep {keep}: threads 1 and 3 differ"
+        );
+    }
+}

@@ -43,10 +43,11 @@ pub struct MergedFrame<'a> {
     tolerance: f64,
     /// Phong: the triangles, each fragment's source, the lighting.
     phong: Option<&'a PhongSurfaces>,
-    /// For each polygon: the first and last pixel row it may reach (both non-decreasing
-    /// along the polygons, which come band by band and strip by strip), or `None` when
-    /// they are not ordered so (then every band takes every polygon).
-    rows: Option<Vec<(i64, i64)>>,
+    /// For each polygon: its pixel row (non-decreasing along the polygons, which come
+    /// band by band and strip by strip; a fragment may reach one row either side, by
+    /// rounding), or `None` when they are not ordered so (then every band takes every
+    /// polygon).
+    rows: Option<&'a [u32]>,
 }
 
 impl<'a> MergedFrame<'a> {
@@ -55,23 +56,12 @@ impl<'a> MergedFrame<'a> {
     pub fn new(
         screen: &'a ScreenScene,
         groups: &'a [u64],
-        rows: &[u32],
+        rows: &'a [u32],
         value: BoxValue,
         tolerance: f64,
         phong: Option<&'a PhongSurfaces>,
     ) -> MergedFrame<'a> {
-        // a fragment's vertices may stray from its strip by rounding: one row either side
-        let mut rows: Vec<(i64, i64)> = rows
-            .iter()
-            .map(|&r| (i64::from(r) - 1, i64::from(r) + 1))
-            .collect();
-        let ordered = rows
-            .windows(2)
-            .all(|w| w[0].0 <= w[1].0 && w[0].1 <= w[1].1)
-            && rows.len() == screen.polygons.len();
-        if !ordered {
-            rows = Vec::new();
-        }
+        let ordered = rows.windows(2).all(|w| w[0] <= w[1]) && rows.len() == screen.polygons.len();
         MergedFrame {
             screen,
             groups,
@@ -205,14 +195,15 @@ impl MergedFrame<'_> {
         let mut result = Ok(());
         // the active slots: the first `active`
         let mut active = 0;
-        // the trapezia of the polygons reaching these rows only: memory bounded by the
+        // the trapezia of the polygons reaching these rows only (a fragment's vertices
+        // may stray from its strip by rounding: one row either side): memory bounded by the
         // band, not the frame (a polygon keeps its order among them, so a row's
         // trapezia are visited as they would be among the frame's)
         let polygons = match &self.rows {
             Some(r) => {
                 let (start, end) = (i64::from(rows.start), i64::from(rows.end));
-                let first = r.partition_point(|&(_, hi)| hi < start);
-                let last = r.partition_point(|&(lo, _)| lo < end);
+                let first = r.partition_point(|&row| i64::from(row) + 1 < start);
+                let last = r.partition_point(|&row| i64::from(row) - 1 < end);
                 first..last.max(first)
             }
             None => 0..self.screen.polygons.len(),
@@ -232,7 +223,7 @@ impl MergedFrame<'_> {
             Some(r) => trapezia
                 .iter()
                 .filter(|t| {
-                    let row = r[base + t.polygon as usize].0 + 1;
+                    let row = i64::from(r[base + t.polygon as usize]);
                     (i64::from(rows.start)..i64::from(rows.end)).contains(&row)
                 })
                 .count() as u64,

@@ -7,7 +7,11 @@
 //! holds one band's pieces per thread (the paper's active subpatches), not the frame's.
 //!
 //! Bands are taken by `threads` workers, one at a time, and joined in band order: the
-//! fragments, counts and statistics are the same bit for bit at any thread count.
+//! fragments, counts and statistics are the same bit for bit at any thread count. On one
+//! thread each band is joined to the frame's fragments as soon as it is resolved (not all
+//! bands held, then joined); on several, this thread joins them in band order as the
+//! workers resolve them (holding only the bands resolved ahead of their turn). Either way
+//! the joined vectors keep no spare room: the fragments are held until the rows are emitted.
 
 use super::{check_budget, PatchScene, Pieces};
 use crate::error::RenderError;
@@ -16,7 +20,7 @@ use cwisim_scene::Polygon;
 use cwisim_world::face::ScreenTriangle;
 use cwisim_world::visibility::{exact_fragments, VisibilityStats};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::Mutex;
+use std::sync::{Condvar, Mutex};
 use std::time::{Duration, Instant};
 
 /// What resolving one band made.
@@ -119,7 +123,10 @@ fn one_band(
             if keep {
                 band.sources.push(a + f.source);
             }
-            band.polygons.push(f.polygon);
+            let mut polygon = f.polygon;
+            // held until the band's rows are emitted: without the clipper's spare room
+            polygon.vertices.shrink_to_fit();
+            band.polygons.push(polygon);
         }
         a = b;
     }
@@ -156,51 +163,6 @@ pub fn resolve(
     }
     .clamp(1, bands.len().max(1));
     let made = AtomicUsize::new(0);
-    let done: Vec<Result<Band, RenderError>> = if threads == 1 {
-        let mut out = Vec::with_capacity(bands.len());
-        for &(top, rows) in &bands {
-            let r = one_band(scene, top, rows, settings, keep, &made);
-            let failed = r.is_err();
-            out.push(r);
-            if failed {
-                break;
-            }
-        }
-        out
-    } else {
-        let next = AtomicUsize::new(0);
-        let failed = AtomicBool::new(false);
-        let slots: Vec<Mutex<Option<Result<Band, RenderError>>>> =
-            bands.iter().map(|_| Mutex::new(None)).collect();
-        std::thread::scope(|s| {
-            for _ in 0..threads {
-                s.spawn(|| loop {
-                    if failed.load(Ordering::Relaxed) {
-                        break;
-                    }
-                    let b = next.fetch_add(1, Ordering::Relaxed);
-                    let Some(&(top, rows)) = bands.get(b) else {
-                        break;
-                    };
-                    let r = one_band(scene, top, rows, settings, keep, &made);
-                    if r.is_err() {
-                        // later bands are not needed: the first error in band order wins
-                        failed.store(true, Ordering::Relaxed);
-                    }
-                    *slots[b].lock().unwrap_or_else(|e| e.into_inner()) = Some(r);
-                });
-            }
-        });
-        let mut out = Vec::with_capacity(bands.len());
-        for slot in slots {
-            match slot.into_inner().unwrap_or_else(|e| e.into_inner()) {
-                Some(r) => out.push(r),
-                // a band no worker reached: an earlier one failed
-                None => break,
-            }
-        }
-        out
-    };
     let mut out = Resolved {
         polygons: Vec::new(),
         sources: Vec::new(),
@@ -215,19 +177,128 @@ pub fn resolve(
         stats: VisibilityStats::default(),
         time: Duration::ZERO,
     };
-    for band in done {
-        let band = band?;
-        let base = out.triangles.len();
-        out.polygons.extend(band.polygons);
-        out.sources.extend(band.sources.iter().map(|s| s + base));
-        out.groups.extend(band.groups);
-        out.rows.extend(band.rows);
-        out.triangles.extend(band.triangles);
-        out.count += band.count as u64;
-        out.pieces.stats.merge(&band.pieces.stats);
-        out.pieces.bands += band.pieces.bands;
-        merge(&mut out.stats, &band.stats);
-        out.time += band.time;
+    if threads == 1 {
+        // each band joined as soon as it is resolved: one band's fragments are held
+        // twice at a time, not the frame's
+        for &(top, rows) in &bands {
+            join(&mut out, one_band(scene, top, rows, settings, keep, &made)?);
+        }
+        shrink(&mut out);
+        return Ok(out);
     }
+    // workers resolve the bands; this thread joins them in band order as they come, so
+    // that only the bands resolved ahead of their turn are held besides the frame's
+    let next = AtomicUsize::new(0);
+    let failed = AtomicBool::new(false);
+    let shared = Mutex::new(Shared {
+        slots: bands.iter().map(|_| None).collect(),
+        running: threads,
+    });
+    let ready = Condvar::new();
+    let mut error = None;
+    std::thread::scope(|s| {
+        for _ in 0..threads {
+            s.spawn(|| {
+                // told when it ends, even by a panic (then the join stops waiting)
+                let _running = Running {
+                    shared: &shared,
+                    ready: &ready,
+                };
+                loop {
+                    if failed.load(Ordering::Relaxed) {
+                        break;
+                    }
+                    let b = next.fetch_add(1, Ordering::Relaxed);
+                    let Some(&(top, rows)) = bands.get(b) else {
+                        break;
+                    };
+                    let r = one_band(scene, top, rows, settings, keep, &made);
+                    if r.is_err() {
+                        // later bands are not needed: the first error in band order wins
+                        failed.store(true, Ordering::Relaxed);
+                    }
+                    lock(&shared).slots[b] = Some(r);
+                    ready.notify_all();
+                }
+            });
+        }
+        let mut state = lock(&shared);
+        for b in 0..bands.len() {
+            let r = loop {
+                if let Some(r) = state.slots[b].take() {
+                    break Some(r);
+                }
+                if state.running == 0 {
+                    // a band no worker reached (a worker panicked): told by the scope
+                    break None;
+                }
+                state = ready.wait(state).unwrap_or_else(|e| e.into_inner());
+            };
+            match r {
+                Some(Ok(band)) => {
+                    drop(state);
+                    join(&mut out, band);
+                    state = lock(&shared);
+                }
+                Some(Err(e)) => {
+                    failed.store(true, Ordering::Relaxed);
+                    error = Some(e);
+                    break;
+                }
+                None => break,
+            }
+        }
+    });
+    if let Some(e) = error {
+        return Err(e);
+    }
+    shrink(&mut out);
     Ok(out)
+}
+
+/// The bands resolved and not yet joined, and the workers still running.
+struct Shared {
+    slots: Vec<Option<Result<Band, RenderError>>>,
+    running: usize,
+}
+
+fn lock(shared: &Mutex<Shared>) -> std::sync::MutexGuard<'_, Shared> {
+    shared.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// A worker running: when dropped, one fewer, told to the joining thread.
+struct Running<'a> {
+    shared: &'a Mutex<Shared>,
+    ready: &'a Condvar,
+}
+
+impl Drop for Running<'_> {
+    fn drop(&mut self) {
+        lock(self.shared).running -= 1;
+        self.ready.notify_all();
+    }
+}
+
+/// Appends one band's fragments, counts and statistics to `out` (bands in order).
+fn join(out: &mut Resolved, band: Band) {
+    let base = out.triangles.len();
+    out.polygons.extend(band.polygons);
+    out.sources.extend(band.sources.iter().map(|s| s + base));
+    out.groups.extend(band.groups);
+    out.rows.extend(band.rows);
+    out.triangles.extend(band.triangles);
+    out.count += band.count as u64;
+    out.pieces.stats.merge(&band.pieces.stats);
+    out.pieces.bands += band.pieces.bands;
+    merge(&mut out.stats, &band.stats);
+    out.time += band.time;
+}
+
+/// `out`'s vectors without their spare capacity (grown band by band).
+fn shrink(out: &mut Resolved) {
+    out.polygons.shrink_to_fit();
+    out.sources.shrink_to_fit();
+    out.groups.shrink_to_fit();
+    out.rows.shrink_to_fit();
+    out.triangles.shrink_to_fit();
 }
