@@ -4,10 +4,13 @@
 //! `tests/fuzz.rs`): byte-level mutations (flip, truncate, splice, duplicate) and
 //! structure-aware ones for text and JSON (a number replaced by an extreme, a key deleted
 //! or repeated, a value wrapped in `[]`), the extreme numbers, and the time bound and
-//! proptest configuration every reader is held to. A test-only crate: nothing of cwisim
-//! depends on it but those tests.
+//! proptest configuration every reader is held to; and [`heap`], the counting allocator
+//! of the tests that measure a peak heap. A test-only crate: nothing of cwisim depends on
+//! it but tests.
 
 #![warn(missing_docs)]
+
+pub mod heap;
 
 use proptest::prelude::*;
 use std::time::Duration;

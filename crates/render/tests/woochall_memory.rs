@@ -3,36 +3,11 @@
 //! rows' state, the bands of scanlines), not with its area. (One test in this binary: the
 //! counting allocator sees every thread's allocations.)
 
+use cwisim_fuzzing::heap::Counting;
 use cwisim_render::{registry, render, ArrayConfig, LoadedScene, Settings, Taps};
 use cwisim_world::embedded::embedded;
 use cwisim_world::parse_any;
 use cwisim_xproc::NullSink;
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
-
-/// The system allocator, counting the bytes live and their peak.
-struct Counting;
-
-static LIVE: AtomicUsize = AtomicUsize::new(0);
-static PEAK: AtomicUsize = AtomicUsize::new(0);
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        // SAFETY: forwarded to the system allocator with the caller's layout.
-        let p = unsafe { System.alloc(layout) };
-        if !p.is_null() {
-            let now = LIVE.fetch_add(layout.size(), Ordering::Relaxed) + layout.size();
-            PEAK.fetch_max(now, Ordering::Relaxed);
-        }
-        p
-    }
-
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: `ptr` came from `alloc` with this layout.
-        unsafe { System.dealloc(ptr, layout) };
-        LIVE.fetch_sub(layout.size(), Ordering::Relaxed);
-    }
-}
 
 #[global_allocator]
 static ALLOCATOR: Counting = Counting;
@@ -51,17 +26,16 @@ fn peak_heap(side: u32) -> (usize, u64) {
     let r =
         (registry::find("woo-chall").unwrap().build)(LoadedScene::built("pot", scene), &settings)
             .unwrap();
-    let base = LIVE.load(Ordering::Relaxed);
-    PEAK.store(base, Ordering::Relaxed);
-    let done = render(
-        &*r,
-        &ArrayConfig::default(),
-        1,
-        &mut NullSink,
-        Taps::default(),
-    )
-    .unwrap();
-    let peak = PEAK.load(Ordering::Relaxed).saturating_sub(base);
+    let (done, peak) = cwisim_fuzzing::heap::peak_heap(|| {
+        render(
+            &*r,
+            &ArrayConfig::default(),
+            1,
+            &mut NullSink,
+            Taps::default(),
+        )
+        .unwrap()
+    });
     (peak, done.counters.get("instructions").unwrap())
 }
 

@@ -1,46 +1,13 @@
 //! The pot drawn as several layers of one surface: the depth-complexity scenes of
-//! `tests/depth_complexity.rs` and `examples/depth_complexity.rs`, and the counting
-//! allocator both measure the peak heap with (each binary that includes this module
-//! allocates through it).
+//! `tests/depth_complexity.rs` and `examples/depth_complexity.rs`, and the peak heap they
+//! measure (each binary that includes this module allocates through
+//! `cwisim_fuzzing::heap::Counting`).
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
-
-/// The system allocator, counting the bytes live and their peak.
-pub struct Counting;
-
-static LIVE: AtomicUsize = AtomicUsize::new(0);
-static PEAK: AtomicUsize = AtomicUsize::new(0);
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        // SAFETY: forwarded to the system allocator with the caller's layout.
-        let p = unsafe { System.alloc(layout) };
-        if !p.is_null() {
-            let now = LIVE.fetch_add(layout.size(), Ordering::Relaxed) + layout.size();
-            PEAK.fetch_max(now, Ordering::Relaxed);
-        }
-        p
-    }
-
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: `ptr` came from `alloc` with this layout.
-        unsafe { System.dealloc(ptr, layout) };
-        LIVE.fetch_sub(layout.size(), Ordering::Relaxed);
-    }
-}
+pub use cwisim_fuzzing::heap::peak_heap;
+use cwisim_fuzzing::heap::Counting;
 
 #[global_allocator]
 static ALLOCATOR: Counting = Counting;
-
-/// What `f` returns, and the most heap it held at once beyond what was live before
-/// (bytes). Measurements on several threads at once see each other's allocations.
-pub fn peak_heap<R>(f: impl FnOnce() -> R) -> (R, usize) {
-    let base = LIVE.load(Ordering::Relaxed);
-    PEAK.store(base, Ordering::Relaxed);
-    let r = f();
-    (r, PEAK.load(Ordering::Relaxed).saturating_sub(base))
-}
 
 /// The pot's profile (`crates/world/scenes/pot.json`).
 const PROFILE: [[f64; 2]; 16] = [
