@@ -86,10 +86,7 @@ pub fn render(
     lines: &mut dyn LineSink<f64>,
     taps: Taps<'_>,
 ) -> Result<Rendered, RenderError> {
-    let threads = match threads {
-        0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
-        n => n,
-    };
+    let threads = cwisim_scene::budget::resolve_threads(threads);
     renderer
         .check_numeric(&array.numeric)
         .map_err(RenderError::Usage)?;

@@ -147,10 +147,24 @@ impl Budget {
     }
 }
 
+/// This machine's cores (1 if it cannot tell).
+fn cores() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
+/// The thread count `--threads N` stands for: `N`, or one per core for 0 (its meaning in
+/// every command and library call that takes a thread count).
+pub fn resolve_threads(threads: usize) -> usize {
+    match threads {
+        0 => cores(),
+        n => n,
+    }
+}
+
 /// The most threads a command may start on this machine: [`THREADS_PER_CORE`] × its
 /// cores.
 pub fn max_threads() -> usize {
-    THREADS_PER_CORE * std::thread::available_parallelism().map_or(1, |n| n.get())
+    THREADS_PER_CORE * cores()
 }
 
 /// `threads` if a command may start that many ([`max_threads`]; 0 means one per core),

@@ -91,7 +91,7 @@ impl<'a> Bench<'a> {
     /// replays, at any count: candidates tried one after another until one holds are
     /// replayed a batch at a time, and those after the first that holds are not counted.
     pub fn threads(mut self, threads: usize) -> Self {
-        self.threads = crate::parallel::resolve_threads(threads);
+        self.threads = cwisim_scene::budget::resolve_threads(threads);
         self
     }
 

@@ -539,11 +539,7 @@ impl Blobs {
     /// and puts each in its placeholder's place in `data`.
     fn fill(self, data: &mut Value, threads: usize) {
         let raw = self.0.into_inner();
-        let threads = match threads {
-            0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
-            n => n,
-        }
-        .clamp(1, raw.len().max(1));
+        let threads = cwisim_scene::budget::resolve_threads(threads).clamp(1, raw.len().max(1));
         let mut order: Vec<usize> = (0..raw.len()).collect();
         order.sort_by_key(|&k| std::cmp::Reverse(raw[k].len()));
         let mut done: Vec<Option<String>> = vec![None; raw.len()];

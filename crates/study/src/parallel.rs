@@ -5,15 +5,6 @@
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::mpsc;
 
-/// The thread count `threads` stands for: itself, or one per core for 0 (as `--threads`
-/// says everywhere).
-pub fn resolve_threads(threads: usize) -> usize {
-    match threads {
-        0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
-        n => n,
-    }
-}
-
 /// What [`ordered`] tells the calling thread as the jobs go.
 pub enum Event<R> {
     /// Job `index` was started (on some worker).
@@ -35,7 +26,7 @@ pub fn ordered<R: Send, E: Send>(
     job: impl Fn(usize) -> Result<R, E> + Sync,
     mut report: impl FnMut(Event<R>),
 ) -> Result<(), E> {
-    let threads = resolve_threads(threads).min(count.max(1));
+    let threads = cwisim_scene::budget::resolve_threads(threads).min(count.max(1));
     if threads <= 1 {
         for k in 0..count {
             report(Event::Started(k));

@@ -221,10 +221,7 @@ pub fn exact_fragments_on(
         channels <= MAX_CHANNELS,
         "{channels} channels; an intensity vector holds at most {MAX_CHANNELS}"
     );
-    let threads = match threads {
-        0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
-        n => n,
-    };
+    let threads = cwisim_scene::budget::resolve_threads(threads);
     let usable: Vec<bool> = tris.iter().map(drawable).collect();
     let planes: Vec<Plane> = tris.iter().map(Plane::of).collect();
     let grid = grid_for(

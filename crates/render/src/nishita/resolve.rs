@@ -157,11 +157,8 @@ pub fn resolve(
     keep: bool,
 ) -> Result<Resolved, RenderError> {
     let bands = scene.bands(settings.band);
-    let threads = match settings.threads {
-        0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
-        n => n,
-    }
-    .clamp(1, bands.len().max(1));
+    let threads =
+        cwisim_scene::budget::resolve_threads(settings.threads).clamp(1, bands.len().max(1));
     let made = AtomicUsize::new(0);
     let mut out = Resolved {
         polygons: Vec::new(),
