@@ -8,44 +8,11 @@
 
 mod common;
 
-use cwisim_isa::{Instruction, Location, Opcode, TraceError, TraceHeader, TraceRead};
-use cwisim_xproc::stepped::SteppedEngine;
+use cwisim_isa::{Instruction, Opcode, TraceHeader};
 use cwisim_xproc::{
-    replay_probed_numeric, replay_visits_numeric, Arith, Engine, F32Arith, FixedArith, Image,
-    ImageSink, Machine, Native, Numeric, Probe, ProcessorState, RunStats, StepFrom,
+    replay_probed_numeric, replay_visits_numeric, Machine, Numeric, Probe, ProcessorState, StepFrom,
 };
 use proptest::prelude::*;
-
-struct VecReader<'a> {
-    header: TraceHeader,
-    instrs: &'a [Instruction],
-    next: usize,
-}
-
-impl TraceRead for VecReader<'_> {
-    fn header(&self) -> &TraceHeader {
-        &self.header
-    }
-    fn next_instruction(&mut self) -> Result<Option<Instruction>, TraceError> {
-        let i = self.instrs.get(self.next).cloned();
-        self.next += usize::from(i.is_some());
-        Ok(i)
-    }
-    fn location(&self) -> Location {
-        Location::Byte(self.next as u64)
-    }
-    fn bytes_read(&self) -> u64 {
-        self.next as u64
-    }
-}
-
-fn reader<'a>(header: &TraceHeader, instrs: &'a [Instruction]) -> VecReader<'a> {
-    VecReader {
-        header: *header,
-        instrs,
-        next: 0,
-    }
-}
 
 /// A state with its values as bits (`NaN`s compare exactly).
 fn bits(s: &ProcessorState) -> (Vec<u64>, [bool; 6]) {
@@ -177,51 +144,6 @@ impl Probe for Log {
     }
 }
 
-fn sink(header: &TraceHeader) -> ImageSink {
-    ImageSink::new(
-        header.width as usize,
-        header.channel_count(),
-        ImageSink::DEFAULT_LIMIT_BYTES,
-    )
-}
-
-fn image_bits(image: &Image) -> Vec<u64> {
-    image.data.iter().map(|v| v.to_bits()).collect()
-}
-
-fn stepped_run<A: Arith<Out = f64>>(
-    header: &TraceHeader,
-    machine: &Machine,
-    arith: A,
-    trace: &[Instruction],
-    log: &mut Log,
-) -> (RunStats, Image) {
-    let timeline = machine.timeline(header).unwrap();
-    let mut s = sink(header);
-    let mut eng = Box::new(SteppedEngine::with_probe_arith(
-        header, timeline, arith, log,
-    ));
-    for i in trace {
-        eng.execute(i, &mut s);
-    }
-    let stats = eng.finish(&mut s);
-    (stats, s.finish().unwrap())
-}
-
-fn stepped(
-    header: &TraceHeader,
-    machine: &Machine,
-    numeric: &Numeric,
-    trace: &[Instruction],
-    log: &mut Log,
-) -> (RunStats, Image) {
-    match numeric {
-        Numeric::F64 => stepped_run(header, machine, Native::<f64>::new(), trace, log),
-        Numeric::F32 => stepped_run(header, machine, F32Arith, trace, log),
-        Numeric::Fixed(f) => stepped_run(header, machine, FixedArith::new(f).unwrap(), trace, log),
-    }
-}
-
 fn check(
     header: &TraceHeader,
     machine: &Machine,
@@ -231,13 +153,14 @@ fn check(
     first: u64,
 ) -> Result<(), TestCaseError> {
     let mut full = Log::watching(watched);
-    let (full_stats, full_image) = stepped(header, machine, numeric, trace, &mut full);
+    let (full_stats, full_image) =
+        common::stepped_numeric(header, machine, numeric, trace, &mut full);
 
     let mut log = Log::watching(watched);
-    let mut s = sink(header);
+    let mut s = common::image_sink(header);
     let mut reports = Vec::new();
     let stats = replay_visits_numeric(
-        &mut reader(header, trace),
+        &mut common::VecReader::new(header, trace),
         machine,
         numeric,
         first,
@@ -246,7 +169,10 @@ fn check(
         &mut |b| reports.push(b),
     )
     .unwrap();
-    prop_assert_eq!(image_bits(&s.finish().unwrap()), image_bits(&full_image));
+    prop_assert_eq!(
+        common::image_bits(&s.finish().unwrap()),
+        common::image_bits(&full_image)
+    );
     prop_assert_eq!(&stats, &full_stats);
     prop_assert!(reports.windows(2).all(|w| w[0] <= w[1]));
     prop_assert_eq!(reports.last().copied(), Some(trace.len() as u64));
@@ -270,7 +196,7 @@ fn check(
     // told once, as the stepped engine's hand-over tells it
     let mut win = Log::watching(watched);
     replay_probed_numeric(
-        &mut reader(header, trace),
+        &mut common::VecReader::new(header, trace),
         machine,
         numeric,
         StepFrom::Scanline(first),
@@ -363,7 +289,7 @@ fn a_nan_shows_every_visit() {
     .unwrap();
     let mut log = Log::watching(&[1]);
     replay_visits_numeric(
-        &mut reader(&header, &trace),
+        &mut common::VecReader::new(&header, &trace),
         &Machine::default(),
         &Numeric::F32,
         0,

@@ -8,49 +8,14 @@
 
 mod common;
 
-use cwisim_isa::{Instruction, Intensity, Location, Opcode, TraceError, TraceHeader, TraceRead};
+use cwisim_isa::{Instruction, Intensity, Opcode, TraceHeader};
 use cwisim_xproc::fast::FastEngine;
-use cwisim_xproc::stepped::SteppedEngine;
 use cwisim_xproc::{
-    replay_probed_from, replay_probed_numeric, Arith, Engine, F32Arith, FixedArith, Image,
-    ImageSink, Machine, Native, NullSink, Numeric, Probe, ProcessorState, RunStats, StepFrom,
+    replay_probed_from, replay_probed_numeric, Engine, Machine, Native, NullSink, Numeric, Probe,
+    ProcessorState, StepFrom,
 };
 use proptest::prelude::*;
 use std::collections::HashMap;
-
-/// A trace held in memory; one "byte" per instruction.
-struct VecReader<'a> {
-    header: TraceHeader,
-    instrs: &'a [Instruction],
-    next: usize,
-}
-
-impl<'a> VecReader<'a> {
-    fn new(header: &TraceHeader, instrs: &'a [Instruction]) -> Self {
-        VecReader {
-            header: *header,
-            instrs,
-            next: 0,
-        }
-    }
-}
-
-impl TraceRead for VecReader<'_> {
-    fn header(&self) -> &TraceHeader {
-        &self.header
-    }
-    fn next_instruction(&mut self) -> Result<Option<Instruction>, TraceError> {
-        let i = self.instrs.get(self.next).cloned();
-        self.next += usize::from(i.is_some());
-        Ok(i)
-    }
-    fn location(&self) -> Location {
-        Location::Byte(self.next as u64)
-    }
-    fn bytes_read(&self) -> u64 {
-        self.next as u64
-    }
-}
 
 /// A processor's state with its values as bits (`NaN`s and signed zeros compare exactly).
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -195,52 +160,6 @@ impl Probe for Log {
     }
 }
 
-fn bits(image: &Image) -> Vec<u64> {
-    image.data.iter().map(|v| v.to_bits()).collect()
-}
-
-fn image_sink(header: &TraceHeader) -> ImageSink {
-    ImageSink::new(
-        header.width as usize,
-        header.channel_count(),
-        ImageSink::DEFAULT_LIMIT_BYTES,
-    )
-}
-
-/// The reference: the stepped engine over the whole trace, from the start.
-fn stepped_run<A: Arith<Out = f64>>(
-    header: &TraceHeader,
-    machine: &Machine,
-    arith: A,
-    trace: &[Instruction],
-    log: &mut Log,
-) -> (RunStats, Image) {
-    let timeline = machine.timeline(header).unwrap();
-    let mut sink = image_sink(header);
-    let mut eng = Box::new(SteppedEngine::with_probe_arith(
-        header, timeline, arith, log,
-    ));
-    for i in trace {
-        eng.execute(i, &mut sink);
-    }
-    let stats = eng.finish(&mut sink);
-    (stats, sink.finish().unwrap())
-}
-
-fn stepped_numeric(
-    header: &TraceHeader,
-    machine: &Machine,
-    numeric: &Numeric,
-    trace: &[Instruction],
-    log: &mut Log,
-) -> (RunStats, Image) {
-    match numeric {
-        Numeric::F64 => stepped_run(header, machine, Native::<f64>::new(), trace, log),
-        Numeric::F32 => stepped_run(header, machine, F32Arith, trace, log),
-        Numeric::Fixed(f) => stepped_run(header, machine, FixedArith::new(f).unwrap(), trace, log),
-    }
-}
-
 /// Runs the trace both ways and checks every promise of the window; the scanline the
 /// stepped engine started with.
 fn check_window(
@@ -252,12 +171,13 @@ fn check_window(
     from: StepFrom,
 ) -> Result<u64, TestCaseError> {
     let mut full = Log::watching(watched.to_vec());
-    let (full_stats, full_image) = stepped_numeric(header, machine, numeric, trace, &mut full);
+    let (full_stats, full_image) =
+        common::stepped_numeric(header, machine, numeric, trace, &mut full);
 
     let mut win = Log::watching(watched.to_vec());
-    let mut sink = image_sink(header);
+    let mut sink = common::image_sink(header);
     let mut reports = Vec::new();
-    let mut reader = VecReader::new(header, trace);
+    let mut reader = common::VecReader::new(header, trace);
     let win_stats = replay_probed_numeric(
         &mut reader,
         machine,
@@ -271,7 +191,10 @@ fn check_window(
     let win_image = sink.finish().unwrap();
 
     // the whole run's scanlines and statistics, records of every scanline included
-    prop_assert_eq!(bits(&win_image), bits(&full_image));
+    prop_assert_eq!(
+        common::image_bits(&win_image),
+        common::image_bits(&full_image)
+    );
     prop_assert_eq!(&win_stats, &full_stats);
     // progress: never backwards, ending with the whole trace
     prop_assert!(reports.windows(2).all(|w| w[0] <= w[1]));
@@ -537,7 +460,7 @@ fn a_window_beyond_2_pow_63_cycles_is_refused() {
         ..Machine::default()
     };
     let trace = vec![Instruction::refresh(); 140];
-    let mut reader = VecReader::new(&header, &trace);
+    let mut reader = common::VecReader::new(&header, &trace);
     let err = replay_probed_from::<f64>(
         &mut reader,
         &machine,
@@ -563,7 +486,7 @@ fn the_native_entry_point_is_the_numeric_one_in_f64() {
         .collect();
     let run = |numeric: bool| {
         let mut log = Log::watching(vec![1, 4]);
-        let mut reader = VecReader::new(&header, &trace);
+        let mut reader = common::VecReader::new(&header, &trace);
         let from = StepFrom::Scanline(3);
         let stats = if numeric {
             replay_probed_numeric(

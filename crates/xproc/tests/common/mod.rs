@@ -1,9 +1,14 @@
-//! Strategies shared by the numeric-format tests.
+//! Strategies shared by the numeric-format tests, and the trace in memory and the
+//! stepped-engine reference shared by the probe tests (`window.rs`, `visits.rs`).
 
 #![allow(dead_code)]
 
-use cwisim_isa::{Instruction, Opcode};
-use cwisim_xproc::{FixedFormat, Numeric, Overflow, Q};
+use cwisim_isa::{Instruction, Location, Opcode, TraceError, TraceHeader, TraceRead};
+use cwisim_xproc::stepped::SteppedEngine;
+use cwisim_xproc::{
+    Arith, Engine, F32Arith, FixedArith, FixedFormat, Image, ImageSink, Machine, Native, Numeric,
+    Overflow, Probe, RunStats, Q,
+};
 use proptest::prelude::*;
 
 /// Any valid `Q`: 1..=64 integer bits, the rest of at most 64 bits fraction.
@@ -113,4 +118,89 @@ pub fn instruction(
             let (count, period) = (n.min(width - x), n.clamp(1, 5));
             Instruction::from_operands(Opcode::ALL[k], x, count, period, &vals, channels)
         })
+}
+
+/// A trace held in memory; one "byte" per instruction.
+pub struct VecReader<'a> {
+    header: TraceHeader,
+    instrs: &'a [Instruction],
+    next: usize,
+}
+
+impl<'a> VecReader<'a> {
+    pub fn new(header: &TraceHeader, instrs: &'a [Instruction]) -> Self {
+        VecReader {
+            header: *header,
+            instrs,
+            next: 0,
+        }
+    }
+}
+
+impl TraceRead for VecReader<'_> {
+    fn header(&self) -> &TraceHeader {
+        &self.header
+    }
+    fn next_instruction(&mut self) -> Result<Option<Instruction>, TraceError> {
+        let i = self.instrs.get(self.next).cloned();
+        self.next += usize::from(i.is_some());
+        Ok(i)
+    }
+    fn location(&self) -> Location {
+        Location::Byte(self.next as u64)
+    }
+    fn bytes_read(&self) -> u64 {
+        self.next as u64
+    }
+}
+
+/// An image collector for `header`'s scanlines.
+pub fn image_sink(header: &TraceHeader) -> ImageSink {
+    ImageSink::new(
+        header.width as usize,
+        header.channel_count(),
+        ImageSink::DEFAULT_LIMIT_BYTES,
+    )
+}
+
+/// An image's values as bits (`NaN`s and signed zeros compare exactly).
+pub fn image_bits(image: &Image) -> Vec<u64> {
+    image.data.iter().map(|v| v.to_bits()).collect()
+}
+
+fn stepped_run<A: Arith<Out = f64>>(
+    header: &TraceHeader,
+    machine: &Machine,
+    arith: A,
+    trace: &[Instruction],
+    probe: &mut dyn Probe,
+) -> (RunStats, Image) {
+    let timeline = machine.timeline(header).unwrap();
+    let mut sink = image_sink(header);
+    let mut eng = Box::new(SteppedEngine::with_probe_arith(
+        header, timeline, arith, probe,
+    ));
+    for i in trace {
+        eng.execute(i, &mut sink);
+    }
+    let stats = eng.finish(&mut sink);
+    (stats, sink.finish().unwrap())
+}
+
+/// The reference: the stepped engine over the whole trace, from the start, with
+/// registers of the format `numeric`, telling `probe`.
+pub fn stepped_numeric(
+    header: &TraceHeader,
+    machine: &Machine,
+    numeric: &Numeric,
+    trace: &[Instruction],
+    probe: &mut dyn Probe,
+) -> (RunStats, Image) {
+    match numeric {
+        Numeric::F64 => stepped_run(header, machine, Native::<f64>::new(), trace, probe),
+        Numeric::F32 => stepped_run(header, machine, F32Arith, trace, probe),
+        Numeric::Fixed(f) => {
+            stepped_run(header, machine, FixedArith::new(f).unwrap(), trace, probe)
+        }
+    }
 }
