@@ -69,6 +69,15 @@ pub enum VisibilityArg {
     Eval0,
 }
 
+/// `--shadows`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ShadowsArg {
+    /// Every light casts shadows.
+    On,
+    /// No light casts shadows.
+    Off,
+}
+
 /// `--grid`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
 pub enum GridArg {
@@ -352,6 +361,12 @@ pub struct DrawArgs {
         help_heading = "Adaptive refinement (refine)"
     )]
     pub phong_angle: Threshold,
+    /// Shadows from every light (on) or from none (off), whatever each light's
+    /// "shadows" entry in the scene says [default: as the scene says]. Exact shadow
+    /// polygons, cut from the visible surfaces with the light as the eye (vanrij; the
+    /// other renderers refuse on).
+    #[arg(long, value_enum, value_name = "on|off")]
+    pub shadows: Option<ShadowsArg>,
 }
 
 /// The help heading of van Rij's trapezia's flags: the pixel filter and the visibility.
@@ -394,6 +409,7 @@ impl Default for DrawArgs {
             gouraud_threshold: Threshold::Above(DEFAULT_GOURAUD_THRESHOLD),
             aa_threshold: Threshold::Above(DEFAULT_AA_THRESHOLD),
             phong_angle: Threshold::Above(DEFAULT_PHONG_ANGLE),
+            shadows: None,
         }
     }
 }
@@ -469,6 +485,7 @@ impl DrawArgs {
             gouraud_threshold: self.gouraud_threshold,
             aa_threshold: self.aa_threshold,
             phong_angle: self.phong_angle,
+            shadows: self.shadows.map(|s| s == ShadowsArg::On),
             threads: 1,
         }
     }

@@ -179,6 +179,7 @@ const DOCUMENTS: &[&str] = &[
     "docs/PERFORMANCE.md",
     "docs/RENDERERS.md",
     "docs/REPRODUCTION.md",
+    "docs/SHADOWS.md",
     "docs/STUDYING.md",
     "docs/TIMING.md",
     "docs/TRADEOFF.md",
@@ -217,6 +218,11 @@ fn renderers() {
 #[test]
 fn reproduction() {
     run_document("docs/REPRODUCTION.md");
+}
+
+#[test]
+fn shadows() {
+    run_document("docs/SHADOWS.md");
 }
 
 #[test]

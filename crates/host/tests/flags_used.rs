@@ -350,6 +350,7 @@ fn example(s: Setting, shading: bool) -> Vec<&'static str> {
         Setting::GouraudThreshold => vec!["--gouraud-threshold", "all"],
         Setting::AaThreshold => vec!["--aa-threshold", "all"],
         Setting::PhongAngle => vec!["--phong-angle", "all"],
+        Setting::Shadows => vec!["--shadows", "on"],
     }
 }
 

@@ -169,7 +169,10 @@ impl FramePlan for PhongFrame<'_> {
                     for (k, &c) in coverage.iter().enumerate() {
                         let centre = [(first + k as i64) as f64 + 0.5, f64::from(row) + 0.5];
                         let p = nearest_in(triangle, centre);
-                        let shade = self.surfaces.shader.at(triangle, p).unwrap_or_default();
+                        let shade = self
+                            .surfaces
+                            .shade(t.polygon as usize, p)
+                            .unwrap_or_default();
                         targets.extend(shade[..channels].iter().map(|v| c * v.max(0.0)));
                     }
                     filled += 1;

@@ -6,9 +6,10 @@
 use crate::error::RenderError;
 use crate::settings::Settings;
 use crate::source::{LoadedScene, Source};
-use cwisim_scene::{ScreenScene, Shading};
+use cwisim_scene::{ScreenScene, Shading, Vector};
 use cwisim_world::face::ScreenTriangle;
 use cwisim_world::shade::PhongShader;
+use cwisim_world::shadow::{self, Casters, LightSet, ShadowStats};
 use cwisim_world::{AnyScene, ProjectStats, Visibility, VisibilityStats};
 use std::time::{Duration, Instant};
 
@@ -33,6 +34,10 @@ pub struct PolygonScene {
     pub transform_time: Duration,
     /// Wall time of hidden-surface removal (world scenes).
     pub visibility_time: Duration,
+    /// What the shadow pass did (world scenes with a light casting shadows).
+    pub shadows: Option<ShadowStats>,
+    /// Wall time of the shadow pass.
+    pub shadow_time: Duration,
     /// With Phong shading: what per-pixel shading needs of the world.
     pub phong: Option<PhongSurfaces>,
     /// Meshes whose material lets light through (`transmittance` > 0), drawn opaque
@@ -51,6 +56,84 @@ pub struct PhongSurfaces {
     pub sources: Vec<usize>,
     /// The lighting.
     pub shader: PhongShader,
+    /// With shadows: which lights reach each polygon.
+    pub shadows: Option<PolygonLights>,
+}
+
+/// Which lights reach each polygon of a scene drawn with shadows.
+#[derive(Clone, Debug)]
+pub struct PolygonLights {
+    /// The lights that cast shadows.
+    pub casters: Casters,
+    /// Per polygon, the casters that reach it.
+    pub lit: Vec<LightSet>,
+}
+
+impl PhongSurfaces {
+    /// Per-pixel shading without shadows.
+    pub fn new(triangles: Vec<ScreenTriangle>, sources: Vec<usize>, shader: PhongShader) -> Self {
+        PhongSurfaces {
+            triangles,
+            sources,
+            shader,
+            shadows: None,
+        }
+    }
+
+    /// The intensity of polygon `polygon` at screen point `p` (on its triangle), by the
+    /// lights that reach it.
+    pub fn shade(&self, polygon: usize, p: [f64; 2]) -> Option<Vector> {
+        let triangle = &self.triangles[self.sources[polygon]];
+        match &self.shadows {
+            None => self.shader.at(triangle, p),
+            Some(s) => self
+                .shader
+                .at_lit(triangle, p, |k| s.casters.reaches(s.lit[polygon], k)),
+        }
+    }
+}
+
+/// The lights of `scene` that cast shadows under `settings` (none in a screen scene).
+pub fn shadow_casters(scene: &AnyScene, settings: &Settings) -> Result<Casters, RenderError> {
+    match scene {
+        AnyScene::World(w) => Ok(shadow::casters(&w.spec, settings.shadows)?),
+        AnyScene::Screen(_) => Ok(Casters::default()),
+    }
+}
+
+/// Refuses shadows a scene asks for (`"shadows": true`) in a renderer (`name`) that does
+/// not draw them, naming the one that does (`--shadows` itself is refused by the
+/// command line for a renderer that does not read it).
+pub fn refuse_shadows(
+    name: &str,
+    scene: &AnyScene,
+    settings: &Settings,
+) -> Result<(), RenderError> {
+    let casters = shadow_casters(scene, settings)?;
+    match casters.lights.first() {
+        None => Ok(()),
+        Some(&k) => Err(RenderError::Usage(format!(
+            "{name} does not draw shadows, and the scene's lights[{k}] casts them (\"shadows\": true): use --renderer vanrij (exact shadow polygons), or set \"shadows\": false"
+        ))),
+    }
+}
+
+/// Refuses a `--shadows` that would change nothing: `on` in a scene without lights,
+/// `off` in one where no light casts shadows.
+fn check_shadows_flag(
+    w: &cwisim_world::WorldScene,
+    settings: &Settings,
+) -> Result<(), RenderError> {
+    let lights = &w.spec.lights;
+    match settings.shadows {
+        Some(true) if lights.is_empty() => Err(RenderError::Usage(
+            "--shadows on: the scene has no lights to cast them (ambient light casts no shadow)".into(),
+        )),
+        Some(false) if !lights.iter().any(|l| l.shadows) => Err(RenderError::Usage(
+            "--shadows off: no light of the scene casts shadows (none says \"shadows\": true), so it would draw exactly as without".into(),
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// The refusal of Phong shading on a screen scene, the same from every renderer.
@@ -123,6 +206,8 @@ impl PolygonScene {
             load_time: loaded.load_time,
             transform_time: Duration::ZERO,
             visibility_time: Duration::ZERO,
+            shadows: None,
+            shadow_time: Duration::ZERO,
             phong: None,
             transparent_meshes: 0,
         };
@@ -153,25 +238,66 @@ impl PolygonScene {
                 let start = Instant::now();
                 let (tris, project) = cwisim_world::project::project(&w, settings.shading)?;
                 prepared.transform_time = start.elapsed();
+                check_shadows_flag(&w, settings)?;
+                let casters = shadow::casters(&w.spec, settings.shadows)?;
                 let start = Instant::now();
-                let (polygons, vis) = if phong {
-                    let (fragments, stats) =
-                        cwisim_world::visibility::exact_fragments_on(
-                            &tris,
-                            w.channels(),
-                            settings.threads,
-                        );
-                    let sources = fragments.iter().map(|f| f.source).collect();
-                    prepared.phong = Some(PhongSurfaces {
-                        triangles: tris,
-                        sources,
-                        shader: PhongShader::new(&w),
-                    });
-                    (fragments.into_iter().map(|f| f.polygon).collect(), Some(stats))
+                let (polygons, vis) = if phong || !casters.is_empty() {
+                    // the fragments with their source triangles: per-pixel shading and
+                    // shadows need them
+                    let (fragments, stats) = match settings.visibility {
+                        Visibility::Exact => {
+                            let (f, stats) = cwisim_world::visibility::exact_fragments_on(
+                                &tris,
+                                w.channels(),
+                                settings.threads,
+                            );
+                            (f, Some(stats))
+                        }
+                        Visibility::Eval0 => (
+                            cwisim_world::visibility::front_to_back_fragments(&tris, w.channels()),
+                            None,
+                        ),
+                    };
+                    prepared.visibility_time = start.elapsed();
+                    let start = Instant::now();
+                    let shadowed = cwisim_world::shadow::shadowed(
+                        &w,
+                        settings.shading,
+                        &tris,
+                        fragments,
+                        &casters,
+                        settings.threads,
+                    )?;
+                    if !casters.is_empty() {
+                        prepared.shadows = Some(shadowed.stats);
+                        prepared.shadow_time = start.elapsed();
+                    }
+                    let sources = shadowed.fragments.iter().map(|f| f.source).collect();
+                    if phong {
+                        let mut surfaces =
+                            PhongSurfaces::new(tris, sources, PhongShader::new(&w));
+                        if !casters.is_empty() {
+                            surfaces.shadows = Some(PolygonLights {
+                                casters,
+                                lit: shadowed.lit,
+                            });
+                        }
+                        prepared.phong = Some(surfaces);
+                    }
+                    (
+                        shadowed.fragments.into_iter().map(|f| f.polygon).collect(),
+                        stats,
+                    )
                 } else {
-                    cwisim_world::resolve_on(&tris, w.channels(), settings.visibility, settings.threads)
+                    let resolved = cwisim_world::resolve_on(
+                        &tris,
+                        w.channels(),
+                        settings.visibility,
+                        settings.threads,
+                    );
+                    prepared.visibility_time = start.elapsed();
+                    resolved
                 };
-                prepared.visibility_time = start.elapsed();
                 prepared.screen = w.screen(polygons);
                 prepared.project = Some(project);
                 prepared.visibility = vis;
@@ -197,6 +323,15 @@ impl PolygonScene {
                 ),
             ));
         }
+        if let Some(s) = &self.shadows {
+            rows.push((
+                "shadows",
+                format!(
+                    "{} light(s) casting, exact: {} shadow polygons among {} pieces of {} fragments ({} triangles in the lights' views, {} seen; {} booleans; {} hole cuts; {} slivers dropped, {:.1e} px² in all)",
+                    s.lights, s.shadow_polygons, s.pieces, s.fragments_in, s.light_triangles, s.light_fragments, s.booleans, s.hole_cuts, s.dropped_slivers, s.dropped_area
+                ),
+            ));
+        }
         if self.transparent_meshes > 0 {
             rows.push((
                 "note",
@@ -209,12 +344,16 @@ impl PolygonScene {
         rows
     }
 
-    /// The host-side stage times: transform & lighting, visibility.
+    /// The host-side stage times: transform & lighting, visibility, shadows (when cast).
     pub fn stage_times(&self) -> Vec<(&'static str, Duration)> {
-        vec![
+        let mut times = vec![
             ("transform & lighting", self.transform_time),
             ("visibility", self.visibility_time),
-        ]
+        ];
+        if self.shadows.is_some() {
+            times.push(("shadows", self.shadow_time));
+        }
+        times
     }
 
     /// The scene part of `--stats-json`: deterministic (no times, no paths).
@@ -226,6 +365,7 @@ impl PolygonScene {
             "visibility": self.visibility_mode.map(Visibility::name),
             "project": self.project,
             "exact_visibility": self.visibility,
+            "shadows": self.shadows,
         })
     }
 }

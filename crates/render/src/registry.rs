@@ -124,6 +124,7 @@ pub const REGISTRY: &[Entry] = &[
             Setting::Size,
             Setting::ShadeTolerance,
             Setting::Tessellate,
+            Setting::Shadows,
         ],
         draws: "it draws trapezia with the box filter or point sampling",
     },

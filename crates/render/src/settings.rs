@@ -102,6 +102,9 @@ pub struct Settings {
     /// Adaptive refinement: a polygon is Phong-shaded when the angle (degrees) between a
     /// corner's highlight vector and the direction to the eye is within this.
     pub phong_angle: Threshold,
+    /// Shadows: `None` as each light of the scene says (`"shadows": true`), `Some(true)`
+    /// every light casts them, `Some(false)` none does (`render --shadows on|off`).
+    pub shadows: Option<bool>,
     /// Threads the host-side preparation may use (exact visibility; 0: one per core).
     /// The polygons are the same, bit for bit, at any count. `render --threads N` sets
     /// it with the pipeline's.
@@ -161,11 +164,13 @@ pub enum Setting {
     AaThreshold,
     /// [`Settings::phong_angle`].
     PhongAngle,
+    /// [`Settings::shadows`].
+    Shadows,
 }
 
 impl Setting {
     /// Every setting, in the order of the command line's drawing flags.
-    pub const ALL: [Setting; 24] = [
+    pub const ALL: [Setting; 25] = [
         Setting::Shading,
         Setting::Aa,
         Setting::Visibility,
@@ -190,6 +195,7 @@ impl Setting {
         Setting::GouraudThreshold,
         Setting::AaThreshold,
         Setting::PhongAngle,
+        Setting::Shadows,
     ];
 
     /// Its flag: `--samples`.
@@ -219,6 +225,7 @@ impl Setting {
             Setting::GouraudThreshold => "--gouraud-threshold",
             Setting::AaThreshold => "--aa-threshold",
             Setting::PhongAngle => "--phong-angle",
+            Setting::Shadows => "--shadows",
         }
     }
 
@@ -238,6 +245,7 @@ impl Setting {
                 | Setting::GouraudThreshold
                 | Setting::AaThreshold
                 | Setting::PhongAngle
+                | Setting::Shadows
         )
     }
 
@@ -449,6 +457,7 @@ impl Default for Settings {
             gouraud_threshold: Threshold::Above(DEFAULT_GOURAUD_THRESHOLD),
             aa_threshold: Threshold::Above(DEFAULT_AA_THRESHOLD),
             phong_angle: Threshold::Above(DEFAULT_PHONG_ANGLE),
+            shadows: None,
             threads: 1,
         }
     }

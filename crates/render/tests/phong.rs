@@ -5,31 +5,18 @@
 //! visibility, the shader or the span fitter.
 
 use cwisim_isa::{Instruction, Opcode};
-use cwisim_render::{emit, registry, render, ArrayConfig, LoadedScene, Settings, Source, Taps};
+use cwisim_render::{emit, registry, LoadedScene, Settings, Source};
 use cwisim_scene::{Antialias, Shading};
 use cwisim_world::embedded::embedded;
 use cwisim_world::{parse_any, AnyScene, Visibility, WorldScene};
-use cwisim_xproc::ImageSink;
 use glam::DVec3;
 
-fn world(text: &str, size: u32) -> WorldScene {
-    match parse_any(text, None)
-        .unwrap()
-        .with_size(size, size)
-        .unwrap()
-    {
-        AnyScene::World(w) => w,
-        AnyScene::Screen(_) => panic!("a world scene"),
-    }
-}
+mod common;
+use common::raycast::{hits, ray};
+use common::rendered;
 
-fn rendered(w: &WorldScene, settings: &Settings) -> Vec<f64> {
-    let loaded = LoadedScene::built("test", AnyScene::World(w.clone()));
-    let r = (registry::find("vanrij").unwrap().build)(loaded, settings).unwrap();
-    let h = r.header();
-    let mut sink = ImageSink::new(h.width as usize, h.channel_count(), 1 << 30);
-    render(&*r, &ArrayConfig::default(), 1, &mut sink, Taps::default()).unwrap();
-    sink.finish().unwrap().data
+fn world(text: &str, size: u32) -> WorldScene {
+    common::world(text, Some((size, size)))
 }
 
 fn phong(aa: Antialias, tolerance: f64) -> Settings {
@@ -39,56 +26,6 @@ fn phong(aa: Antialias, tolerance: f64) -> Settings {
         shade_tolerance: tolerance,
         ..Settings::default()
     }
-}
-
-/// A hit: distance along the ray, the triangle's three corners (mesh, face, corner
-/// index in the face), world barycentrics, and how close to an edge it is.
-struct Hit {
-    t: f64,
-    mesh: usize,
-    face: usize,
-    corners: [usize; 3],
-    bary: [f64; 3],
-    margin: f64,
-}
-
-/// Every hit of the ray `o + t·d` with the scene's triangles (fans of faces).
-fn hits(w: &WorldScene, o: DVec3, d: DVec3) -> Vec<Hit> {
-    let mut out = Vec::new();
-    for (m, mesh) in w.meshes.iter().enumerate() {
-        for (f, face) in mesh.faces.iter().enumerate() {
-            for k in 1..face.corners.len() - 1 {
-                let c = [0, k, k + 1];
-                let p = c.map(|i| mesh.positions[face.corners[i] as usize]);
-                // Möller–Trumbore
-                let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
-                let q = d.cross(e2);
-                let det = e1.dot(q);
-                if det.abs() < 1e-14 {
-                    continue;
-                }
-                let s = o - p[0];
-                let u = s.dot(q) / det;
-                let r = s.cross(e1);
-                let v = d.dot(r) / det;
-                let t = e2.dot(r) / det;
-                let bary = [1.0 - u - v, u, v];
-                if t > 0.0 && bary.iter().all(|&b| b >= -1e-12) {
-                    let margin = bary.iter().cloned().fold(f64::INFINITY, f64::min);
-                    out.push(Hit {
-                        t,
-                        mesh: m,
-                        face: f,
-                        corners: c,
-                        bary,
-                        margin,
-                    });
-                }
-            }
-        }
-    }
-    out.sort_by(|a, b| a.t.total_cmp(&b.t));
-    out
 }
 
 /// The report's formula: `I = I_a·k_a + Σ I_l·(k_d·(N·L) + k_s·(R·V)^n)`, terms that face
@@ -117,26 +54,13 @@ fn lit(w: &WorldScene, mesh: usize, p: DVec3, n: DVec3) -> f64 {
     i
 }
 
-/// The ray through screen point `(x, y)` of a `size × size` image.
-fn ray(w: &WorldScene, size: u32, x: f64, y: f64) -> (DVec3, DVec3) {
-    let c = &w.spec.camera;
-    let eye = DVec3::from_array(c.eye);
-    let forward = (DVec3::from_array(c.target) - eye).normalize();
-    let right = forward.cross(DVec3::from_array(c.up)).normalize();
-    let up = right.cross(forward);
-    let focal = 0.5 * f64::from(size) / (0.5 * c.fov_y.to_radians()).tan();
-    let half = 0.5 * f64::from(size);
-    let d = forward * focal + right * (x - half) - up * (y - half);
-    (eye, d.normalize())
-}
-
 /// The reference at a screen point: `Some(value)` where the nearest hit is clear of
 /// every edge and of the next hit; `None` where a ray misses; `Err` where it is too close
 /// to call.
 type Seen = (f64, usize, usize, [usize; 3]);
 
 fn reference(w: &WorldScene, size: u32, x: f64, y: f64) -> Result<Option<Seen>, ()> {
-    let (o, d) = ray(w, size, x, y);
+    let (o, d) = ray(w, size, size, x, y);
     let hits = hits(w, o, d);
     let Some(h) = hits.first() else {
         return Ok(None);

@@ -24,6 +24,7 @@
 #![warn(missing_docs)]
 
 pub mod bezier;
+mod boolean;
 pub mod camera;
 pub mod clip;
 pub mod embedded;
@@ -34,6 +35,7 @@ pub mod obj;
 pub mod project;
 pub mod scene;
 pub mod shade;
+pub mod shadow;
 pub mod visibility;
 
 use cwisim_scene::Shading;
@@ -232,15 +234,9 @@ pub fn resolve_on(
             )
         }
         Visibility::Eval0 => (
-            visibility::front_to_back(tris)
+            visibility::front_to_back_fragments(tris, channels)
                 .into_iter()
-                .map(|k| {
-                    let t = &tris[k];
-                    Polygon::new(
-                        t.points.to_vec(),
-                        t.intensity.iter().map(|i| i[..channels].to_vec()).collect(),
-                    )
-                })
+                .map(|f| f.polygon)
                 .collect(),
             None,
         ),

@@ -33,9 +33,27 @@ pub struct Lighting {
 impl Lighting {
     /// The intensity at `point` with unit normal `normal`, seen from `eye`.
     pub fn intensity(&self, m: &Material, point: DVec3, normal: DVec3, eye: DVec3) -> Vector {
+        self.intensity_lit(m, point, normal, eye, |_| true)
+    }
+
+    /// [`Self::intensity`] with only the lights `reaches(k)` says reach the point (light
+    /// `k` of [`Self::lights`]): a shadowed point keeps the ambient term and every other
+    /// light's, and loses that light's diffuse and specular terms. With every light
+    /// reaching it is [`Self::intensity`], bit for bit.
+    pub fn intensity_lit(
+        &self,
+        m: &Material,
+        point: DVec3,
+        normal: DVec3,
+        eye: DVec3,
+        reaches: impl Fn(usize) -> bool,
+    ) -> Vector {
         let v = (eye - point).normalize_or_zero();
         let mut out = vector(self.channels, |c| self.ambient.get(c) * m.k_a.get(c));
-        for light in &self.lights {
+        for (k, light) in self.lights.iter().enumerate() {
+            if !reaches(k) {
+                continue;
+            }
             let l = (DVec3::from_array(light.position) - point).normalize_or_zero();
             let n_dot_l = normal.dot(l);
             if n_dot_l <= 0.0 {
@@ -92,6 +110,7 @@ mod tests {
             lights: vec![LightSpec {
                 position: [0.0, 10.0, 0.0],
                 intensity: PerChannel::Each(vec![1.0, 0.5, 0.0]),
+                shadows: false,
             }],
             channels: 3,
         }
@@ -146,6 +165,7 @@ mod tests {
             lights: vec![LightSpec {
                 position: [0.9095578363365777, 8.098510160219618, -2.4368424793545906],
                 intensity: PerChannel::All(1.0),
+                shadows: false,
             }],
             ..lighting()
         };

@@ -15,9 +15,9 @@ use crate::camera::Camera;
 use crate::face::{ScreenTriangle, Surface};
 use crate::lighting::Lighting;
 use crate::mesh::Mesh;
-use crate::scene::WorldScene;
-use cwisim_scene::Shading;
+use crate::scene::{Material, WorldScene};
 use cwisim_scene::{SceneError, SceneErrorKind, MAX_COORDINATE};
+use cwisim_scene::{Shading, Vector};
 use glam::DVec3;
 
 /// What projection did.
@@ -102,16 +102,8 @@ pub fn project(
         let material = &mspec.material;
         for (f, face) in mesh.faces.iter().enumerate() {
             stats.faces += 1;
-            let flat = (shading == Shading::Flat).then(|| {
-                let centroid = face
-                    .corners
-                    .iter()
-                    .map(|&c| mesh.positions[c as usize])
-                    .sum::<DVec3>()
-                    / face.corners.len() as f64;
-                let n = mesh.face_normal(f).normalize();
-                (centroid, n)
-            });
+            let flat = (shading == Shading::Flat)
+                .then(|| (face_centroid(mesh, f), mesh.face_normal(f).normalize()));
             for tri in face.triangles() {
                 stats.triangles += 1;
                 let idx = tri.map(|c| face.corners[c] as usize);
@@ -138,20 +130,12 @@ pub fn project(
                     Some((_, n)) => [toward * n; 3],
                     None => tri.map(|c| toward * face.normals[c]),
                 };
-                let intensity = match flat {
-                    Some((centroid, n)) => {
-                        let i = lighting.intensity(material, centroid, toward * n, camera.eye);
-                        [i; 3]
-                    }
-                    None => std::array::from_fn(|c| {
-                        lighting.intensity(
-                            material,
-                            p[c],
-                            toward * face.normals[tri[c]],
-                            camera.eye,
-                        )
-                    }),
-                };
+                let surface = Surface { world: p, normals };
+                let centroid = flat.map(|(centroid, _)| centroid);
+                let intensity =
+                    lit_corners(&lighting, material, centroid, &surface, camera.eye, |_| {
+                        true
+                    });
                 for i in &intensity {
                     crate::lighting::check_lit(i, channels, || {
                         (format!("meshes[{k}]"), format!("face {f}"))
@@ -163,10 +147,49 @@ pub fn project(
                     intensity,
                     mesh: k as u32,
                     face: f as u32,
-                    surface: Surface { world: p, normals },
+                    surface,
                 });
             }
         }
     }
     Ok((out, stats))
+}
+
+/// The centroid of face `f` of `mesh`: where flat shading lights it.
+pub fn face_centroid(mesh: &Mesh, f: usize) -> DVec3 {
+    let face = &mesh.faces[f];
+    face.corners
+        .iter()
+        .map(|&c| mesh.positions[c as usize])
+        .sum::<DVec3>()
+        / face.corners.len() as f64
+}
+
+/// A triangle's corner intensities as [`project`] lights them, by the lights `reaches`
+/// says reach it ([`Lighting::intensity_lit`]): at each corner with its shading normal
+/// (Gouraud), or once at the face's `centroid` with its normal (flat: `Some`, the
+/// normals being the face's). With every light reaching, [`project`]'s own, bit for bit.
+pub fn lit_corners(
+    lighting: &Lighting,
+    material: &Material,
+    centroid: Option<DVec3>,
+    surface: &Surface,
+    eye: DVec3,
+    reaches: impl Fn(usize) -> bool,
+) -> [Vector; 3] {
+    match centroid {
+        Some(centroid) => {
+            let i = lighting.intensity_lit(material, centroid, surface.normals[0], eye, reaches);
+            [i; 3]
+        }
+        None => std::array::from_fn(|c| {
+            lighting.intensity_lit(
+                material,
+                surface.world[c],
+                surface.normals[c],
+                eye,
+                &reaches,
+            )
+        }),
+    }
 }

@@ -146,6 +146,10 @@ pub struct LightSpec {
     pub position: [f64; 3],
     /// `I_l`.
     pub intensity: PerChannel,
+    /// It casts shadows (`"shadows": true`; `render --shadows on|off` overrides every
+    /// light): see [`crate::shadow`].
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub shadows: bool,
 }
 
 /// The reflection coefficients of the report's formula.

@@ -92,10 +92,24 @@ impl PhongShader {
 
     /// The intensity of `t` at screen point `p` (see [`Self::surface_at`]).
     pub fn at(&self, t: &ScreenTriangle, p: [f64; 2]) -> Option<Vector> {
+        self.at_lit(t, p, |_| true)
+    }
+
+    /// [`Self::at`] by the lights `reaches` says reach the point (light `k` of the scene;
+    /// [`crate::shadow`]): a shadowed point loses that light's terms.
+    pub fn at_lit(
+        &self,
+        t: &ScreenTriangle,
+        p: [f64; 2],
+        reaches: impl Fn(usize) -> bool,
+    ) -> Option<Vector> {
         let (point, normal) = self.surface_at(t, p)?;
-        Some(
-            self.lighting
-                .intensity(&self.materials[t.mesh as usize], point, normal, self.eye),
-        )
+        Some(self.lighting.intensity_lit(
+            &self.materials[t.mesh as usize],
+            point,
+            normal,
+            self.eye,
+            reaches,
+        ))
     }
 }

@@ -105,43 +105,21 @@
 //! covers and hides what comes later: the triangles sorted by the depth of their
 //! centroid, nearest first.
 
+use crate::boolean::{area, cross, grid_for, overlay, positive, settle, Contour, Grid, Losses, Pt};
 use crate::face::ScreenTriangle;
 use arrayvec::ArrayVec;
 use cwisim_scene::Polygon;
 use cwisim_scene::Vector;
-use i_overlay::core::fill_rule::FillRule;
-use i_overlay::core::overlay::ShapeType;
 use i_overlay::core::overlay_rule::OverlayRule;
-use i_overlay::core::solver::Solver;
-use i_overlay::float::overlay::{FloatOverlay, OverlayOptions};
-use i_overlay::i_float::adapter::FloatPointAdapter;
-use i_overlay::i_float::float::rect::FloatRect;
 use std::collections::HashMap;
 use std::hash::{Hash, Hasher};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
-/// A screen point `[x, y]`.
-type Pt = [f64; 2];
-/// A closed contour (the last vertex joins the first).
-type Contour = Vec<Pt>;
-/// An outline followed by its holes.
-type Shape = Vec<Contour>;
-/// The integer grid all polygon booleans run on.
-type Grid = FloatPointAdapter<Pt, i64>;
-
-/// Contours with less area (px²) are dropped.
-const SLIVER_AREA: f64 = 1e-12;
 /// Occluder pieces with at most this area (px²) are skipped.
 const PIECE_AREA: f64 = 1e-13;
 /// Relative `1/depth` difference below which two overlapping triangles are coplanar.
 const COPLANAR: f64 = 1e-12;
-/// A vertex where the boundary turns back within this angle (its sine) is a spike.
-const SPIKE_SIN: f64 = 1e-12;
-/// Consecutive vertices closer than this, relative to their coordinates' magnitude (at
-/// least 1 px), are merged: a few hundred units in the last place, well above the
-/// rounding of the grid's coordinates to `f64`.
-const NEAR_VERTEX: f64 = 1e-13;
 /// The most channels an intensity vector holds.
 const MAX_CHANNELS: usize = std::mem::size_of::<Vector>() / std::mem::size_of::<f64>();
 
@@ -295,10 +273,10 @@ pub fn exact_fragments_on(
         stats.hidden += t.stats.hidden;
         stats.copies_hidden += t.stats.copies_hidden;
         stats.candidates_skipped += t.stats.candidates_skipped;
-        stats.hole_cuts += t.stats.hole_cuts;
-        stats.dropped_slivers += t.stats.dropped_slivers;
+        stats.hole_cuts += t.losses.hole_cuts;
+        stats.dropped_slivers += t.losses.dropped.len() as u64;
         // in triangle order, one at a time, as one thread adds them
-        for a in t.dropped {
+        for a in t.losses.dropped {
             stats.dropped_area += a;
         }
         fragments.extend(t.fragments);
@@ -328,7 +306,7 @@ struct Shared<'a> {
 struct Tally {
     fragments: Vec<Fragment>,
     stats: VisibilityStats,
-    dropped: Vec<f64>,
+    losses: Losses,
 }
 
 impl Shared<'_> {
@@ -346,7 +324,7 @@ impl Shared<'_> {
         let mut tally = Tally {
             fragments: Vec::new(),
             stats: VisibilityStats::default(),
-            dropped: Vec::new(),
+            losses: Losses::default(),
         };
         let mut seen: HashMap<u64, usize> = HashMap::new();
         let mut stamp = Vec::new();
@@ -403,7 +381,7 @@ impl Shared<'_> {
                 let shapes = cut.unwrap_or_else(|| vec![vec![tri.points.to_vec()]]);
                 contours.clear();
                 for shape in shapes {
-                    settle(grid, shape, usize::MAX, &mut contours, &mut tally);
+                    settle(grid, shape, usize::MAX, &mut contours, &mut tally.losses);
                 }
                 for c in contours.drain(..) {
                     let intensity = c
@@ -493,6 +471,24 @@ pub fn front_to_back(tris: &[ScreenTriangle]) -> Vec<usize> {
     let mut order: Vec<usize> = (0..tris.len()).collect();
     order.sort_by(|&a, &b| depth[a].total_cmp(&depth[b]).then(a.cmp(&b)));
     order
+}
+
+/// Every triangle whole, in [`front_to_back`] order, as a fragment of itself (its
+/// vertices' intensities, the first `channels` entries).
+pub fn front_to_back_fragments(tris: &[ScreenTriangle], channels: usize) -> Vec<Fragment> {
+    front_to_back(tris)
+        .into_iter()
+        .map(|k| {
+            let t = &tris[k];
+            Fragment {
+                source: k,
+                polygon: Polygon::new(
+                    t.points.to_vec(),
+                    t.intensity.iter().map(|i| i[..channels].to_vec()).collect(),
+                ),
+            }
+        })
+        .collect()
 }
 
 // ---------------------------------------------------------------------------------------
@@ -597,37 +593,6 @@ fn contains_triangle(piece: &[Pt], t: &[Pt; 3]) -> bool {
             let (a, b) = (piece[e], piece[(e + 1) % piece.len()]);
             t.iter().all(|&p| cross(a, b, p) >= 0.0)
         })
-}
-
-/// Twice the signed area of the triangle `a b c`.
-fn cross(a: Pt, b: Pt, c: Pt) -> f64 {
-    (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1])
-}
-
-/// The signed shoelace area of a contour, relative to its first vertex.
-fn signed_area(v: &[Pt]) -> f64 {
-    if v.len() < 3 {
-        return 0.0;
-    }
-    let o = v[0];
-    let mut sum = 0.0;
-    for k in 1..v.len() - 1 {
-        sum += cross(o, v[k], v[k + 1]);
-    }
-    0.5 * sum
-}
-
-/// The absolute area of a contour.
-fn area(v: &[Pt]) -> f64 {
-    signed_area(v).abs()
-}
-
-/// The contour with positive signed area (reversed if need be).
-fn positive(mut v: Contour) -> Contour {
-    if signed_area(&v) < 0.0 {
-        v.reverse();
-    }
-    v
 }
 
 /// A convex polygon of at most [`SMALL`] vertices: a triangle clipped by up to five
@@ -853,127 +818,10 @@ impl BoxIndex {
     }
 }
 
-// ---------------------------------------------------------------------------------------
-// Polygon booleans.
-
-/// The grid for points `pts`: `i64` over `[−m, m]²`, `m` the power of two at or above
-/// their largest magnitude (at least 1).
-fn grid_for(pts: impl Iterator<Item = Pt>) -> Grid {
-    let big = pts.fold(1.0f64, |b, p| b.max(p[0].abs()).max(p[1].abs()));
-    let mut m = 1.0f64;
-    while m < big {
-        m *= 2.0;
-    }
-    let rect = FloatRect::new(-m, m, -m, m).expect("finite, ordered bounds");
-    FloatPointAdapter::new_conservative(rect)
-}
-
-/// The half-extent `m` of the grid's square.
-fn grid_extent(grid: &Grid) -> f64 {
-    grid.rect().max_x
-}
-
-/// `subject ∘ clip` on the shared grid, non-zero fill, OGC-valid output (outlines with
-/// positive signed area, holes negative).
-fn overlay(grid: &Grid, subject: &Shape, clip: &Shape, rule: OverlayRule) -> Vec<Shape> {
-    let capacity = subject.iter().chain(clip).map(Vec::len).sum();
-    FloatOverlay::new_custom(
-        grid.clone(),
-        OverlayOptions::<f64, i64>::ogc(),
-        Solver::default(),
-        capacity,
-    )
-    .unsafe_add_source(subject, ShapeType::Subject)
-    .unsafe_add_source(clip, ShapeType::Clip)
-    .overlay(rule, FillRule::NonZero)
-}
-
-/// Turns one result shape (outline, then holes) into hole-free contours in `out`:
-/// drops slivers, cuts holes away, tidies the outlines. `max_holes` is what a part of a
-/// cut may still have (the safeguard against endless recursion).
-fn settle(grid: &Grid, shape: Shape, max_holes: usize, out: &mut Vec<Contour>, tally: &mut Tally) {
-    let mut contours = shape.into_iter();
-    let Some(outline) = contours.next() else {
-        return;
-    };
-    let outline_area = area(&outline);
-    if outline_area < SLIVER_AREA {
-        tally.stats.dropped_slivers += 1;
-        tally.dropped.push(outline_area);
-        return;
-    }
-    let mut holes = Vec::new();
-    for h in contours {
-        let a = area(&h);
-        if a < SLIVER_AREA {
-            tally.stats.dropped_slivers += 1;
-            tally.dropped.push(a);
-        } else {
-            holes.push(h);
-        }
-    }
-    if holes.len() > max_holes {
-        // never observed: the cut did not remove a hole
-        for h in holes.drain(..) {
-            tally.stats.dropped_slivers += 1;
-            tally.dropped.push(area(&h));
-        }
-    }
-    if holes.is_empty() {
-        let outline = tidy(outline);
-        let a = area(&outline);
-        if outline.len() < 3 || a < SLIVER_AREA {
-            tally.stats.dropped_slivers += 1;
-            tally.dropped.push(a);
-        } else {
-            out.push(outline);
-        }
-        return;
-    }
-    tally.stats.hole_cuts += 1;
-    let (lo, hi) = holes[0]
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
-            (lo.min(p[1]), hi.max(p[1]))
-        });
-    let cut = lo + 0.5 * (hi - lo);
-    let m = grid_extent(grid);
-    let left = holes.len() - 1;
-    let whole: Shape = std::iter::once(outline).chain(holes).collect();
-    for (top, bottom) in [(-m, cut), (cut, m)] {
-        let half = vec![vec![[-m, top], [m, top], [m, bottom], [-m, bottom]]];
-        for part in overlay(grid, &whole, &half, OverlayRule::Intersect) {
-            settle(grid, part, left, out, tally);
-        }
-    }
-}
-
-/// Removes consecutive vertices within [`NEAR_VERTEX`] (relative) of each other and spikes
-/// (a vertex where the boundary turns back on itself within an angle of [`SPIKE_SIN`]),
-/// repeatedly.
-fn tidy(mut v: Contour) -> Contour {
-    'again: while v.len() >= 3 {
-        let n = v.len();
-        for k in 0..n {
-            let (a, b, c) = (v[(k + n - 1) % n], v[k], v[(k + 1) % n]);
-            let (u, w) = ([b[0] - a[0], b[1] - a[1]], [c[0] - b[0], c[1] - b[1]]);
-            let turn = u[0] * w[1] - u[1] * w[0];
-            let back = u[0] * w[0] + u[1] * w[1] < 0.0;
-            let near =
-                u[0].abs().max(u[1].abs()) <= NEAR_VERTEX * b[0].abs().max(b[1].abs()).max(1.0);
-            if near || (back && turn.abs() <= SPIKE_SIN * u[0].hypot(u[1]) * w[0].hypot(w[1])) {
-                v.remove(k);
-                continue 'again;
-            }
-        }
-        break;
-    }
-    v
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::boolean::{grid_extent, tidy};
 
     fn tri(points: [Pt; 3], inv_depth: [f64; 3]) -> ScreenTriangle {
         let mut intensity = [[0.0; MAX_CHANNELS]; 3];

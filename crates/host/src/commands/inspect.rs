@@ -201,6 +201,7 @@ fn draw_value(d: &DrawArgs, flag: &str) -> Result<Option<String>, ()> {
         "--gouraud-threshold" => Some(d.gouraud_threshold.to_string()),
         "--aa-threshold" => Some(d.aa_threshold.to_string()),
         "--phong-angle" => Some(d.phong_angle.to_string()),
+        "--shadows" => d.shadows.as_ref().and_then(name),
         _ => return Err(()),
     })
 }

@@ -136,6 +136,7 @@ impl Bsp {
         loaded: LoadedScene,
         settings: &Settings,
     ) -> Result<Box<dyn Renderer>, RenderError> {
+        crate::prepare::refuse_shadows("bsp", &loaded.scene, settings)?;
         Ok(Box::new(Bsp::new(loaded, settings)?))
     }
 

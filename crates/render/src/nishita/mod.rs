@@ -390,11 +390,8 @@ impl Nishita {
             if settings.aa.is_box() {
                 groups = Some((r.groups, r.rows));
             }
-            let surfaces = phong.then(|| PhongSurfaces {
-                triangles: r.triangles,
-                sources: r.sources,
-                shader: PhongShader::new(&w),
-            });
+            let surfaces =
+                phong.then(|| PhongSurfaces::new(r.triangles, r.sources, PhongShader::new(&w)));
             (
                 r.pieces,
                 r.count,
@@ -429,11 +426,11 @@ impl Nishita {
                 (
                     polygons,
                     Some(stats),
-                    Some(PhongSurfaces {
-                        triangles: tris.clone(),
+                    Some(PhongSurfaces::new(
+                        tris.clone(),
                         sources,
-                        shader: PhongShader::new(&w),
-                    }),
+                        PhongShader::new(&w),
+                    )),
                 )
             } else {
                 let (p, s) = cwisim_world::resolve_on(
@@ -472,6 +469,8 @@ impl Nishita {
             load_time: loaded.load_time,
             transform_time: geometry_time,
             visibility_time,
+            shadows: None,
+            shadow_time: std::time::Duration::ZERO,
             phong: surfaces,
             transparent_meshes: w
                 .spec
@@ -509,6 +508,7 @@ impl Nishita {
         loaded: LoadedScene,
         settings: &Settings,
     ) -> Result<Box<dyn Renderer>, RenderError> {
+        crate::prepare::refuse_shadows("nishita", &loaded.scene, settings)?;
         Ok(Box::new(Nishita::new(loaded, settings)?))
     }
 

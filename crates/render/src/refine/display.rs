@@ -62,11 +62,7 @@ impl Subset {
         let phong = match &scene.phong {
             Some(s) if !phong.polygons.is_empty() => Some((
                 phong,
-                PhongSurfaces {
-                    triangles: s.triangles.clone(),
-                    sources,
-                    shader: s.shader.clone(),
-                },
+                PhongSurfaces::new(s.triangles.clone(), sources, s.shader.clone()),
             )),
             _ => None,
         };

@@ -367,6 +367,7 @@ impl Refine {
         loaded: LoadedScene,
         settings: &Settings,
     ) -> Result<Box<dyn Renderer>, RenderError> {
+        crate::prepare::refuse_shadows("refine", &loaded.scene, settings)?;
         Ok(Box::new(Refine::new(loaded, settings)?))
     }
 

@@ -89,6 +89,7 @@ impl SBuffer {
         loaded: LoadedScene,
         settings: &Settings,
     ) -> Result<Box<dyn Renderer>, RenderError> {
+        crate::prepare::refuse_shadows("sbuffer", &loaded.scene, settings)?;
         Ok(Box::new(SBuffer::new(loaded, settings)?))
     }
 

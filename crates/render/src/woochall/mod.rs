@@ -84,6 +84,7 @@ impl WooChall {
         loaded: LoadedScene,
         settings: &Settings,
     ) -> Result<Box<dyn Renderer>, RenderError> {
+        crate::prepare::refuse_shadows("woo-chall", &loaded.scene, settings)?;
         Ok(Box::new(WooChall::new(loaded, settings)?))
     }
 

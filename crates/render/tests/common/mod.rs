@@ -1,0 +1,30 @@
+//! Helpers shared by the integration tests of `cwisim-render`.
+
+pub mod raycast;
+
+use cwisim_render::{registry, render, ArrayConfig, LoadedScene, Settings, Taps};
+use cwisim_world::{parse_any, AnyScene, WorldScene};
+use cwisim_xproc::ImageSink;
+
+/// The world scene of `text`, at `size` (`None`: its own).
+pub fn world(text: &str, size: Option<(u32, u32)>) -> WorldScene {
+    let scene = parse_any(text, None).unwrap();
+    let scene = match size {
+        Some((w, h)) => scene.with_size(w, h).unwrap(),
+        None => scene,
+    };
+    match scene {
+        AnyScene::World(w) => w,
+        AnyScene::Screen(_) => panic!("a world scene"),
+    }
+}
+
+/// The image `vanrij` draws of `w` under `settings` (the array's exact values).
+pub fn rendered(w: &WorldScene, settings: &Settings) -> Vec<f64> {
+    let loaded = LoadedScene::built("test", AnyScene::World(w.clone()));
+    let r = (registry::find("vanrij").unwrap().build)(loaded, settings).unwrap();
+    let h = r.header();
+    let mut sink = ImageSink::new(h.width as usize, h.channel_count(), 1 << 30);
+    render(&*r, &ArrayConfig::default(), 1, &mut sink, Taps::default()).unwrap();
+    sink.finish().unwrap().data
+}

@@ -1,0 +1,625 @@
+//! Shadows, exactly: each visible fragment cut into the parts every shadow-casting light
+//! reaches and the parts it does not (Atherton, Weiler and Greenberg's method, the one the
+//! papers cite: the polygons a light sees are the visible fragments with the light as the
+//! eye).
+//!
+//! For each light that casts shadows ([`casters`]):
+//!
+//! 1. **The light's view.** A pinhole camera at the light looks along the mean direction
+//!    to the scene's vertices, with a field of view holding all of them. Every triangle
+//!    of every mesh, front or back (an open surface's inside casts shadows too), is
+//!    projected through it and [`exact_fragments`] finds what the light sees of each: the
+//!    same exact polygon booleans as the camera's visibility, with their precision and
+//!    their bounds on memory and depth complexity. A light must see the whole scene
+//!    within such a view: one among the objects (vertices more than 170° apart from it)
+//!    or on a vertex is refused, located at `lights[k].position`.
+//! 2. **Back to the camera.** Each fragment the light sees lies in its triangle's plane:
+//!    its vertices are mapped to the world on that plane (perspective-correct weights of
+//!    the triangle's corners, as [`crate::shade`] does) and projected by the camera.
+//!    Projective maps between planes keep straight edges straight, so these are the lit
+//!    parts of the triangle on the screen, exactly.
+//! 3. **Cut.** Each camera fragment of the triangle is cut into its intersection with the
+//!    lit parts and its difference from them (one boolean each on the visibility's
+//!    integer grid; holes cut away and slivers dropped and counted as visibility does).
+//!    A fragment whose triangle the light sees whole is lit whole, and one it does not see
+//!    at all is shadowed whole, without a boolean. With several lights the pieces are cut
+//!    again for each, so a piece knows every light that reaches it ([`LightSet`]).
+//! 4. **Shade.** A piece keeps its triangle's shading less the terms of the lights that
+//!    do not reach it ([`crate::project::lit_corners`]): a flat face's one intensity less
+//!    those lights' terms at its centroid; Gouraud's corner intensities relit without them
+//!    and interpolated at the piece's vertices; Phong (per pixel) asks the shader with the
+//!    piece's [`LightSet`]. A fragment every light reaches is output as it came, bit for
+//!    bit.
+//!
+//! Whether a point is lit is decided by the geometry alone: a triangle facing away from a
+//! light is shadowed by its own mesh's near side, whatever its shading normals say (a
+//! smooth surface's terminator follows the facets).
+//!
+//! Output order: the input fragments' order, each fragment's pieces together (lit first,
+//! then shadowed, light by light). Deterministic at any thread count (the light's view
+//! runs on threads as [`crate::visibility::exact_fragments_on`] does).
+
+use crate::boolean::{grid_for, overlay, positive, settle, Contour, Losses, Pt, Shape};
+use crate::camera::Camera;
+use crate::face::{ScreenTriangle, Surface};
+use crate::lighting::Lighting;
+use crate::project::{face_centroid, lit_corners};
+use crate::scene::{CameraSpec, WorldScene, WorldSpec};
+use crate::visibility::{exact_fragments_on, Fragment};
+use cwisim_scene::{Polygon, SceneError, SceneErrorKind, Shading, Vector};
+use glam::DVec3;
+use i_overlay::core::overlay_rule::OverlayRule;
+use std::collections::HashMap;
+
+/// The most lights that may cast shadows in one scene (a [`LightSet`] has a bit for each).
+pub const MAX_CASTERS: usize = 64;
+
+/// The light's view is square, this many units a side: about a large image's pixels, so
+/// that the visibility's area thresholds (1e-12 px²) mean there what they mean on screen.
+const LIGHT_VIEW_SIDE: u32 = 2048;
+
+/// The smallest cosine between a vertex's direction from a light and the light view's
+/// axis: a light must see the scene within a cone under 170°.
+const MIN_COS: f64 = 0.087_155_742_747_658_17; // cos 85°
+
+/// Which shadow-casting lights reach a piece: bit `i` for the `i`-th caster
+/// ([`Casters::lights`]). Lights that cast no shadow reach everything.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct LightSet(pub u64);
+
+impl LightSet {
+    /// Every caster reaches.
+    pub const ALL: LightSet = LightSet(u64::MAX);
+
+    /// Whether caster `i` reaches.
+    pub fn has(self, i: usize) -> bool {
+        self.0 >> i & 1 == 1
+    }
+
+    fn without(self, i: usize) -> LightSet {
+        LightSet(self.0 & !(1 << i))
+    }
+}
+
+/// The lights of a scene that cast shadows, by index into the scene's lights.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Casters {
+    /// Indices into `WorldSpec::lights`, ascending.
+    pub lights: Vec<usize>,
+}
+
+impl Casters {
+    /// No light casts shadows.
+    pub fn is_empty(&self) -> bool {
+        self.lights.is_empty()
+    }
+
+    /// Whether light `k` of the scene reaches a piece lit by `set`.
+    pub fn reaches(&self, set: LightSet, k: usize) -> bool {
+        match self.lights.iter().position(|&l| l == k) {
+            Some(i) => set.has(i),
+            None => true,
+        }
+    }
+}
+
+/// The lights of `spec` that cast shadows: those whose entry says `"shadows": true`, or
+/// every light (`force: Some(true)`, `render --shadows on`) or none (`Some(false)`).
+/// More than [`MAX_CASTERS`] is refused, located at the first light past the limit.
+pub fn casters(spec: &WorldSpec, force: Option<bool>) -> Result<Casters, SceneError> {
+    let lights: Vec<usize> = (0..spec.lights.len())
+        .filter(|&k| force.unwrap_or(spec.lights[k].shadows))
+        .collect();
+    if lights.len() > MAX_CASTERS {
+        let k = lights[MAX_CASTERS];
+        return Err(SceneError::at_field(
+            SceneErrorKind::Limit,
+            format!("lights[{k}].shadows"),
+            format!(
+                "{} lights cast shadows; at most {MAX_CASTERS} may (each piece of a surface records which of them reach it)",
+                lights.len()
+            ),
+        ));
+    }
+    Ok(Casters { lights })
+}
+
+/// What the shadow pass did (for the summary).
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct ShadowStats {
+    /// Lights casting shadows.
+    pub lights: u64,
+    /// Triangles projected into the lights' views (every triangle, once per light).
+    pub light_triangles: u64,
+    /// Fragments the lights see, over all lights.
+    pub light_fragments: u64,
+    /// Camera fragments taken in.
+    pub fragments_in: u64,
+    /// Pieces out: polygons each lit by one set of lights.
+    pub pieces: u64,
+    /// Pieces some shadow-casting light does not reach: the shadow polygons.
+    pub shadow_polygons: u64,
+    /// Polygon booleans made (an intersection and a difference per cut).
+    pub booleans: u64,
+    /// Horizontal cuts made to remove holes.
+    pub hole_cuts: u64,
+    /// Contours dropped for having less than 1e-12 px² of area.
+    pub dropped_slivers: u64,
+    /// Their total area (px²).
+    pub dropped_area: f64,
+}
+
+/// Fragments cut by the lights that reach them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Shadowed {
+    /// The pieces, each a simple polygon of its source triangle shaded by the lights that
+    /// reach it.
+    pub fragments: Vec<Fragment>,
+    /// The lights that reach each piece.
+    pub lit: Vec<LightSet>,
+    /// What was done.
+    pub stats: ShadowStats,
+}
+
+/// A light's view: every triangle of the scene as the light sees it, and what it sees of each.
+struct LightView {
+    /// The light-view triangles, one per fan triangle of every face of every mesh.
+    tris: Vec<ScreenTriangle>,
+    /// Per light-view triangle, the range of its fragments in `fragments`.
+    ranges: Vec<std::ops::Range<usize>>,
+    /// What the light sees, by source triangle.
+    fragments: Vec<Fragment>,
+}
+
+/// Every fan triangle of every mesh of `scene` in the world, with its mesh and face, in
+/// mesh, face and fan order.
+fn world_triangles(scene: &WorldScene) -> Vec<(u32, u32, [DVec3; 3])> {
+    let mut out = Vec::new();
+    for (k, mesh) in scene.meshes.iter().enumerate() {
+        for (f, face) in mesh.faces.iter().enumerate() {
+            for tri in face.triangles() {
+                let p = tri.map(|c| mesh.positions[face.corners[c] as usize]);
+                out.push((k as u32, f as u32, p));
+            }
+        }
+    }
+    out
+}
+
+impl LightView {
+    /// Light `k`'s view of `world`, or why the light cannot see the scene in one view.
+    fn new(
+        spec: &WorldSpec,
+        k: usize,
+        world: &[(u32, u32, [DVec3; 3])],
+        threads: usize,
+    ) -> Result<LightView, SceneError> {
+        let light = DVec3::from_array(spec.lights[k].position);
+        let place = format!("lights[{k}].position");
+        let refuse = |why: String| {
+            Err(SceneError::at_field(
+                SceneErrorKind::Geometry,
+                place.clone(),
+                format!("light {k} at {light} casts shadows, but {why}"),
+            ))
+        };
+        let corners = || world.iter().flat_map(|(_, _, p)| p.iter().copied());
+        let scale = corners()
+            .map(|p| (p - light).length())
+            .fold(0.0f64, f64::max);
+        let mut sum = DVec3::ZERO;
+        for p in corners() {
+            let d = p - light;
+            let length = d.length();
+            if length.is_nan() || length <= 1e-9 * scale {
+                return refuse(format!(
+                    "it is on a vertex of the scene ({p}): a light on a surface lights it edge-on; move it off the surface"
+                ));
+            }
+            sum += d / length;
+        }
+        let Some(axis) = sum.try_normalize() else {
+            return refuse("the scene surrounds it: it sees vertices in every direction; move it outside the objects, or set \"shadows\": false for it".into());
+        };
+        let widest = corners()
+            .map(|p| (p - light).normalize().dot(axis))
+            .fold(1.0f64, f64::min);
+        if widest < MIN_COS {
+            return refuse(format!(
+                "it sees the scene's vertices up to {:.1}° from their mean direction (at most 85°: one view must hold them all); move it outside the objects, or set \"shadows\": false for it",
+                widest.clamp(-1.0, 1.0).acos().to_degrees()
+            ));
+        }
+        let up = if axis.x.abs() < 0.5 {
+            DVec3::X
+        } else {
+            DVec3::Y
+        };
+        // a margin of 1° past the widest vertex on every side
+        let half = widest.acos() + 1f64.to_radians();
+        let camera = Camera::new(
+            &CameraSpec {
+                eye: spec.lights[k].position,
+                target: (light + axis).to_array(),
+                up: up.to_array(),
+                fov_y: 2.0 * half.to_degrees(),
+                near: 0.0,
+            },
+            LIGHT_VIEW_SIDE,
+            LIGHT_VIEW_SIDE,
+        );
+        let tris: Vec<ScreenTriangle> = world
+            .iter()
+            .map(|&(mesh, face, world)| ScreenTriangle {
+                points: world.map(|p| camera.project(p)),
+                inv_depth: world.map(|p| 1.0 / camera.depth(p)),
+                intensity: [Vector::default(); 3],
+                mesh,
+                face,
+                surface: Surface {
+                    world,
+                    normals: [DVec3::ZERO; 3],
+                },
+            })
+            .collect();
+        let (fragments, _) = exact_fragments_on(&tris, 1, threads);
+        let mut ranges = vec![0..0; tris.len()];
+        let mut start = 0;
+        while start < fragments.len() {
+            let source = fragments[start].source;
+            let end = start
+                + fragments[start..]
+                    .iter()
+                    .take_while(|f| f.source == source)
+                    .count();
+            ranges[source] = start..end;
+            start = end;
+        }
+        Ok(LightView {
+            tris,
+            ranges,
+            fragments,
+        })
+    }
+
+    /// How the light sees light-view triangle `j`: wholly (`Some(true)`), not at all
+    /// (`Some(false)`), or in part (`None`).
+    fn whole(&self, j: usize) -> Option<bool> {
+        let range = self.ranges[j].clone();
+        if range.is_empty() {
+            return Some(false);
+        }
+        let t = &self.tris[j];
+        let one = &self.fragments[range.start].polygon.vertices;
+        if range.len() == 1 && one.len() == 3 && one.iter().all(|p| t.points.contains(p)) {
+            return Some(true);
+        }
+        None
+    }
+
+    /// What the light sees of light-view triangle `j`, as contours on the camera's screen.
+    fn lit_on_screen(&self, j: usize, camera: &Camera) -> Shape {
+        let t = &self.tris[j];
+        self.fragments[self.ranges[j].clone()]
+            .iter()
+            .map(|f| {
+                let contour: Contour = f
+                    .polygon
+                    .vertices
+                    .iter()
+                    .map(|&q| camera.project(world_at(t, q)))
+                    .collect();
+                positive(contour)
+            })
+            .collect()
+    }
+}
+
+/// The world point of light-view triangle `t` at its screen point `q`: the corners
+/// weighted by the screen barycentrics times `1/depth` (perspective-correct).
+fn world_at(t: &ScreenTriangle, q: Pt) -> DVec3 {
+    let b = t.barycentric(q).unwrap_or([1.0 / 3.0; 3]);
+    let w = [0, 1, 2].map(|k| b[k] * t.inv_depth[k]);
+    let sum = w[0] + w[1] + w[2];
+    let s = &t.surface.world;
+    (w[0] * s[0] + w[1] * s[1] + w[2] * s[2]) / sum
+}
+
+/// Cuts the camera's `fragments` of the screen triangles `tris` (made by
+/// [`crate::project::project`] of `scene` under `shading`) into the pieces each set of
+/// the `casters` reaches, shaded accordingly (see the [module docs](self)). The lights'
+/// views run on `threads` threads (0: one per core).
+pub fn shadowed(
+    scene: &WorldScene,
+    shading: Shading,
+    tris: &[ScreenTriangle],
+    fragments: Vec<Fragment>,
+    casters: &Casters,
+    threads: usize,
+) -> Result<Shadowed, SceneError> {
+    let spec = &scene.spec;
+    let channels = scene.channels();
+    let mut stats = ShadowStats {
+        lights: casters.lights.len() as u64,
+        fragments_in: fragments.len() as u64,
+        ..ShadowStats::default()
+    };
+    if casters.is_empty() {
+        stats.pieces = fragments.len() as u64;
+        let lit = vec![LightSet::ALL; fragments.len()];
+        return Ok(Shadowed {
+            fragments,
+            lit,
+            stats,
+        });
+    }
+    let world = world_triangles(scene);
+    // camera triangle → light-view triangle: the same mesh, face and corners
+    let mut by_face: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
+    for (j, (mesh, face, _)) in world.iter().enumerate() {
+        by_face.entry((*mesh, *face)).or_default().push(j);
+    }
+    let light_index: Vec<usize> = tris
+        .iter()
+        .map(|t| {
+            by_face
+                .get(&(t.mesh, t.face))
+                .and_then(|js| js.iter().copied().find(|&j| world[j].2 == t.surface.world))
+                .unwrap_or(usize::MAX)
+        })
+        .collect();
+    let mut views = Vec::with_capacity(casters.lights.len());
+    for &k in &casters.lights {
+        let view = LightView::new(spec, k, &world, threads)?;
+        stats.light_triangles += view.tris.len() as u64;
+        stats.light_fragments += view.fragments.len() as u64;
+        views.push(view);
+    }
+    let camera = Camera::new(&spec.camera, scene.width(), scene.height());
+    let lighting = Lighting {
+        ambient: spec.ambient.clone(),
+        lights: spec.lights.clone(),
+        channels,
+    };
+    let grid = grid_for(tris.iter().flat_map(|t| t.points));
+    let mut losses = Losses::default();
+    let mut out = Shadowed {
+        fragments: Vec::with_capacity(fragments.len()),
+        lit: Vec::with_capacity(fragments.len()),
+        stats: ShadowStats::default(),
+    };
+    // the lit parts of the current source triangle on the screen, per light (made once
+    // per triangle: its fragments come together)
+    let mut lit_source = usize::MAX;
+    let mut lit_parts: Vec<Option<Shape>> = Vec::new();
+    let mut wholly: Vec<Option<bool>> = Vec::new();
+    let mut relit: HashMap<LightSet, [Vector; 3]> = HashMap::new();
+    for fragment in fragments {
+        let t = &tris[fragment.source];
+        let j = light_index[fragment.source];
+        if fragment.source != lit_source {
+            lit_source = fragment.source;
+            relit.clear();
+            wholly = views
+                .iter()
+                .map(|v| {
+                    if j == usize::MAX {
+                        Some(true)
+                    } else {
+                        v.whole(j)
+                    }
+                })
+                .collect();
+            lit_parts = views
+                .iter()
+                .zip(&wholly)
+                .map(|(v, w)| w.is_none().then(|| v.lit_on_screen(j, &camera)))
+                .collect();
+        }
+        let mut pieces: Vec<(Contour, LightSet)> =
+            vec![(fragment.polygon.vertices.clone(), LightSet::ALL)];
+        for (i, whole) in wholly.iter().enumerate() {
+            match whole {
+                Some(true) => {}
+                Some(false) => {
+                    for piece in &mut pieces {
+                        piece.1 = piece.1.without(i);
+                    }
+                }
+                None => {
+                    let lit = lit_parts[i]
+                        .as_ref()
+                        .expect("made for a partly lit triangle");
+                    let mut next = Vec::with_capacity(pieces.len() * 2);
+                    for (contour, set) in pieces {
+                        let subject = vec![positive(contour)];
+                        for (rule, set) in [
+                            (OverlayRule::Intersect, set),
+                            (OverlayRule::Difference, set.without(i)),
+                        ] {
+                            stats.booleans += 1;
+                            let mut contours = Vec::new();
+                            for shape in overlay(&grid, &subject, lit, rule) {
+                                settle(&grid, shape, usize::MAX, &mut contours, &mut losses);
+                            }
+                            next.extend(contours.into_iter().map(|c| (c, set)));
+                        }
+                    }
+                    pieces = next;
+                }
+            }
+        }
+        if let [(_, LightSet::ALL)] = pieces.as_slice() {
+            // every light reaches all of it: the fragment as it came
+            out.fragments.push(fragment);
+            out.lit.push(LightSet::ALL);
+            continue;
+        }
+        for (contour, set) in pieces {
+            let corners = *relit.entry(set).or_insert_with(|| {
+                let material = &spec.meshes[t.mesh as usize].material;
+                let centroid = (shading == Shading::Flat)
+                    .then(|| face_centroid(&scene.meshes[t.mesh as usize], t.face as usize));
+                lit_corners(&lighting, material, centroid, &t.surface, camera.eye, |k| {
+                    casters.reaches(set, k)
+                })
+            });
+            let shaded = ScreenTriangle {
+                intensity: corners,
+                ..*t
+            };
+            let intensity = contour
+                .iter()
+                .map(|&p| {
+                    let v = shaded
+                        .intensity_at(p, channels)
+                        .expect("a visible triangle has nonzero area");
+                    v[..channels].to_vec()
+                })
+                .collect();
+            out.fragments.push(Fragment {
+                source: fragment.source,
+                polygon: Polygon::new(contour, intensity),
+            });
+            out.lit.push(set);
+        }
+    }
+    stats.pieces = out.fragments.len() as u64;
+    stats.shadow_polygons = out.lit.iter().filter(|&&s| s != LightSet::ALL).count() as u64;
+    stats.hole_cuts = losses.hole_cuts;
+    stats.dropped_slivers = losses.dropped.len() as u64;
+    stats.dropped_area = losses.dropped.iter().sum();
+    out.stats = stats;
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::project::project;
+
+    /// A floor, and a box standing on it, lit by `lights` (JSON).
+    fn scene(lights: &str) -> WorldScene {
+        let text = format!(
+            r#"{{"kind": "world", "width": 40, "height": 30, "channels": 1,
+"camera": {{"eye": [0, 4, 6], "target": [0, 0, 0], "fov_y": 40}},
+"ambient": 0.2, "lights": {lights},
+"meshes": [
+  {{"material": {{"k_a": 0.5, "k_d": 0.7, "k_s": 0, "n": 1}},
+    "vertices": [[-3, 0, -3], [-3, 0, 3], [3, 0, 3], [3, 0, -3]], "faces": [[0, 1, 2, 3]]}},
+  {{"material": {{"k_a": 0.5, "k_d": 0.7, "k_s": 0, "n": 1}},
+    "vertices": [[-0.5, 0.2, -0.5], [0.5, 0.2, -0.5], [0.5, 0.2, 0.5], [-0.5, 0.2, 0.5],
+                 [-0.5, 1.2, -0.5], [0.5, 1.2, -0.5], [0.5, 1.2, 0.5], [-0.5, 1.2, 0.5]],
+    "faces": [[0, 1, 2, 3], [4, 7, 6, 5], [0, 4, 5, 1], [1, 5, 6, 2], [2, 6, 7, 3], [3, 7, 4, 0]]}}
+]}}"#
+        );
+        crate::scene::parse_world(&text, None).unwrap()
+    }
+
+    fn cut(w: &WorldScene, force: Option<bool>) -> Result<Shadowed, SceneError> {
+        let (tris, _) = project(w, Shading::Flat)?;
+        let (fragments, _) = crate::visibility::exact_fragments(&tris, 1);
+        shadowed(
+            w,
+            Shading::Flat,
+            &tris,
+            fragments,
+            &casters(&w.spec, force)?,
+            1,
+        )
+    }
+
+    fn area(v: &[Pt]) -> f64 {
+        crate::boolean::area(v)
+    }
+
+    #[test]
+    fn a_light_overhead_shadows_the_floor_under_the_box_exactly() {
+        let w = scene(r#"[{"position": [0, 10, 0], "intensity": 0.8, "shadows": true}]"#);
+        let s = cut(&w, None).unwrap();
+        assert_eq!(s.stats.lights, 1);
+        // the shadow on the floor: the box's top square projected from the light onto
+        // y = 0, scaled by 10 / (10 − 1.2), then projected by the camera
+        let camera = Camera::new(&w.spec.camera, 40, 30);
+        let half = 0.5 * 10.0 / 8.8;
+        let square: Vec<Pt> = [[-half, -half], [half, -half], [half, half], [-half, half]]
+            .iter()
+            .map(|&[x, z]| camera.project(DVec3::new(x, 0.0, z)))
+            .collect();
+        // the floor's shadowed pieces and the box's front face hiding part of it: the
+        // floor's shadow plus its lit part add up to the floor's visible area
+        let floor: Vec<usize> = (0..s.fragments.len())
+            .filter(|&k| s.fragments[k].source < 2)
+            .collect();
+        let dark: f64 = floor
+            .iter()
+            .filter(|&&k| !s.lit[k].has(0))
+            .map(|&k| area(&s.fragments[k].polygon.vertices))
+            .sum();
+        assert!(
+            dark > 0.0 && dark < area(&square),
+            "{dark} {}",
+            area(&square)
+        );
+        // every shadowed floor piece lies within the projected square
+        let sign = {
+            let [a, b, c, _] = [square[0], square[1], square[2], square[3]];
+            ((b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1])).signum()
+        };
+        for &k in &floor {
+            if !s.lit[k].has(0) {
+                for p in &s.fragments[k].polygon.vertices {
+                    let inside = (0..4).all(|e| {
+                        let (a, b) = (square[e], square[(e + 1) % 4]);
+                        let cross = (b[0] - a[0]) * (p[1] - a[1]) - (p[0] - a[0]) * (b[1] - a[1]);
+                        cross.abs() <= 1e-9 || cross.signum() == sign
+                    });
+                    assert!(inside, "{p:?} {square:?}");
+                }
+            }
+        }
+        // the floor's shadow has the ambient term alone, its lit part more
+        let ambient = 0.2 * 0.5;
+        for k in &floor {
+            let v = s.fragments[*k].polygon.intensity[0][0];
+            if !s.lit[*k].has(0) {
+                assert_eq!(v, ambient);
+            } else {
+                assert!(v > ambient);
+            }
+        }
+        // the same scene without shadows: the fragments as they came, all lit
+        let plain = cut(&w, Some(false)).unwrap();
+        assert!(plain.lit.iter().all(|&l| l == LightSet::ALL));
+        assert_eq!(plain.stats.shadow_polygons, 0);
+    }
+
+    #[test]
+    fn lights_that_cannot_see_the_scene_in_one_view_are_refused_where_they_are() {
+        // inside the box: the scene surrounds it
+        let w = scene(r#"[{"position": [0, 0.7, 0], "intensity": 0.8, "shadows": true}]"#);
+        let e = cut(&w, None).unwrap_err();
+        assert_eq!(e.field.as_deref(), Some("lights[0].position"), "{e}");
+        assert!(e.to_string().contains("move it outside the objects"), "{e}");
+        // on a vertex of the box
+        let w = scene(r#"[{"position": [0.5, 1.2, 0.5], "intensity": 0.8, "shadows": true}]"#);
+        let e = cut(&w, None).unwrap_err();
+        assert!(e.to_string().contains("on a vertex of the scene"), "{e}");
+        // the same lights without shadows draw as before
+        assert!(cut(&w, Some(false)).is_ok());
+    }
+
+    #[test]
+    fn more_casters_than_a_light_set_holds_are_refused_at_the_first_beyond() {
+        let one = r#"{"position": [0, 10, 0], "intensity": 0.01, "shadows": true}"#;
+        let lights = format!("[{}]", vec![one; MAX_CASTERS + 1].join(", "));
+        let w = scene(&lights);
+        let e = casters(&w.spec, None).unwrap_err();
+        assert_eq!(e.field.as_deref(), Some("lights[64].shadows"), "{e}");
+        assert!(
+            e.to_string().contains("65 lights cast shadows; at most 64"),
+            "{e}"
+        );
+        assert_eq!(casters(&w.spec, Some(false)).unwrap().lights.len(), 0);
+    }
+}
