@@ -363,8 +363,8 @@ pub struct DrawArgs {
     pub phong_angle: Threshold,
     /// Shadows from every light (on) or from none (off), whatever each light's
     /// "shadows" entry in the scene says [default: as the scene says]. Exact shadow
-    /// polygons, cut from the visible surfaces with the light as the eye (vanrij; the
-    /// other renderers refuse on).
+    /// polygons, cut from the visible surfaces with the light as the eye (vanrij, refine),
+    /// or the same lit parts tested at each sample (woo-chall, sbuffer, bsp).
     #[arg(long, value_enum, value_name = "on|off")]
     pub shadows: Option<ShadowsArg>,
 }

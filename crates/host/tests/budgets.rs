@@ -162,3 +162,25 @@ fn a_waveform_past_the_budget_is_refused() {
     );
     assert!(out.status.success(), "{:?}", text(&out));
 }
+
+#[test]
+fn a_shadow_pass_past_the_budget_is_refused_before_any_light_s_view() {
+    let dir = scratch("budget-shadows");
+    let out = cwisim_env(
+        &dir,
+        &[("CWISIM_MAX_MEMORY", "4M")],
+        &["render", "teapot", "--shadows", "on", "-o", "t.png"],
+    );
+    refused(
+        &out,
+        "the shadow pass (4032 triangles seen from 1 light(s))",
+    );
+    assert!(!dir.join("t.png").exists());
+    // without shadows it fits
+    let out = cwisim_env(
+        &dir,
+        &[("CWISIM_MAX_MEMORY", "4M")],
+        &["render", "teapot", "-o", "t.png"],
+    );
+    assert!(out.status.success(), "{:?}", text(&out));
+}

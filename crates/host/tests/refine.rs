@@ -192,7 +192,10 @@ fn bad_input_is_refused_in_one_line_with_exit_2() {
     for (args, says) in [
         (vec!["--phases", "gouraud,flat"], "--phases"),
         (vec!["--phases", "flat,vertices"], "out of order"),
-        (vec!["--phases", "flat,shadows"], "not built"),
+        (
+            vec!["--phases", "flat,shadows"],
+            "no light of the scene casts shadows",
+        ),
         (vec!["--phong-angle", "270"], "--phong-angle is an angle"),
         (vec!["--aa-threshold", "lots"], "expected `all`, `none`"),
         (vec!["--sweep", "size=1,2"], "unknown threshold `size`"),

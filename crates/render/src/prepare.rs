@@ -118,12 +118,13 @@ pub fn refuse_shadows(
     }
 }
 
-/// Refuses a `--shadows` that would change nothing: `on` in a scene without lights,
-/// `off` in one where no light casts shadows.
-fn check_shadows_flag(
+/// The lights of world scene `w` that cast shadows under `settings`, refusing a
+/// `--shadows` that would change nothing: `on` in a scene without lights, `off` in one
+/// where no light casts shadows.
+pub(crate) fn world_casters(
     w: &cwisim_world::WorldScene,
     settings: &Settings,
-) -> Result<(), RenderError> {
+) -> Result<Casters, RenderError> {
     let lights = &w.spec.lights;
     match settings.shadows {
         Some(true) if lights.is_empty() => Err(RenderError::Usage(
@@ -132,7 +133,7 @@ fn check_shadows_flag(
         Some(false) if !lights.iter().any(|l| l.shadows) => Err(RenderError::Usage(
             "--shadows off: no light of the scene casts shadows (none says \"shadows\": true), so it would draw exactly as without".into(),
         )),
-        _ => Ok(()),
+        _ => Ok(shadow::casters(&w.spec, settings.shadows)?),
     }
 }
 
@@ -238,8 +239,7 @@ impl PolygonScene {
                 let start = Instant::now();
                 let (tris, project) = cwisim_world::project::project(&w, settings.shading)?;
                 prepared.transform_time = start.elapsed();
-                check_shadows_flag(&w, settings)?;
-                let casters = shadow::casters(&w.spec, settings.shadows)?;
+                let casters = world_casters(&w, settings)?;
                 let start = Instant::now();
                 let (polygons, vis) = if phong || !casters.is_empty() {
                     // the fragments with their source triangles: per-pixel shading and

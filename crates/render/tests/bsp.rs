@@ -42,10 +42,19 @@ fn by_name(renderer: &str, scene: &str, s: &Settings) -> (Vec<f64>, Counters, u6
     draw(&*(registry::find(renderer).unwrap().build)(loaded(scene, s), s).unwrap())
 }
 
+/// With and without shadows (every light casting).
 #[test]
 fn every_mode_draws_what_the_s_buffer_and_exact_visibility_draw() {
-    for scene in ["still-life", "pot"] {
-        let s = flat_one_sample();
+    for (scene, shadows) in [
+        ("still-life", None),
+        ("pot", None),
+        ("still-life", Some(true)),
+        ("pot", Some(true)),
+    ] {
+        let s = Settings {
+            shadows,
+            ..flat_one_sample()
+        };
         let (sbuffer, _, _) = by_name("sbuffer", scene, &s);
         let vr = Settings {
             aa: Antialias::None,

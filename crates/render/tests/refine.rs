@@ -141,9 +141,11 @@ fn every_threshold_at_all_gives_van_rijs_phong_box_filter_bit_for_bit() {
             );
             self::run(&*r, 1).frames.remove(0)
         };
-        assert_eq!(bits(&run.frames[1]), bits(&point(Shading::Gouraud)));
+        // (with a light casting shadows, the shadow phase would come second)
+        let gouraud = run.frames.len() - 3;
+        assert_eq!(bits(&run.frames[gouraud]), bits(&point(Shading::Gouraud)));
         // and the Phong phase lights every polygon per pixel: van Rij's Phong, sampled
-        assert_eq!(bits(&run.frames[2]), bits(&point(Shading::Phong)));
+        assert_eq!(bits(&run.frames[gouraud + 1]), bits(&point(Shading::Phong)));
         // nothing was masked: every pixel box-filtered
         assert_eq!(run.counters.get("aa_masks"), Some(0));
         let h = r.header();
@@ -152,6 +154,72 @@ fn every_threshold_at_all_gives_van_rijs_phong_box_filter_bit_for_bit() {
             Some(u64::from(h.width) * u64::from(h.lines))
         );
     }
+}
+
+/// With every light casting shadows: the shadow phase follows the flat one and darkens
+/// exactly the shadow polygons, and every later phase draws what `vanrij` draws with
+/// the same shadows, bit for bit.
+#[test]
+fn the_shadow_phase_darkens_the_flat_frame_and_later_phases_keep_the_shadows() {
+    let shadows = Settings {
+        shadows: Some(true),
+        ..thresholds(Threshold::All, Threshold::All, Threshold::All)
+    };
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    let r = Refine::new(scene("still-life", 96), &shadows).unwrap();
+    assert_eq!(
+        r.phases(),
+        [
+            Phase::Flat,
+            Phase::Shadows,
+            Phase::Gouraud,
+            Phase::Phong,
+            Phase::Antialias
+        ]
+    );
+    let run = run(&r, 1);
+    let (flat, shadowed) = (&run.frames[0], &run.frames[1]);
+    assert!(shadowed.iter().zip(flat).all(|(s, f)| s <= f));
+    let darker = shadowed.iter().zip(flat).filter(|(s, f)| s < f).count();
+    assert!(darker > 300, "{darker} samples darker");
+    assert!(run.counters.get("shadows_polygons").unwrap() > 0);
+    let vanrij = |shading, aa| {
+        let r = build(
+            "vanrij",
+            scene("still-life", 96),
+            &Settings {
+                aa,
+                shading,
+                shadows: Some(true),
+                ..Settings::default()
+            },
+        );
+        self::run(&*r, 1).frames.remove(0)
+    };
+    assert_eq!(
+        bits(&run.frames[2]),
+        bits(&vanrij(Shading::Gouraud, Antialias::None))
+    );
+    assert_eq!(
+        bits(&run.frames[3]),
+        bits(&vanrij(Shading::Phong, Antialias::None))
+    );
+    assert_eq!(
+        bits(&run.frames[4]),
+        bits(&vanrij(Shading::Phong, Antialias::Box))
+    );
+    // without a light casting, no shadow phase can be asked for
+    let e = Refine::with_phases(
+        scene("pot", 32),
+        &Settings::default(),
+        &[Phase::Flat, Phase::Shadows],
+    )
+    .unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("no light of the scene casts shadows"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -228,7 +296,8 @@ fn aa_flags_are_the_3x3_range_of_the_previous_output_and_the_rest_is_kept() {
         let h = r.header();
         let (w, lines, ch) = (h.width as usize, h.lines as usize, h.channel_count());
         let run = run(&*r, 1);
-        let flags = brute_flags(&run.frames[2], w, lines, ch, t);
+        // the frame before the anti-aliasing one (the last)
+        let flags = brute_flags(&run.frames[run.frames.len() - 2], w, lines, ch, t);
         let flagged = flags.iter().filter(|&&f| f).count();
         assert!(
             flagged > 0 && flagged < w * lines,
@@ -242,12 +311,13 @@ fn aa_flags_are_the_3x3_range_of_the_previous_output_and_the_rest_is_kept() {
         // a flagged pixel holds the display list's box filter (every pixel filtered)
         let filtered = build("refine", scene(name, 80), &some(Threshold::All));
         let filtered = self::run(&*filtered, 1).frames.pop().unwrap();
+        let (last, before) = (run.frames.len() - 1, run.frames.len() - 2);
         for (p, &f) in flags.iter().enumerate() {
-            let got = &run.frames[3][p * ch..(p + 1) * ch];
+            let got = &run.frames[last][p * ch..(p + 1) * ch];
             let want = if f {
                 &filtered[p * ch..(p + 1) * ch]
             } else {
-                &run.frames[2][p * ch..(p + 1) * ch]
+                &run.frames[before][p * ch..(p + 1) * ch]
             };
             assert_eq!(bits(got), bits(want), "{name}: pixel {p} (flagged: {f})");
         }
@@ -612,7 +682,8 @@ fn phase_lists_are_checked() {
         ("flat,phong,gouraud", "out of order"),
         ("flat,flat", "out of order"),
         ("vertices,gouraud", "list `flat` before it"),
-        ("flat,shadows", "shadow phase is not built"),
+        ("shadows,flat", "list `flat` before it"),
+        ("flat,gouraud,shadows", "out of order"),
         ("flat,ray-tracing", "unknown phase `ray-tracing`"),
         ("", "unknown phase ``"),
     ] {

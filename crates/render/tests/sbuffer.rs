@@ -189,10 +189,19 @@ fn without_depth_a_later_polygon_is_in_front() {
     assert_eq!(c.get("visible_runs"), Some(2 * 4));
 }
 
+/// With and without shadows (every light casting).
 #[test]
 fn sbuffer_equals_vanrij_exact_visibility_on_flat_world_scenes() {
-    for scene in ["still-life", "pot"] {
-        let s = one_sample(Shading::Flat);
+    for (scene, shadows) in [
+        ("still-life", None),
+        ("pot", None),
+        ("still-life", Some(true)),
+        ("pot", Some(true)),
+    ] {
+        let s = Settings {
+            shadows,
+            ..one_sample(Shading::Flat)
+        };
         let (sb, c) = embedded(scene, &s, "sbuffer");
         let vr = Settings {
             aa: cwisim_scene::Antialias::None,
@@ -200,7 +209,7 @@ fn sbuffer_equals_vanrij_exact_visibility_on_flat_world_scenes() {
             ..s
         };
         let (vanrij, _) = embedded(scene, &vr, "vanrij");
-        assert_eq!(sb, vanrij, "{scene}");
+        assert_eq!(sb, vanrij, "{scene}, shadows {shadows:?}");
         assert!(c.get("pixels_overwritten").unwrap() > 0);
         // and the study mode draws the same image, bit for bit
         let od = Settings {
@@ -208,7 +217,7 @@ fn sbuffer_equals_vanrij_exact_visibility_on_flat_world_scenes() {
             ..s
         };
         let (overdraw, oc) = embedded(scene, &od, "sbuffer");
-        assert_eq!(overdraw, sb, "{scene} overdraw");
+        assert_eq!(overdraw, sb, "{scene} overdraw, shadows {shadows:?}");
         assert!(oc.get("undo_runs").unwrap() > 0);
         assert!(oc.get("instructions") > c.get("instructions"));
     }

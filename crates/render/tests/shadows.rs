@@ -13,7 +13,7 @@ use glam::DVec3;
 
 mod common;
 use common::raycast::{hits, ray, Hit};
-use common::rendered;
+use common::{rendered, rendered_by};
 
 fn world(text: &str) -> WorldScene {
     common::world(text, None)
@@ -24,14 +24,29 @@ fn still_life() -> WorldScene {
     common::world(embedded("still-life").unwrap().text, Some((192, 128)))
 }
 
-fn settings(shading: Shading, shadows: bool) -> Settings {
+/// Point sampling at the pixel centres, as `renderer` is told it: `--aa none` for
+/// `vanrij`, one sample per pixel for the others.
+fn settings(renderer: &str, shading: Shading, shadows: bool) -> Settings {
+    let point = if renderer == "vanrij" {
+        Settings {
+            aa: Antialias::None,
+            ..Settings::default()
+        }
+    } else {
+        Settings {
+            samples: 1,
+            ..Settings::default()
+        }
+    };
     Settings {
         shading,
-        aa: Antialias::None,
         shadows: Some(shadows),
-        ..Settings::default()
+        ..point
     }
 }
+
+/// The renderers that draw shadows.
+const RENDERERS: [&str; 4] = ["vanrij", "woo-chall", "sbuffer", "bsp"];
 
 /// How close to an edge (in barycentric terms) a ray may pass and still be called.
 const MARGIN: f64 = 1e-6;
@@ -130,24 +145,54 @@ fn reference(w: &WorldScene, shading: Shading, x: f64, y: f64) -> Result<Option<
 }
 
 /// Point-sampled, the shadows are the ray caster's at every pixel it can call, on
-/// `still-life` with both its lights casting, flat and Gouraud.
+/// `still-life` with both its lights casting, flat and Gouraud, from every renderer that
+/// draws them.
 #[test]
 fn point_sampled_shadows_are_the_ray_caster_s() {
     let w = still_life();
     let (width, height) = (w.width(), w.height());
     let channels = w.channels();
+    // the reference once per shading, every renderer against it
     for shading in [Shading::Flat, Shading::Gouraud] {
-        let image = rendered(&w, &settings(shading, true));
+        let mut seen = Vec::new();
+        for py in 0..height {
+            for px in 0..width {
+                seen.push(reference(
+                    &w,
+                    shading,
+                    f64::from(px) + 0.5,
+                    f64::from(py) + 0.5,
+                ));
+            }
+        }
+        for renderer in RENDERERS {
+            let image = rendered_by(renderer, &w, &settings(renderer, shading, true));
+            against(&image, &seen, width, height, channels, shading, renderer);
+        }
+    }
+}
+
+/// Holds `image` to the reference at every pixel it can call.
+fn against(
+    image: &[f64],
+    seen: &[Result<Option<Seen>, ()>],
+    width: u32,
+    height: u32,
+    channels: usize,
+    shading: Shading,
+    renderer: &str,
+) {
+    {
         let (mut checked, mut shadowed) = (0, [0usize; 2]);
         for py in 0..height {
             for px in 0..width {
-                let Ok(seen) = reference(&w, shading, f64::from(px) + 0.5, f64::from(py) + 0.5)
-                else {
+                let Ok(seen) = &seen[(py * width + px) as usize] else {
                     continue;
                 };
                 let k = (py * width + px) as usize * channels;
                 let got = &image[k..k + channels];
-                let (expected, reach) = seen.unwrap_or((vec![0.0; channels], vec![true; 2]));
+                let (expected, reach) =
+                    seen.clone().unwrap_or((vec![0.0; channels], vec![true; 2]));
                 let tolerance = if shading == Shading::Flat {
                     1e-12
                 } else {
@@ -157,7 +202,7 @@ fn point_sampled_shadows_are_the_ray_caster_s() {
                     got.iter()
                         .zip(&expected)
                         .all(|(g, e)| (g - e).abs() <= tolerance),
-                    "{shading:?} pixel ({px}, {py}): {got:?}, the ray caster {expected:?} (lights reaching: {reach:?})"
+                    "{renderer} {shading:?} pixel ({px}, {py}): {got:?}, the ray caster {expected:?} (lights reaching: {reach:?})"
                 );
                 checked += 1;
                 for (l, r) in reach.iter().enumerate() {
@@ -330,8 +375,9 @@ mod analytic {
 /// the one that does; `--shadows` that would change nothing is refused.
 #[test]
 fn shadows_that_would_be_dropped_or_a_flag_that_changes_nothing_are_refused() {
+    // still-life with its main light casting shadows
     let text = embedded("still-life").unwrap().text;
-    let casting = text.replacen(
+    let casting = &text.replacen(
         r#""intensity": [0.8, 0.78, 0.72] }"#,
         r#""intensity": [0.8, 0.78, 0.72], "shadows": true }"#,
         1,
@@ -341,26 +387,35 @@ fn shadows_that_would_be_dropped_or_a_flag_that_changes_nothing_are_refused() {
         let loaded = LoadedScene::built("test", AnyScene::World(world(text)));
         (registry::find(name).unwrap().build)(loaded, settings).map(|_| ())
     };
-    for name in ["woo-chall", "sbuffer", "bsp", "refine"] {
-        let e = build(name, &casting, &Settings::default()).unwrap_err();
-        assert_eq!(
-            e.to_string(),
-            format!("{name} does not draw shadows, and the scene's lights[0] casts them (\"shadows\": true): use --renderer vanrij (exact shadow polygons), or set \"shadows\": false"),
-        );
-        assert!(build(name, text, &Settings::default()).is_ok(), "{name}");
+    let teapot = embedded("teapot").unwrap().text;
+    let casting_teapot = teapot.replacen(
+        r#""intensity": 0.85 }"#,
+        r#""intensity": 0.85, "shadows": true }"#,
+        1,
+    );
+    assert_ne!(casting_teapot, teapot);
+    let e = build("nishita", &casting_teapot, &Settings::default()).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "nishita does not draw shadows, and the scene's lights[0] casts them (\"shadows\": true): use --renderer vanrij (exact shadow polygons), or set \"shadows\": false",
+    );
+    assert!(build("nishita", teapot, &Settings::default()).is_ok());
+    for name in RENDERERS.into_iter().chain(["refine"]) {
+        assert!(build(name, casting, &Settings::default()).is_ok(), "{name}");
     }
-    assert!(build("vanrij", &casting, &Settings::default()).is_ok());
     let off = Settings {
         shadows: Some(false),
         ..Settings::default()
     };
-    assert!(build("vanrij", &casting, &off).is_ok());
-    let e = build("vanrij", text, &off).unwrap_err();
-    assert!(
-        e.to_string()
-            .starts_with("--shadows off: no light of the scene casts shadows"),
-        "{e}"
-    );
+    assert!(build("vanrij", casting, &off).is_ok());
+    for name in RENDERERS {
+        let e = build(name, text, &off).unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("--shadows off: no light of the scene casts shadows"),
+            "{name}: {e}"
+        );
+    }
     let dark = r#"{"kind": "world", "width": 8, "height": 8, "channels": 1,
 "camera": {"eye": [0, 0, 5], "target": [0, 0, 0], "fov_y": 40}, "ambient": 0.5, "lights": [],
 "meshes": [{"material": {"k_a": 1, "k_d": 0, "k_s": 0, "n": 1},
@@ -369,10 +424,12 @@ fn shadows_that_would_be_dropped_or_a_flag_that_changes_nothing_are_refused() {
         shadows: Some(true),
         ..Settings::default()
     };
-    let e = build("vanrij", dark, &on).unwrap_err();
-    assert!(
-        e.to_string()
-            .starts_with("--shadows on: the scene has no lights"),
-        "{e}"
-    );
+    for name in RENDERERS {
+        let e = build(name, dark, &on).unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("--shadows on: the scene has no lights"),
+            "{name}: {e}"
+        );
+    }
 }

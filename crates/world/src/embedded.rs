@@ -35,6 +35,11 @@ pub const EMBEDDED: &[Embedded] = &[
         text: include_str!("../scenes/still-life.json"),
     },
     Embedded {
+        name: "bowl",
+        about: "world, RGB: a red ball above a shallow bowl and a blue cone in it; the one light casts shadows, the ball's onto the bowl's curved inside",
+        text: include_str!("../scenes/bowl.json"),
+    },
+    Embedded {
         name: "teapot",
         about: "world, grey, 500×500 as in Nishita et al.: the Utah teapot, Newell's 32 bicubic Bézier patches with Crow's bottom, tessellated 8×8 per patch, two-sided (its inside shows through the lid gap)",
         text: include_str!("../scenes/teapot.json"),

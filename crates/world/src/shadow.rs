@@ -58,6 +58,12 @@ pub const MAX_CASTERS: usize = 64;
 /// that the visibility's area thresholds (1e-12 px²) mean there what they mean on screen.
 const LIGHT_VIEW_SIDE: u32 = 2048;
 
+/// Memory per triangle of one light's view: the projected triangle and what exact
+/// visibility holds for it (about 1 kB per triangle, docs/PERFORMANCE.md).
+const VIEW_BYTES_PER_TRIANGLE: u64 = 1536;
+/// Memory per triangle and light of the lit parts kept.
+const LIT_BYTES_PER_TRIANGLE: u64 = 128;
+
 /// The smallest cosine between a vertex's direction from a light and the light view's
 /// axis: a light must see the scene within a cone under 170°.
 const MIN_COS: f64 = 0.087_155_742_747_658_17; // cos 85°
@@ -325,6 +331,178 @@ fn world_at(t: &ScreenTriangle, q: Pt) -> DVec3 {
     (w[0] * s[0] + w[1] * s[1] + w[2] * s[2]) / sum
 }
 
+/// How a light reaches one camera triangle.
+#[derive(Clone, Debug, PartialEq)]
+enum Reach {
+    /// All of it.
+    All,
+    /// None of it.
+    Nothing,
+    /// The parts it sees, on the camera's screen (disjoint simple polygons, positive).
+    Parts(Shape),
+}
+
+/// What every shadow-casting light reaches of every camera triangle, on the screen: what
+/// [`shadowed`] cuts fragments with, and what a renderer that samples points asks at each
+/// sample ([`ShadowTest::lit_at`]) — the same lit parts, so the two agree.
+#[derive(Clone, Debug)]
+pub struct ShadowTest {
+    casters: Casters,
+    /// Per camera triangle, per caster.
+    reach: Vec<Vec<Reach>>,
+    /// Per camera triangle, flat shading's centroid (`None`: Gouraud or Phong).
+    centroids: Vec<Option<DVec3>>,
+    lighting: Lighting,
+    materials: Vec<crate::scene::Material>,
+    eye: DVec3,
+    /// Triangles in the lights' views, over all lights.
+    pub light_triangles: u64,
+    /// Fragments the lights see, over all lights.
+    pub light_fragments: u64,
+}
+
+impl ShadowTest {
+    /// The lit parts of the camera's triangles `tris` (made by [`crate::project::project`]
+    /// of `scene` under `shading`) for every light of `casters`; the lights' views run on
+    /// `threads` threads (0: one per core). A light that cannot see the scene in one view
+    /// is refused at `lights[k].position` (see the [module docs](self)).
+    pub fn new(
+        scene: &WorldScene,
+        shading: Shading,
+        tris: &[ScreenTriangle],
+        casters: &Casters,
+        threads: usize,
+    ) -> Result<ShadowTest, SceneError> {
+        let spec = &scene.spec;
+        let camera = Camera::new(&spec.camera, scene.width(), scene.height());
+        let mut test = ShadowTest {
+            casters: casters.clone(),
+            reach: vec![Vec::with_capacity(casters.lights.len()); tris.len()],
+            centroids: tris
+                .iter()
+                .map(|t| {
+                    (shading == Shading::Flat)
+                        .then(|| face_centroid(&scene.meshes[t.mesh as usize], t.face as usize))
+                })
+                .collect(),
+            lighting: Lighting {
+                ambient: spec.ambient.clone(),
+                lights: spec.lights.clone(),
+                channels: scene.channels(),
+            },
+            materials: spec.meshes.iter().map(|m| m.material.clone()).collect(),
+            eye: camera.eye,
+            light_triangles: 0,
+            light_fragments: 0,
+        };
+        if casters.is_empty() {
+            return Ok(test);
+        }
+        let world = world_triangles(scene);
+        // one light's view at a time (its triangles and exact visibility's work), and
+        // every light's lit parts kept: refused before any is made when over the budget
+        let bytes = (world.len() as u64)
+            .saturating_mul(VIEW_BYTES_PER_TRIANGLE.saturating_add(
+                LIT_BYTES_PER_TRIANGLE.saturating_mul(casters.lights.len() as u64),
+            ));
+        cwisim_scene::budget::Budget::current()
+            .check_memory(
+                &format!(
+                    "the shadow pass ({} triangles seen from {} light(s))",
+                    world.len(),
+                    casters.lights.len()
+                ),
+                bytes,
+            )
+            .map_err(|e| SceneError::at_field(SceneErrorKind::Limit, "lights", e.to_string()))?;
+        // camera triangle → light-view triangle: the same mesh, face and corners
+        let mut by_face: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
+        for (j, (mesh, face, _)) in world.iter().enumerate() {
+            by_face.entry((*mesh, *face)).or_default().push(j);
+        }
+        let light_index: Vec<Option<usize>> = tris
+            .iter()
+            .map(|t| {
+                by_face
+                    .get(&(t.mesh, t.face))
+                    .and_then(|js| js.iter().copied().find(|&j| world[j].2 == t.surface.world))
+            })
+            .collect();
+        for &k in &casters.lights {
+            let view = LightView::new(spec, k, &world, threads)?;
+            test.light_triangles += view.tris.len() as u64;
+            test.light_fragments += view.fragments.len() as u64;
+            for (reach, j) in test.reach.iter_mut().zip(&light_index) {
+                reach.push(match j.map(|j| (j, view.whole(j))) {
+                    // not a face of the scene's meshes: nothing in the light's view to
+                    // shadow it by (never made by `project`)
+                    None => Reach::All,
+                    Some((_, Some(true))) => Reach::All,
+                    Some((_, Some(false))) => Reach::Nothing,
+                    Some((j, None)) => Reach::Parts(view.lit_on_screen(j, &camera)),
+                });
+            }
+        }
+        Ok(test)
+    }
+
+    /// The lights that cast shadows.
+    pub fn casters(&self) -> &Casters {
+        &self.casters
+    }
+
+    /// The casters that reach camera triangle `k` at screen point `p` (a point on an edge
+    /// of a lit part counts as lit).
+    pub fn lit_at(&self, k: usize, p: Pt) -> LightSet {
+        let mut set = LightSet::ALL;
+        for (i, reach) in self.reach[k].iter().enumerate() {
+            let lit = match reach {
+                Reach::All => true,
+                Reach::Nothing => false,
+                Reach::Parts(parts) => parts.iter().any(|c| inside(c, p)),
+            };
+            if !lit {
+                set = set.without(i);
+            }
+        }
+        set
+    }
+
+    /// Camera triangle `t` (number `k`)'s corner intensities by the lights of `set`
+    /// ([`crate::project::lit_corners`]; `project`'s own when every light reaches).
+    pub fn corners(&self, k: usize, t: &ScreenTriangle, set: LightSet) -> [Vector; 3] {
+        lit_corners(
+            &self.lighting,
+            &self.materials[t.mesh as usize],
+            self.centroids[k],
+            &t.surface,
+            self.eye,
+            |l| self.casters.reaches(set, l),
+        )
+    }
+}
+
+/// Whether `p` is inside the closed contour `c` or on its boundary (crossings of the
+/// horizontal ray to the right, half-open in y; a point on an edge counts as inside).
+fn inside(c: &[Pt], p: Pt) -> bool {
+    let mut odd = false;
+    for e in 0..c.len() {
+        let (a, b) = (c[e], c[(e + 1) % c.len()]);
+        let cross = (b[0] - a[0]) * (p[1] - a[1]) - (p[0] - a[0]) * (b[1] - a[1]);
+        let within = |u: f64, v: f64, w: f64| u.min(v) <= w && w <= u.max(v);
+        if cross == 0.0 && within(a[0], b[0], p[0]) && within(a[1], b[1], p[1]) {
+            return true;
+        }
+        if (a[1] > p[1]) != (b[1] > p[1]) {
+            let x = a[0] + (p[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]);
+            if p[0] < x {
+                odd = !odd;
+            }
+        }
+    }
+    odd
+}
+
 /// Cuts the camera's `fragments` of the screen triangles `tris` (made by
 /// [`crate::project::project`] of `scene` under `shading`) into the pieces each set of
 /// the `casters` reaches, shaded accordingly (see the [module docs](self)). The lights'
@@ -337,7 +515,6 @@ pub fn shadowed(
     casters: &Casters,
     threads: usize,
 ) -> Result<Shadowed, SceneError> {
-    let spec = &scene.spec;
     let channels = scene.channels();
     let mut stats = ShadowStats {
         lights: casters.lights.len() as u64,
@@ -353,34 +530,9 @@ pub fn shadowed(
             stats,
         });
     }
-    let world = world_triangles(scene);
-    // camera triangle → light-view triangle: the same mesh, face and corners
-    let mut by_face: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
-    for (j, (mesh, face, _)) in world.iter().enumerate() {
-        by_face.entry((*mesh, *face)).or_default().push(j);
-    }
-    let light_index: Vec<usize> = tris
-        .iter()
-        .map(|t| {
-            by_face
-                .get(&(t.mesh, t.face))
-                .and_then(|js| js.iter().copied().find(|&j| world[j].2 == t.surface.world))
-                .unwrap_or(usize::MAX)
-        })
-        .collect();
-    let mut views = Vec::with_capacity(casters.lights.len());
-    for &k in &casters.lights {
-        let view = LightView::new(spec, k, &world, threads)?;
-        stats.light_triangles += view.tris.len() as u64;
-        stats.light_fragments += view.fragments.len() as u64;
-        views.push(view);
-    }
-    let camera = Camera::new(&spec.camera, scene.width(), scene.height());
-    let lighting = Lighting {
-        ambient: spec.ambient.clone(),
-        lights: spec.lights.clone(),
-        channels,
-    };
+    let test = ShadowTest::new(scene, shading, tris, casters, threads)?;
+    stats.light_triangles = test.light_triangles;
+    stats.light_fragments = test.light_fragments;
     let grid = grid_for(tris.iter().flat_map(|t| t.points));
     let mut losses = Losses::default();
     let mut out = Shadowed {
@@ -388,48 +540,28 @@ pub fn shadowed(
         lit: Vec::with_capacity(fragments.len()),
         stats: ShadowStats::default(),
     };
-    // the lit parts of the current source triangle on the screen, per light (made once
-    // per triangle: its fragments come together)
-    let mut lit_source = usize::MAX;
-    let mut lit_parts: Vec<Option<Shape>> = Vec::new();
-    let mut wholly: Vec<Option<bool>> = Vec::new();
+    // the corner intensities per light set of the current source triangle (its
+    // fragments come together)
+    let mut relit_source = usize::MAX;
     let mut relit: HashMap<LightSet, [Vector; 3]> = HashMap::new();
     for fragment in fragments {
-        let t = &tris[fragment.source];
-        let j = light_index[fragment.source];
-        if fragment.source != lit_source {
-            lit_source = fragment.source;
+        let k = fragment.source;
+        let t = &tris[k];
+        if k != relit_source {
+            relit_source = k;
             relit.clear();
-            wholly = views
-                .iter()
-                .map(|v| {
-                    if j == usize::MAX {
-                        Some(true)
-                    } else {
-                        v.whole(j)
-                    }
-                })
-                .collect();
-            lit_parts = views
-                .iter()
-                .zip(&wholly)
-                .map(|(v, w)| w.is_none().then(|| v.lit_on_screen(j, &camera)))
-                .collect();
         }
         let mut pieces: Vec<(Contour, LightSet)> =
             vec![(fragment.polygon.vertices.clone(), LightSet::ALL)];
-        for (i, whole) in wholly.iter().enumerate() {
-            match whole {
-                Some(true) => {}
-                Some(false) => {
+        for (i, reach) in test.reach[k].iter().enumerate() {
+            match reach {
+                Reach::All => {}
+                Reach::Nothing => {
                     for piece in &mut pieces {
                         piece.1 = piece.1.without(i);
                     }
                 }
-                None => {
-                    let lit = lit_parts[i]
-                        .as_ref()
-                        .expect("made for a partly lit triangle");
+                Reach::Parts(lit) => {
                     let mut next = Vec::with_capacity(pieces.len() * 2);
                     for (contour, set) in pieces {
                         let subject = vec![positive(contour)];
@@ -456,14 +588,7 @@ pub fn shadowed(
             continue;
         }
         for (contour, set) in pieces {
-            let corners = *relit.entry(set).or_insert_with(|| {
-                let material = &spec.meshes[t.mesh as usize].material;
-                let centroid = (shading == Shading::Flat)
-                    .then(|| face_centroid(&scene.meshes[t.mesh as usize], t.face as usize));
-                lit_corners(&lighting, material, centroid, &t.surface, camera.eye, |k| {
-                    casters.reaches(set, k)
-                })
-            });
+            let corners = *relit.entry(set).or_insert_with(|| test.corners(k, t, set));
             let shaded = ScreenTriangle {
                 intensity: corners,
                 ..*t
@@ -478,7 +603,7 @@ pub fn shadowed(
                 })
                 .collect();
             out.fragments.push(Fragment {
-                source: fragment.source,
+                source: k,
                 polygon: Polygon::new(contour, intensity),
             });
             out.lit.push(set);
@@ -592,6 +717,37 @@ mod tests {
         let plain = cut(&w, Some(false)).unwrap();
         assert!(plain.lit.iter().all(|&l| l == LightSet::ALL));
         assert_eq!(plain.stats.shadow_polygons, 0);
+    }
+
+    #[test]
+    fn the_test_at_a_point_agrees_with_the_pieces_cut() {
+        let w = scene(
+            r#"[{"position": [0, 10, 0], "intensity": 0.8, "shadows": true},
+                {"position": [-6, 3, 1], "intensity": 0.3},
+                {"position": [5, 4, 4], "intensity": 0.5, "shadows": true}]"#,
+        );
+        let (tris, _) = project(&w, Shading::Gouraud).unwrap();
+        let casters = casters(&w.spec, None).unwrap();
+        assert_eq!(casters.lights, [0, 2]);
+        let (fragments, _) = crate::visibility::exact_fragments(&tris, 1);
+        let s = shadowed(&w, Shading::Gouraud, &tris, fragments, &casters, 1).unwrap();
+        let test = ShadowTest::new(&w, Shading::Gouraud, &tris, &casters, 1).unwrap();
+        let mut sets = std::collections::BTreeSet::new();
+        for (f, &set) in s.fragments.iter().zip(&s.lit) {
+            // a point well inside the piece: its first fan triangle's centroid
+            let v = &f.polygon.vertices;
+            let (a, b, c) = (v[0], v[1], v[2]);
+            if crate::boolean::area(&[a, b, c]) < 1e-3 {
+                continue;
+            }
+            let p = [(a[0] + b[0] + c[0]) / 3.0, (a[1] + b[1] + c[1]) / 3.0];
+            assert_eq!(test.lit_at(f.source, p), set, "{f:?}");
+            sets.insert(set);
+            // the light that casts no shadow reaches every piece
+            assert!(casters.reaches(set, 1));
+        }
+        // lit by both, by one, by the other and by neither all occur
+        assert!(sets.len() >= 3, "{sets:?}");
     }
 
     #[test]

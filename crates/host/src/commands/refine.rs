@@ -32,7 +32,8 @@ pub struct RefineArgs {
     #[arg(value_name = "SCENE")]
     pub scene: Option<PathBuf>,
     /// The phases to run, comma-separated, in this order: vertices, edges (depth-cued
-    /// points and lines), flat, gouraud, phong, aa; flat before any phase refining it.
+    /// points and lines), flat, shadows, gouraud, phong, aa; flat before any phase
+    /// refining it. The shadow phase runs after flat whenever a light casts shadows.
     #[arg(long, value_name = "LIST", default_value = "flat,gouraud,phong,aa")]
     pub phases: String,
     /// The Gouraud phase shades a polygon whose vertex-intensity range exceeds T; `all`

@@ -65,7 +65,7 @@ impl Bsp {
     pub fn new(loaded: LoadedScene, settings: &Settings) -> Result<Bsp, RenderError> {
         let loaded = loaded.drawn_as(settings)?;
         settings.check().map_err(RenderError::Usage)?;
-        let polys = Polys::new(loaded, settings.shading)?;
+        let polys = Polys::new(loaded, settings)?;
         let sampler = Sampler::new(settings.samples, settings.grid, polys.width, polys.height)
             .map_err(RenderError::Usage)?;
         let eval0 = settings.bsp_order == BspOrder::FrontToBack && settings.unset == Unset::Eval0;
@@ -136,7 +136,6 @@ impl Bsp {
         loaded: LoadedScene,
         settings: &Settings,
     ) -> Result<Box<dyn Renderer>, RenderError> {
-        crate::prepare::refuse_shadows("bsp", &loaded.scene, settings)?;
         Ok(Box::new(Bsp::new(loaded, settings)?))
     }
 
@@ -284,10 +283,12 @@ impl Renderer for Bsp {
     }
 
     fn stage_times(&self) -> Vec<(&'static str, Duration)> {
-        vec![
-            ("transform & lighting", self.polys.transform_time),
-            ("BSP tree", self.build_time),
-        ]
+        let mut times = vec![("transform & lighting", self.polys.transform_time)];
+        if self.polys.shadows.is_some() {
+            times.push(("shadows", self.polys.shadow_time));
+        }
+        times.push(("BSP tree", self.build_time));
+        times
     }
 
     fn scene_json(&self) -> serde_json::Value {

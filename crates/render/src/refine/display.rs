@@ -3,12 +3,35 @@
 //! and those the phase regenerates.
 
 use super::measure::flattened;
-use crate::prepare::{PhongSurfaces, PolygonScene};
-use cwisim_scene::ScreenScene;
+use crate::prepare::{PhongSurfaces, PolygonLights, PolygonScene};
+use cwisim_scene::{Polygon, ScreenScene};
+
+/// Polygon `k` (`p`) of `scene` as every light would shade it: its triangle's own
+/// intensities at its vertices (the polygon itself where it has no triangle, or no light
+/// casts shadows).
+fn unshadowed(scene: &PolygonScene, k: usize, p: &Polygon) -> Polygon {
+    let Some(s) = &scene.phong else {
+        return p.clone();
+    };
+    let t = &s.triangles[s.sources[k]];
+    let channels = scene.screen.channel_count();
+    let intensity = p
+        .vertices
+        .iter()
+        .map(|&v| {
+            t.intensity_at(v, channels)
+                .map_or_else(|| vec![0.0; channels], |i| i[..channels].to_vec())
+        })
+        .collect();
+    Polygon::new(p.vertices.clone(), intensity)
+}
 
 /// How a polygon is drawn.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Mode {
+    /// At one intensity, every light reaching it (the mean of its triangle's unshadowed
+    /// intensities at its vertices): the flat phase before the shadow phase.
+    Unshadowed,
     /// At one intensity (the mean of its vertex intensities).
     Flat,
     /// Its vertex intensities interpolated (DO_FILL's Gouraud).
@@ -42,6 +65,7 @@ impl Subset {
         let mut dofill = empty();
         let mut phong = empty();
         let mut sources = Vec::new();
+        let mut lit = Vec::new();
         let mut polygons = 0;
         for (k, p) in scene.screen.polygons.iter().enumerate() {
             if !pick(k) {
@@ -49,21 +73,31 @@ impl Subset {
             }
             polygons += 1;
             match modes[k] {
+                Mode::Unshadowed => dofill.polygons.push(flattened(&unshadowed(scene, k, p))),
                 Mode::Flat => dofill.polygons.push(flattened(p)),
                 Mode::Gouraud => dofill.polygons.push(p.clone()),
                 Mode::Phong => {
                     phong.polygons.push(p.clone());
                     if let Some(s) = &scene.phong {
                         sources.push(s.sources[k]);
+                        if let Some(l) = &s.shadows {
+                            lit.push(l.lit[k]);
+                        }
                     }
                 }
             }
         }
         let phong = match &scene.phong {
-            Some(s) if !phong.polygons.is_empty() => Some((
-                phong,
-                PhongSurfaces::new(s.triangles.clone(), sources, s.shader.clone()),
-            )),
+            Some(s) if !phong.polygons.is_empty() => {
+                let mut surfaces =
+                    PhongSurfaces::new(s.triangles.clone(), sources, s.shader.clone());
+                // the attribute the shadow phase set: the lights that reach each polygon
+                surfaces.shadows = s.shadows.as_ref().map(|l| PolygonLights {
+                    casters: l.casters.clone(),
+                    lit,
+                });
+                Some((phong, surfaces))
+            }
             _ => None,
         };
         Subset {

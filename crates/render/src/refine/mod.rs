@@ -21,9 +21,15 @@
 //!    frame's own instructions are re-sent with the flagged pixels masked (`Dis` before
 //!    each Eval reaching them), then the box filter's with the others masked.
 //!
+//! When a light casts shadows, a **shadow** phase follows the flat one: the flat phase
+//! draws every polygon as if every light reached it, and the shadow phase redraws the
+//! shadow polygons (the exact pieces some light does not reach, `cwisim_world::shadow`)
+//! without those lights' terms; the lights reaching each polygon stay with it (the
+//! paper's pixel attribute buffer, per polygon here), so the later phases shade the
+//! shadows too.
+//!
 //! A screen scene (intensities only, nothing to light) is drawn as one frame: Gouraud
-//! with the box filter, as `vanrij` draws it. Shadows are not built: no scene format
-//! carries the paper's precomputed shadow polygons (docs/RENDERERS.md, "refine").
+//! with the box filter, as `vanrij` draws it.
 
 pub mod display;
 pub mod frame;
@@ -40,6 +46,7 @@ use crate::settings::{Settings, Threshold};
 use crate::source::LoadedScene;
 use cwisim_isa::TraceHeader;
 use cwisim_scene::{Antialias, Shading};
+use cwisim_world::shadow::LightSet;
 use cwisim_world::{AnyScene, Visibility};
 use cwisim_xproc::{Image, RunStats};
 use cwisim_ypipe::{emit_rows, header, ScanPlan};
@@ -63,6 +70,9 @@ pub enum Phase {
     Edges,
     /// Every polygon at its mean intensity, point-sampled.
     Flat,
+    /// The polygons in some light's shadow (the shadow polygons) drawn darker, the
+    /// lights reaching each kept for the phases after (the paper's attribute buffer).
+    Shadows,
     /// Polygons above the Gouraud threshold Gouraud-shaded, point-sampled.
     Gouraud,
     /// Polygons passing the highlight test lit per pixel, point-sampled.
@@ -80,6 +90,7 @@ impl Phase {
             Phase::Vertices => "vertices",
             Phase::Edges => "edges",
             Phase::Flat => "flat",
+            Phase::Shadows => "shadows",
             Phase::Gouraud => "gouraud",
             Phase::Phong => "phong",
             Phase::Antialias => "aa",
@@ -91,7 +102,7 @@ impl Phase {
     /// the vertex and edge phases, the points or lines drawn) of this phase:
     /// `gouraud_polygons`, `aa_instructions`, ….
     pub fn counter(self, what: &str) -> &'static str {
-        const NAMES: [[&str; 4]; 7] = [
+        const NAMES: [[&str; 4]; 8] = [
             [
                 "vertices_instructions",
                 "vertices_regenerated",
@@ -109,6 +120,12 @@ impl Phase {
                 "flat_regenerated",
                 "flat_pixels",
                 "flat_polygons",
+            ],
+            [
+                "shadows_instructions",
+                "shadows_regenerated",
+                "shadows_pixels",
+                "shadows_polygons",
             ],
             [
                 "gouraud_instructions",
@@ -134,10 +151,11 @@ impl Phase {
             Phase::Vertices => 0,
             Phase::Edges => 1,
             Phase::Flat => 2,
-            Phase::Gouraud => 3,
-            Phase::Phong => 4,
-            Phase::Antialias => 5,
-            Phase::Whole => 6,
+            Phase::Shadows => 3,
+            Phase::Gouraud => 4,
+            Phase::Phong => 5,
+            Phase::Antialias => 6,
+            Phase::Whole => 7,
         };
         let col = match what {
             "instructions" => 0,
@@ -152,10 +170,11 @@ impl Phase {
 /// The phases of a world scene, in order.
 pub const WORLD_PHASES: [Phase; 4] = [Phase::Flat, Phase::Gouraud, Phase::Phong, Phase::Antialias];
 
-/// `--phases`: a comma-separated list of `vertices`, `edges`, `flat`, `gouraud`, `phong`,
-/// `aa`, in that order, each at most once, with `flat` whenever a later phase refines it.
+/// `--phases`: a comma-separated list of `vertices`, `edges`, `flat`, `shadows`,
+/// `gouraud`, `phong`, `aa`, in that order, each at most once, with `flat` whenever a
+/// later phase refines it.
 pub fn parse_phases(list: &str) -> Result<Vec<Phase>, String> {
-    const KNOWN: &str = "vertices, edges, flat, gouraud, phong, aa";
+    const KNOWN: &str = "vertices, edges, flat, shadows, gouraud, phong, aa";
     let mut phases = Vec::new();
     for name in list.split(',').map(str::trim) {
         let phase = match name {
@@ -165,11 +184,7 @@ pub fn parse_phases(list: &str) -> Result<Vec<Phase>, String> {
             "gouraud" => Phase::Gouraud,
             "phong" => Phase::Phong,
             "aa" | "anti-aliasing" => Phase::Antialias,
-            "shadows" => {
-                return Err(format!(
-                    "--phases: the paper's shadow phase is not built: no scene format carries its precomputed shadow polygons (docs/RENDERERS.md, \"refine\"); known: {KNOWN}"
-                ))
-            }
+            "shadows" => Phase::Shadows,
             _ => return Err(format!("--phases: unknown phase `{name}`; known: {KNOWN}")),
         };
         if phases.last().is_some_and(|&p| p >= phase) {
@@ -212,6 +227,7 @@ pub struct Refine {
     /// How each polygon is drawn after the last shading phase.
     modes: Vec<Mode>,
     gouraud_polygons: u64,
+    shadow_polygons: u64,
     phong_polygons: u64,
     /// Visible triangles (with a fragment in the display list) passing the highlight
     /// test, and how many are visible.
@@ -267,11 +283,25 @@ impl Refine {
         };
         let scene = PolygonScene::new(loaded, &prepared)?;
         let n = scene.screen.polygons.len();
+        // the shadow phase runs after the flat one exactly when a light casts shadows
+        let mut checked = checked;
+        let casting = scene.shadows.is_some();
+        if world && casting && !checked.contains(&Phase::Shadows) {
+            if let Some(at) = checked.iter().position(|&p| p == Phase::Flat) {
+                checked.insert(at + 1, Phase::Shadows);
+            }
+        }
+        if world && !casting && checked.contains(&Phase::Shadows) {
+            return Err(RenderError::Usage(
+                "--phases shadows: no light of the scene casts shadows (give one \"shadows\": true, or render with --shadows on)".into(),
+            ));
+        }
         let mut refine = Refine {
             phases: if world { checked } else { vec![Phase::Whole] },
             plans: Vec::new(),
             modes: vec![Mode::Flat; n],
             gouraud_polygons: 0,
+            shadow_polygons: 0,
             phong_polygons: 0,
             highlight: (0, 0),
             gouraud_threshold: settings.gouraud_threshold,
@@ -302,13 +332,28 @@ impl Refine {
     fn plan(&mut self) {
         let scene = &self.scene;
         let n = scene.screen.polygons.len();
-        let mut modes = vec![Mode::Flat; n];
+        // before a shadow phase, the flat phase draws every polygon as if lit by all
+        let first = if self.phases.contains(&Phase::Shadows) {
+            Mode::Unshadowed
+        } else {
+            Mode::Flat
+        };
+        // the lights that reach each polygon (every light without shadows)
+        let shadowed = |k: usize| {
+            scene
+                .phong
+                .as_ref()
+                .and_then(|s| s.shadows.as_ref())
+                .is_some_and(|l| l.lit[k] != LightSet::ALL)
+        };
+        let mut modes = vec![first; n];
         let mut plans = Vec::new();
         for &phase in &self.phases {
             let next: Vec<Mode> = (0..n)
                 .map(|k| {
                     let p = &scene.screen.polygons[k];
                     match phase {
+                        Phase::Shadows if modes[k] == Mode::Unshadowed => Mode::Flat,
                         Phase::Gouraud
                             if modes[k] == Mode::Flat
                                 && self.gouraud_threshold.passes(intensity_range(p)) =>
@@ -327,11 +372,18 @@ impl Refine {
                     }
                 })
                 .collect();
+            // the shadow phase redraws the shadow polygons only: a polygon every light
+            // reaches draws the same either way
             let changed: Vec<bool> = (0..n)
-                .map(|k| phase == Phase::Flat || next[k] != modes[k])
+                .map(|k| match phase {
+                    Phase::Flat => true,
+                    Phase::Shadows => shadowed(k),
+                    _ => next[k] != modes[k],
+                })
                 .collect();
             let regenerated = changed.iter().filter(|&&c| c).count() as u64;
             match phase {
+                Phase::Shadows => self.shadow_polygons = regenerated,
                 Phase::Gouraud => self.gouraud_polygons = regenerated,
                 Phase::Phong => self.phong_polygons = regenerated,
                 _ => {}
@@ -367,7 +419,6 @@ impl Refine {
         loaded: LoadedScene,
         settings: &Settings,
     ) -> Result<Box<dyn Renderer>, RenderError> {
-        crate::prepare::refuse_shadows("refine", &loaded.scene, settings)?;
         Ok(Box::new(Refine::new(loaded, settings)?))
     }
 
@@ -528,8 +579,8 @@ impl Renderer for Refine {
     }
 
     fn summary_rows(&self, counters: &Counters, stats: &RunStats) -> Vec<(&'static str, String)> {
-        const LABELS: [&str; 6] = [
-            "phase 1", "phase 2", "phase 3", "phase 4", "phase 5", "phase 6",
+        const LABELS: [&str; 7] = [
+            "phase 1", "phase 2", "phase 3", "phase 4", "phase 5", "phase 6", "phase 7",
         ];
         let mut rows = self.scene.summary_rows();
         if self.phases == [Phase::Whole] {
@@ -554,7 +605,14 @@ impl Renderer for Refine {
                     get("edges_drawn"),
                     get("edges_pixels")
                 ),
+                Phase::Flat if self.phases.contains(&Phase::Shadows) => format!(
+                    "flat: {polygons} polygons at one intensity, every light reaching"
+                ),
                 Phase::Flat => format!("flat: {polygons} polygons at one intensity"),
+                Phase::Shadows => format!(
+                    "shadows: {} of {polygons} polygons in some light's shadow redrawn without its terms (the lights reaching each kept for the later phases)",
+                    get("shadows_polygons")
+                ),
                 Phase::Gouraud => format!(
                     "Gouraud: {} of {polygons} polygons Gouraud-shaded",
                     get("gouraud_polygons")
@@ -595,6 +653,7 @@ impl Renderer for Refine {
         let mut j = self.scene.scene_json();
         j["phases"] = serde_json::json!(self.phases.iter().map(|p| p.name()).collect::<Vec<_>>());
         j["gouraud_polygons"] = serde_json::json!(self.gouraud_polygons);
+        j["shadow_polygons"] = serde_json::json!(self.shadow_polygons);
         j["phong_polygons"] = serde_json::json!(self.phong_polygons);
         j
     }

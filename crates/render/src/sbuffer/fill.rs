@@ -27,6 +27,8 @@ use crate::woochall::emit::{emit_row, EmitRule, Subline};
 use crate::woochall::lists::NONE;
 use cwisim_isa::{Instruction, Intensity, Opcode, TraceWrite};
 use cwisim_scene::{Shading, Vector};
+use cwisim_world::shadow::LightSet;
+use std::collections::HashMap;
 use std::io;
 use std::ops::Range;
 
@@ -322,6 +324,11 @@ impl Scan<'_> {
         let mut set = Vec::new();
         let mut taken = Vec::new();
         let rule = self.rule;
+        let shadows = self.scene.shadows.is_some();
+        // with shadows: the lights reaching each sample of the span, and the polygons
+        // relit for the light sets met on this line
+        let mut lights: Vec<LightSet> = Vec::new();
+        let mut relit: HashMap<(u32, LightSet), Poly> = HashMap::new();
         sweep.line(j, y, |k, p: &Poly, aet| {
             counts.polygons_walked += 1;
             for pair in aet.chunks_exact(2) {
@@ -338,41 +345,72 @@ impl Scan<'_> {
                     continue;
                 }
                 counts.spans += 1;
+                lights.clear();
+                if shadows {
+                    lights.extend((first..end).map(|c| self.scene.lit_at(p, s.column_x(c), y)));
+                }
+                let light_of = |c: usize| lights.get(c - first).copied().unwrap_or(LightSet::ALL);
+                let mut relit_of = |lit: LightSet| -> Poly {
+                    relit
+                        .entry((k, lit))
+                        .or_insert_with(|| self.scene.relit(p, lit))
+                        .clone()
+                };
                 if rule == Rule::Claim {
-                    // the array keeps the list: claim the whole span, count what its
-                    // locks will suppress
-                    for c in first..end {
-                        if line.owner[c] == NONE {
-                            line.owner[c] = k;
-                            line.span[c] = span_id;
-                            line.val[c] = p.flat;
-                            counts.pixels_set += 1;
-                        } else {
-                            counts.suppressed_claims += 1;
+                    // the array keeps the list: claim the whole span (a run per light set
+                    // with shadows), count what its locks will suppress
+                    let mut c = first;
+                    while c < end {
+                        let (start, here) = (c, light_of(c));
+                        while c < end && light_of(c) == here {
+                            c += 1;
                         }
-                    }
-                    if let Some(out) = out.as_deref_mut() {
-                        out.push(Instruction::eval0(
-                            first as u32,
-                            (end - first) as u32,
-                            Intensity::new(&p.flat[..ch]),
-                        ));
+                        if start != first {
+                            span_id += 1;
+                        }
+                        let flat = if here == LightSet::ALL {
+                            p.flat
+                        } else {
+                            relit_of(here).flat
+                        };
+                        for x in start..c {
+                            if line.owner[x] == NONE {
+                                line.owner[x] = k;
+                                line.span[x] = span_id;
+                                line.val[x] = flat;
+                                counts.pixels_set += 1;
+                            } else {
+                                counts.suppressed_claims += 1;
+                            }
+                        }
+                        if let Some(out) = out.as_deref_mut() {
+                            out.push(Instruction::eval0(
+                                start as u32,
+                                (c - start) as u32,
+                                Intensity::new(&flat[..ch]),
+                            ));
+                        }
                     }
                     continue;
                 }
-                let (mut v, d) = if flat || self.shading == Shading::Phong {
-                    (p.flat, Vector::default())
-                } else {
-                    let il = edge_value(p, a, y, ch);
-                    let ir = edge_value(p, b, y, ch);
-                    let d = span_gradient(&il, &ir, a.xc, b.xc, ch);
-                    let dx = s.column_x(first) - a.xc;
-                    // the chain steps one sample column: 1 pixel at one sample, else
-                    // 1/l (centre grid) or 1/(l − 1) (corner grid)
-                    let per = f64::from(s.step_count());
-                    let step = cwisim_scene::vector(ch, |c| d[c] / per);
-                    (cwisim_scene::vector(ch, |c| il[c] + dx * d[c]), step)
+                // the span's values from `q`'s: its Gouraud chain's value at sample `at`
+                // and its step
+                let values = |q: &Poly, at: usize| -> (Vector, Vector) {
+                    if flat || self.shading == Shading::Phong {
+                        (q.flat, Vector::default())
+                    } else {
+                        let il = edge_value(q, a, y, ch);
+                        let ir = edge_value(q, b, y, ch);
+                        let d = span_gradient(&il, &ir, a.xc, b.xc, ch);
+                        let dx = s.column_x(at) - a.xc;
+                        // the chain steps one sample column: 1 pixel at one sample, else
+                        // 1/l (centre grid) or 1/(l − 1) (corner grid)
+                        let per = f64::from(s.step_count());
+                        let step = cwisim_scene::vector(ch, |c| d[c] / per);
+                        (cwisim_scene::vector(ch, |c| il[c] + dx * d[c]), step)
+                    }
                 };
+                let (mut v, span_step) = values(p, first);
                 set.clear();
                 match rule {
                     Rule::Nearer => {
@@ -398,17 +436,27 @@ impl Scan<'_> {
                 let mut c = first;
                 while c < end {
                     if !set[c - first] {
-                        for x in v.iter_mut().zip(&d) {
+                        for x in v.iter_mut().zip(&span_step) {
                             *x.0 += x.1;
                         }
                         c += 1;
                         continue;
                     }
-                    let start = c;
-                    let v0 = v;
-                    while c < end && set[c - first] {
+                    let (start, here) = (c, light_of(c));
+                    while c < end && set[c - first] && light_of(c) == here {
                         c += 1;
                     }
+                    if shadows && start != first {
+                        // a run of its own, so that it is sent with its own values
+                        span_id += 1;
+                    }
+                    // the span's chain where every light reaches; the relit polygon's
+                    // own chain from the run's start where some does not
+                    let (v0, d) = if here == LightSet::ALL {
+                        (v, span_step)
+                    } else {
+                        values(&relit_of(here), start)
+                    };
                     if let Some(out) = out.as_deref_mut() {
                         // undo each earlier owner's part of the run, then draw it
                         let mut undo = Vec::new();
@@ -449,7 +497,16 @@ impl Scan<'_> {
                             *q.0 += q.1;
                         }
                     }
-                    v = w;
+                    if here == LightSet::ALL {
+                        v = w;
+                    } else {
+                        // the span's own chain steps over the relit run
+                        for _ in start..c {
+                            for q in v.iter_mut().zip(&span_step) {
+                                *q.0 += q.1;
+                            }
+                        }
+                    }
                 }
             }
             // Gordon & Chen: the walk stops once every sample is set

@@ -58,7 +58,7 @@ impl SBuffer {
     pub fn new(loaded: LoadedScene, settings: &Settings) -> Result<SBuffer, RenderError> {
         let loaded = loaded.drawn_as(settings)?;
         settings.check().map_err(RenderError::Usage)?;
-        let polys = Polys::new(loaded, settings.shading)?;
+        let polys = Polys::new(loaded, settings)?;
         let sampler = Sampler::new(settings.samples, settings.grid, polys.width, polys.height)
             .map_err(RenderError::Usage)?;
         if settings.sbuffer == SbufferMode::Overdraw {
@@ -89,7 +89,6 @@ impl SBuffer {
         loaded: LoadedScene,
         settings: &Settings,
     ) -> Result<Box<dyn Renderer>, RenderError> {
-        crate::prepare::refuse_shadows("sbuffer", &loaded.scene, settings)?;
         Ok(Box::new(SBuffer::new(loaded, settings)?))
     }
 
@@ -174,7 +173,11 @@ impl Renderer for SBuffer {
     }
 
     fn stage_times(&self) -> Vec<(&'static str, Duration)> {
-        vec![("transform & lighting", self.polys.transform_time)]
+        let mut times = vec![("transform & lighting", self.polys.transform_time)];
+        if self.polys.shadows.is_some() {
+            times.push(("shadows", self.polys.shadow_time));
+        }
+        times
     }
 
     fn scene_json(&self) -> serde_json::Value {

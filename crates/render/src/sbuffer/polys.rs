@@ -13,11 +13,13 @@
 
 use crate::cp::CpPolygon;
 use crate::error::RenderError;
+use crate::settings::Settings;
 use crate::source::{LoadedScene, Source};
 use cwisim_isa::TraceHeader;
 use cwisim_scene::{Polygon, Shading, Vector};
 use cwisim_world::face::ScreenTriangle;
 use cwisim_world::shade::PhongShader;
+use cwisim_world::shadow::{LightSet, ShadowTest};
 use cwisim_world::{AnyScene, ProjectStats};
 use std::time::{Duration, Instant};
 
@@ -99,6 +101,10 @@ pub struct Polys {
     pub project: Option<ProjectStats>,
     /// Polygons with no area on the screen, dropped (`c = 0` or no plane).
     pub degenerate: u64,
+    /// With shadows: what the lights that cast them reach of each projected triangle.
+    pub shadows: Option<ShadowTest>,
+    /// Wall time of the shadow pass (the lights' views).
+    pub shadow_time: Duration,
     /// Wall time of reading the scene.
     pub load_time: Duration,
     /// Wall time of projection and lighting, or of preparing the polygons.
@@ -106,8 +112,11 @@ pub struct Polys {
 }
 
 impl Polys {
-    /// The polygons of `loaded`, lit for `shading`.
-    pub fn new(loaded: LoadedScene, shading: Shading) -> Result<Polys, RenderError> {
+    /// The polygons of `loaded`, lit for `settings.shading`, with what the lights that
+    /// cast shadows reach of each (`settings.shadows`; their views on `settings.threads`).
+    pub fn new(loaded: LoadedScene, settings: &Settings) -> Result<Polys, RenderError> {
+        let shading = settings.shading;
+        let (mut shadows, mut shadow_time) = (None, Duration::ZERO);
         let start = Instant::now();
         let kind = loaded.scene.kind();
         let (mut project, mut shader, mut triangles, mut eye) = (None, None, None, None);
@@ -173,6 +182,18 @@ impl Polys {
                 if shading == Shading::Phong {
                     shader = Some(PhongShader::new(&w));
                 }
+                let casters = crate::prepare::world_casters(&w, settings)?;
+                if !casters.is_empty() {
+                    let begun = Instant::now();
+                    shadows = Some(ShadowTest::new(
+                        &w,
+                        shading,
+                        &tris,
+                        &casters,
+                        settings.threads,
+                    )?);
+                    shadow_time = begun.elapsed();
+                }
                 triangles = Some(tris);
                 eye = Some(w.spec.camera.eye);
                 (w.width(), w.height(), w.channels() as u8)
@@ -193,8 +214,10 @@ impl Polys {
             eye,
             project,
             degenerate,
+            shadows,
+            shadow_time,
             load_time: loaded.load_time,
-            transform_time: start.elapsed(),
+            transform_time: start.elapsed() - shadow_time,
         })
     }
 
@@ -212,18 +235,73 @@ impl Polys {
     /// dropped), at the point of its triangle nearest `(x, y)`.
     pub fn phong(&self, p: &Poly, x: f64, y: f64) -> Option<Vector> {
         let (shader, tris) = (self.shader.as_ref()?, self.triangles.as_ref()?);
-        let t = &tris[p.source as usize];
-        let mut v = shader
-            .at(t, crate::phong::nearest_in(t, [x, y]))
-            .unwrap_or_default();
+        let k = p.source as usize;
+        let t = &tris[k];
+        let at = crate::phong::nearest_in(t, [x, y]);
+        let mut v = match &self.shadows {
+            Some(test) => {
+                let lit = test.lit_at(k, [x, y]);
+                shader.at_lit(t, at, |l| test.casters().reaches(lit, l))
+            }
+            None => shader.at(t, at),
+        }
+        .unwrap_or_default();
         for c in v.iter_mut() {
             *c = c.max(0.0);
         }
         Some(v)
     }
 
-    /// The summary's geometry row.
+    /// The lights that reach polygon `p` (of a world scene) at sample `(x, y)`: every
+    /// light without shadows.
+    pub fn lit_at(&self, p: &Poly, x: f64, y: f64) -> LightSet {
+        match &self.shadows {
+            Some(test) => test.lit_at(p.source as usize, [x, y]),
+            None => LightSet::ALL,
+        }
+    }
+
+    /// Polygon `p` shaded by the lights of `lit` only: its vertices' intensities from its
+    /// triangle's corners relit ([`ShadowTest::corners`]), its flat value their mean.
+    pub fn relit(&self, p: &Poly, lit: LightSet) -> Poly {
+        let (Some(test), Some(tris)) = (&self.shadows, &self.triangles) else {
+            return p.clone();
+        };
+        let ch = self.channel_count();
+        let k = p.source as usize;
+        let t = &tris[k];
+        let shaded = ScreenTriangle {
+            intensity: test.corners(k, t, lit),
+            ..*t
+        };
+        let intensity: Vec<Vector> = (0..p.cp.len())
+            .map(|i| shaded.intensity_at(p.cp.vertex(i), ch).unwrap_or_default())
+            .collect();
+        Poly {
+            flat: cwisim_ypipe::flat_mean(&intensity, ch),
+            intensity,
+            ..p.clone()
+        }
+    }
+
+    /// The summary's geometry row, and with shadows their row.
     pub fn summary_rows(&self) -> Vec<(&'static str, String)> {
+        let mut rows = self.geometry_rows();
+        if let Some(test) = &self.shadows {
+            rows.push((
+                "shadows",
+                format!(
+                    "{} light(s) casting, exact: each sample a polygon sets is tested against its triangle's lit parts, and a run split where the lights change ({} triangles in the lights' views, {} seen)",
+                    test.casters().lights.len(),
+                    test.light_triangles,
+                    test.light_fragments
+                ),
+            ));
+        }
+        rows
+    }
+
+    fn geometry_rows(&self) -> Vec<(&'static str, String)> {
         let polygons = self.polys.len() as u64 + self.degenerate;
         match &self.project {
             Some(g) => vec![(
@@ -252,6 +330,11 @@ impl Polys {
             "polygons": self.polys.len(),
             "degenerate": self.degenerate,
             "project": self.project,
+            "shadows": self.shadows.as_ref().map(|test| serde_json::json!({
+                "lights": test.casters().lights.len(),
+                "light_triangles": test.light_triangles,
+                "light_fragments": test.light_fragments,
+            })),
         })
     }
 }

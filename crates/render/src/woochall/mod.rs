@@ -54,7 +54,7 @@ impl WooChall {
     pub fn new(loaded: LoadedScene, settings: &Settings) -> Result<WooChall, RenderError> {
         let loaded = loaded.drawn_as(settings)?;
         settings.check().map_err(RenderError::Usage)?;
-        let triangles = Triangles::new(loaded, settings.shading)?;
+        let triangles = Triangles::new(loaded, settings)?;
         let sampler = Sampler::new(
             settings.samples,
             settings.grid,
@@ -84,7 +84,6 @@ impl WooChall {
         loaded: LoadedScene,
         settings: &Settings,
     ) -> Result<Box<dyn Renderer>, RenderError> {
-        crate::prepare::refuse_shadows("woo-chall", &loaded.scene, settings)?;
         Ok(Box::new(WooChall::new(loaded, settings)?))
     }
 
@@ -444,7 +443,11 @@ impl Renderer for WooChall {
     }
 
     fn stage_times(&self) -> Vec<(&'static str, Duration)> {
-        vec![("transform & lighting", self.triangles.transform_time)]
+        let mut times = vec![("transform & lighting", self.triangles.transform_time)];
+        if self.triangles.shadows.is_some() {
+            times.push(("shadows", self.triangles.shadow_time));
+        }
+        times
     }
 
     fn scene_json(&self) -> serde_json::Value {

@@ -7,11 +7,13 @@
 
 use super::triangle::Tri;
 use crate::error::RenderError;
+use crate::settings::Settings;
 use crate::source::{LoadedScene, Source};
 use cwisim_isa::TraceHeader;
 use cwisim_scene::{ScreenScene, Shading, Vector};
 use cwisim_world::face::ScreenTriangle;
 use cwisim_world::shade::PhongShader;
+use cwisim_world::shadow::{LightSet, ShadowTest};
 use cwisim_world::{AnyScene, ProjectStats};
 use std::time::{Duration, Instant};
 
@@ -33,6 +35,11 @@ pub struct Triangles {
     /// With Phong shading: the projected triangles (`Tri::source` indexes them) and the
     /// lighting.
     pub phong: Option<(Vec<ScreenTriangle>, PhongShader)>,
+    /// With shadows: what the lights reach of each projected triangle, and the projected
+    /// triangles (`Tri::source` indexes them).
+    pub shadows: Option<(ShadowTest, Vec<ScreenTriangle>)>,
+    /// Wall time of the shadow pass (the lights' views).
+    pub shadow_time: Duration,
     /// What projection did (world scenes).
     pub project: Option<ProjectStats>,
     /// Polygons triangulated (screen scenes).
@@ -44,11 +51,14 @@ pub struct Triangles {
 }
 
 impl Triangles {
-    /// The triangles of `loaded`, lit for `shading`.
-    pub fn new(loaded: LoadedScene, shading: Shading) -> Result<Triangles, RenderError> {
+    /// The triangles of `loaded`, lit for `settings.shading`, with what the lights that
+    /// cast shadows reach of each (`settings.shadows`; their views on `settings.threads`).
+    pub fn new(loaded: LoadedScene, settings: &Settings) -> Result<Triangles, RenderError> {
+        let shading = settings.shading;
         let start = Instant::now();
         let kind = loaded.scene.kind();
         let (mut project, mut phong, mut polygons) = (None, None, 0);
+        let (mut shadows, mut shadow_time) = (None, Duration::ZERO);
         let (width, height, channels, tris) = match loaded.scene {
             AnyScene::Screen(s) => {
                 if shading == Shading::Phong {
@@ -71,6 +81,13 @@ impl Triangles {
                     })
                     .collect();
                 project = Some(stats);
+                let casters = crate::prepare::world_casters(&w, settings)?;
+                if !casters.is_empty() {
+                    let begun = Instant::now();
+                    let test = ShadowTest::new(&w, shading, &screen, &casters, settings.threads)?;
+                    shadows = Some((test, screen.clone()));
+                    shadow_time = begun.elapsed();
+                }
                 if shading == Shading::Phong {
                     phong = Some((screen, PhongShader::new(&w)));
                 }
@@ -88,10 +105,12 @@ impl Triangles {
             header,
             tris,
             phong,
+            shadows,
+            shadow_time,
             project,
             polygons,
             load_time: loaded.load_time,
-            transform_time: start.elapsed(),
+            transform_time: start.elapsed() - shadow_time,
         })
     }
 
@@ -103,22 +122,57 @@ impl Triangles {
     /// One shading call: the colour of `tri` at `(x, y)`.
     pub fn shade(&self, tri: &Tri, x: f64, y: f64) -> Vector {
         let channels = usize::from(self.channels);
-        match &self.phong {
-            Some((tris, shader)) => {
-                let mut v = shader
-                    .at(&tris[tri.source as usize], [x, y])
-                    .unwrap_or_default();
+        let k = tri.source as usize;
+        // the lights that reach the sample (every light without shadows)
+        let lit = self
+            .shadows
+            .as_ref()
+            .map_or(LightSet::ALL, |(test, _)| test.lit_at(k, [x, y]));
+        match (&self.phong, &self.shadows) {
+            (Some((tris, shader)), shadows) => {
+                let mut v = match shadows {
+                    Some((test, _)) if lit != LightSet::ALL => {
+                        shader.at_lit(&tris[k], [x, y], |l| test.casters().reaches(lit, l))
+                    }
+                    _ => shader.at(&tris[k], [x, y]),
+                }
+                .unwrap_or_default();
                 for c in v.iter_mut() {
                     *c = c.max(0.0);
                 }
                 v
             }
-            None => tri.intensity_at(x, y, channels),
+            (None, Some((test, screen))) if lit != LightSet::ALL => {
+                // Gouraud or flat without the lights that do not reach: the corners relit
+                let t = &screen[k];
+                let shaded = ScreenTriangle {
+                    intensity: test.corners(k, t, lit),
+                    ..*t
+                };
+                shaded.intensity_at([x, y], channels).unwrap_or_default()
+            }
+            _ => tri.intensity_at(x, y, channels),
         }
     }
 
     /// The summary's geometry row.
     pub fn summary_rows(&self) -> Vec<(&'static str, String)> {
+        let mut rows = self.geometry_rows();
+        if let Some((test, _)) = &self.shadows {
+            rows.push((
+                "shadows",
+                format!(
+                    "{} light(s) casting, exact: each shading call tests its sample against the lit parts ({} triangles in the lights' views, {} seen)",
+                    test.casters().lights.len(),
+                    test.light_triangles,
+                    test.light_fragments
+                ),
+            ));
+        }
+        rows
+    }
+
+    fn geometry_rows(&self) -> Vec<(&'static str, String)> {
         match &self.project {
             Some(g) => vec![(
                 "geometry",
@@ -145,6 +199,11 @@ impl Triangles {
             "kind": self.kind,
             "triangles": self.tris.len(),
             "project": self.project,
+            "shadows": self.shadows.as_ref().map(|(test, _)| serde_json::json!({
+                "lights": test.casters().lights.len(),
+                "light_triangles": test.light_triangles,
+                "light_fragments": test.light_fragments,
+            })),
         })
     }
 }

@@ -21,8 +21,13 @@ pub fn world(text: &str, size: Option<(u32, u32)>) -> WorldScene {
 
 /// The image `vanrij` draws of `w` under `settings` (the array's exact values).
 pub fn rendered(w: &WorldScene, settings: &Settings) -> Vec<f64> {
+    rendered_by("vanrij", w, settings)
+}
+
+/// The image renderer `name` draws of `w` under `settings` (the array's exact values).
+pub fn rendered_by(name: &str, w: &WorldScene, settings: &Settings) -> Vec<f64> {
     let loaded = LoadedScene::built("test", AnyScene::World(w.clone()));
-    let r = (registry::find("vanrij").unwrap().build)(loaded, settings).unwrap();
+    let r = (registry::find(name).unwrap().build)(loaded, settings).unwrap();
     let h = r.header();
     let mut sink = ImageSink::new(h.width as usize, h.channel_count(), 1 << 30);
     render(&*r, &ArrayConfig::default(), 1, &mut sink, Taps::default()).unwrap();
