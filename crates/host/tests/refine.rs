@@ -265,3 +265,43 @@ fn refine_writes_the_polygon_id_view() {
     assert!(err.contains("--ids"), "{err}");
     assert!(!dir.join("ids.txt").exists());
 }
+
+#[test]
+fn shadows_on_adds_the_shadow_phase_after_flat() {
+    let dir = scratch("refine-shadows");
+    let out = cwisim_ok(
+        &dir,
+        &["refine", "still-life", "--size", "96x64", "--shadows", "on"],
+    );
+    let phases: Vec<&str> = out
+        .lines()
+        .filter_map(|l| l.split_whitespace().next())
+        .filter(|w| ["flat", "shadows", "gouraud", "phong", "aa"].contains(w))
+        .take(5)
+        .collect();
+    assert_eq!(
+        phases,
+        ["flat", "shadows", "gouraud", "phong", "aa"],
+        "{out}"
+    );
+    // without it, still-life casts none: no shadow phase, and --shadows off is refused
+    let out = cwisim_ok(&dir, &["refine", "still-life", "--size", "96x64"]);
+    assert!(!out.lines().any(|l| l.starts_with("shadows ")), "{out}");
+    let out = cwisim(
+        &dir,
+        &[
+            "refine",
+            "still-life",
+            "--size",
+            "96x64",
+            "--shadows",
+            "off",
+        ],
+    );
+    let (_, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("--shadows off: no light of the scene casts shadows"),
+        "{stderr}"
+    );
+}

@@ -338,8 +338,34 @@ enum Reach {
     All,
     /// None of it.
     Nothing,
-    /// The parts it sees, on the camera's screen (disjoint simple polygons, positive).
-    Parts(Shape),
+    /// The parts it sees, on the camera's screen (disjoint simple polygons, positive),
+    /// with each one's bounding box `[x0, y0, x1, y1]`.
+    Parts(Shape, Vec<[f64; 4]>),
+}
+
+/// The bounding box `[x0, y0, x1, y1]` of each contour.
+fn boxes(shape: &Shape) -> Vec<[f64; 4]> {
+    shape
+        .iter()
+        .map(|c| {
+            c.iter().fold(
+                [
+                    f64::INFINITY,
+                    f64::INFINITY,
+                    f64::NEG_INFINITY,
+                    f64::NEG_INFINITY,
+                ],
+                |b, p| {
+                    [
+                        b[0].min(p[0]),
+                        b[1].min(p[1]),
+                        b[2].max(p[0]),
+                        b[3].max(p[1]),
+                    ]
+                },
+            )
+        })
+        .collect()
 }
 
 /// What every shadow-casting light reaches of every camera triangle, on the screen: what
@@ -439,7 +465,11 @@ impl ShadowTest {
                     None => Reach::All,
                     Some((_, Some(true))) => Reach::All,
                     Some((_, Some(false))) => Reach::Nothing,
-                    Some((j, None)) => Reach::Parts(view.lit_on_screen(j, &camera)),
+                    Some((j, None)) => {
+                        let parts = view.lit_on_screen(j, &camera);
+                        let boxes = boxes(&parts);
+                        Reach::Parts(parts, boxes)
+                    }
                 });
             }
         }
@@ -459,13 +489,62 @@ impl ShadowTest {
             let lit = match reach {
                 Reach::All => true,
                 Reach::Nothing => false,
-                Reach::Parts(parts) => parts.iter().any(|c| inside(c, p)),
+                Reach::Parts(parts, boxes) => parts.iter().zip(boxes).any(|(c, b)| {
+                    b[0] <= p[0] && p[0] <= b[2] && b[1] <= p[1] && p[1] <= b[3] && inside(c, p)
+                }),
             };
             if !lit {
                 set = set.without(i);
             }
         }
         set
+    }
+
+    /// The casters that reach camera triangle `k` along the horizontal line `y`, ready to
+    /// be asked at many `x` ([`LineLights::at`]): each lit part's crossings of the line,
+    /// sorted, so that a point costs a binary search (the in/out parity along a scanline)
+    /// rather than a point-in-polygon test. It agrees with [`Self::lit_at`] except at a
+    /// point exactly on a lit part's right-hand edge.
+    pub fn line(&self, k: usize, y: f64) -> LineLights {
+        let reach = self.reach[k]
+            .iter()
+            .map(|r| match r {
+                Reach::All => LineReach::All,
+                Reach::Nothing => LineReach::Nothing,
+                Reach::Parts(parts, boxes) => {
+                    let mut xs = Vec::new();
+                    for (c, b) in parts.iter().zip(boxes) {
+                        if y < b[1] || y > b[3] {
+                            continue;
+                        }
+                        for e in 0..c.len() {
+                            let (a, b) = (c[e], c[(e + 1) % c.len()]);
+                            if (a[1] > y) != (b[1] > y) {
+                                xs.push(a[0] + (y - a[1]) / (b[1] - a[1]) * (b[0] - a[0]));
+                            }
+                        }
+                    }
+                    xs.sort_by(f64::total_cmp);
+                    LineReach::Crossings(xs)
+                }
+            })
+            .collect();
+        LineLights { reach }
+    }
+
+    /// The casters that reach all of camera triangle `k`, when that is the same at every
+    /// point of it (each caster reaching all of it or none); `None` when some caster
+    /// reaches a part of it (ask [`Self::lit_at`] point by point).
+    pub fn uniform(&self, k: usize) -> Option<LightSet> {
+        let mut set = LightSet::ALL;
+        for (i, reach) in self.reach[k].iter().enumerate() {
+            match reach {
+                Reach::All => {}
+                Reach::Nothing => set = set.without(i),
+                Reach::Parts(..) => return None,
+            }
+        }
+        Some(set)
     }
 
     /// Camera triangle `t` (number `k`)'s corner intensities by the lights of `set`
@@ -479,6 +558,39 @@ impl ShadowTest {
             self.eye,
             |l| self.casters.reaches(set, l),
         )
+    }
+}
+
+/// How the casters reach one triangle along one horizontal line ([`ShadowTest::line`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LineLights {
+    reach: Vec<LineReach>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+enum LineReach {
+    All,
+    Nothing,
+    /// Where the line crosses the lit parts' edges, sorted: lit where an odd number of
+    /// them lie to the right.
+    Crossings(Vec<f64>),
+}
+
+impl LineLights {
+    /// The casters that reach the line's point at `x`.
+    pub fn at(&self, x: f64) -> LightSet {
+        let mut set = LightSet::ALL;
+        for (i, r) in self.reach.iter().enumerate() {
+            let lit = match r {
+                LineReach::All => true,
+                LineReach::Nothing => false,
+                LineReach::Crossings(xs) => (xs.len() - xs.partition_point(|&v| v <= x)) % 2 == 1,
+            };
+            if !lit {
+                set = set.without(i);
+            }
+        }
+        set
     }
 }
 
@@ -561,7 +673,7 @@ pub fn shadowed(
                         piece.1 = piece.1.without(i);
                     }
                 }
-                Reach::Parts(lit) => {
+                Reach::Parts(lit, _) => {
                     let mut next = Vec::with_capacity(pieces.len() * 2);
                     for (contour, set) in pieces {
                         let subject = vec![positive(contour)];
@@ -742,6 +854,8 @@ mod tests {
             }
             let p = [(a[0] + b[0] + c[0]) / 3.0, (a[1] + b[1] + c[1]) / 3.0];
             assert_eq!(test.lit_at(f.source, p), set, "{f:?}");
+            // and along the line through it, by the crossings
+            assert_eq!(test.line(f.source, p[1]).at(p[0]), set, "{f:?}");
             sets.insert(set);
             // the light that casts no shadow reaches every piece
             assert!(casters.reaches(set, 1));

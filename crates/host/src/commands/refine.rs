@@ -4,6 +4,7 @@
 
 use super::MachineArgs;
 use crate::cost_args::check_extension;
+use crate::draw::ShadowsArg;
 use crate::error::CliError;
 use crate::files::{check_outputs, write_atomic};
 use crate::output::{write_png, write_rgb_png};
@@ -54,6 +55,11 @@ pub struct RefineArgs {
     /// Tessellate Bézier meshes N×N per patch (default: as the scene says).
     #[arg(long, value_name = "N")]
     pub tessellate: Option<u32>,
+    /// Shadows from every light (on) or from none (off), whatever each light's "shadows"
+    /// entry in the scene says [default: as the scene says]; with shadows, the shadow
+    /// phase runs after flat (docs/SHADOWS.md).
+    #[arg(long, value_enum, value_name = "on|off")]
+    pub shadows: Option<ShadowsArg>,
     /// Phong's span fitter tolerance, in intensity.
     #[arg(long, value_name = "E", default_value_t = 1.0 / 512.0)]
     pub shade_tolerance: f64,
@@ -170,6 +176,7 @@ pub fn run(args: &RefineArgs, stdout: &mut dyn Write, progress: bool) -> Result<
         size: args.size,
         tessellate: args.tessellate,
         shade_tolerance: args.shade_tolerance,
+        shadows: args.shadows.map(|s| s == ShadowsArg::On),
         ..Settings::default()
     };
     settings.check().map_err(CliError::Usage)?;

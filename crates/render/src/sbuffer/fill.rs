@@ -347,7 +347,16 @@ impl Scan<'_> {
                 counts.spans += 1;
                 lights.clear();
                 if shadows {
-                    lights.extend((first..end).map(|c| self.scene.lit_at(p, s.column_x(c), y)));
+                    // a test per sample only where a light reaches part of the triangle
+                    match self.scene.uniform_lit(p) {
+                        Some(LightSet::ALL) => {}
+                        Some(set) => lights.resize(end - first, set),
+                        None => {
+                            if let Some(line) = self.scene.line_lights(p, y) {
+                                lights.extend((first..end).map(|c| line.at(s.column_x(c))));
+                            }
+                        }
+                    }
                 }
                 let light_of = |c: usize| lights.get(c - first).copied().unwrap_or(LightSet::ALL);
                 let mut relit_of = |lit: LightSet| -> Poly {

@@ -19,7 +19,7 @@ use cwisim_isa::TraceHeader;
 use cwisim_scene::{Polygon, Shading, Vector};
 use cwisim_world::face::ScreenTriangle;
 use cwisim_world::shade::PhongShader;
-use cwisim_world::shadow::{LightSet, ShadowTest};
+use cwisim_world::shadow::{LightSet, LineLights, ShadowTest};
 use cwisim_world::{AnyScene, ProjectStats};
 use std::time::{Duration, Instant};
 
@@ -258,6 +258,24 @@ impl Polys {
         match &self.shadows {
             Some(test) => test.lit_at(p.source as usize, [x, y]),
             None => LightSet::ALL,
+        }
+    }
+
+    /// The lights that reach polygon `p` along line `y` (of a world scene with shadows),
+    /// ready to be asked at each sample of a span.
+    pub fn line_lights(&self, p: &Poly, y: f64) -> Option<LineLights> {
+        self.shadows
+            .as_ref()
+            .map(|test| test.line(p.source as usize, y))
+    }
+
+    /// The lights that reach all of polygon `p`, when that is the same everywhere on it
+    /// (every light without shadows); `None` when it must be asked sample by sample
+    /// ([`Self::lit_at`]).
+    pub fn uniform_lit(&self, p: &Poly) -> Option<LightSet> {
+        match &self.shadows {
+            Some(test) => test.uniform(p.source as usize),
+            None => Some(LightSet::ALL),
         }
     }
 

@@ -17,6 +17,17 @@ use cwisim_world::shadow::{LightSet, ShadowTest};
 use cwisim_world::{AnyScene, ProjectStats};
 use std::time::{Duration, Instant};
 
+/// What shading calls need to shade with shadows.
+pub struct Shadows {
+    /// What the lights reach of each projected triangle.
+    pub test: ShadowTest,
+    /// The projected triangles (`Tri::source` indexes them).
+    pub screen: Vec<ScreenTriangle>,
+    /// Per projected triangle that the same lights reach everywhere, not all of them: the
+    /// triangle relit by those lights (made once, not per call).
+    pub relit: Vec<Option<ScreenTriangle>>,
+}
+
 /// The triangles of a scene, and what making them did.
 pub struct Triangles {
     /// Where the scene came from.
@@ -35,9 +46,8 @@ pub struct Triangles {
     /// With Phong shading: the projected triangles (`Tri::source` indexes them) and the
     /// lighting.
     pub phong: Option<(Vec<ScreenTriangle>, PhongShader)>,
-    /// With shadows: what the lights reach of each projected triangle, and the projected
-    /// triangles (`Tri::source` indexes them).
-    pub shadows: Option<(ShadowTest, Vec<ScreenTriangle>)>,
+    /// With shadows: what the lights reach of each projected triangle.
+    pub shadows: Option<Shadows>,
     /// Wall time of the shadow pass (the lights' views).
     pub shadow_time: Duration,
     /// What projection did (world scenes).
@@ -85,7 +95,20 @@ impl Triangles {
                 if !casters.is_empty() {
                     let begun = Instant::now();
                     let test = ShadowTest::new(&w, shading, &screen, &casters, settings.threads)?;
-                    shadows = Some((test, screen.clone()));
+                    let relit = (0..screen.len())
+                        .map(|k| match test.uniform(k) {
+                            Some(set) if set != LightSet::ALL => Some(ScreenTriangle {
+                                intensity: test.corners(k, &screen[k], set),
+                                ..screen[k]
+                            }),
+                            _ => None,
+                        })
+                        .collect();
+                    shadows = Some(Shadows {
+                        test,
+                        screen: screen.clone(),
+                        relit,
+                    });
                     shadow_time = begun.elapsed();
                 }
                 if shading == Shading::Phong {
@@ -127,12 +150,12 @@ impl Triangles {
         let lit = self
             .shadows
             .as_ref()
-            .map_or(LightSet::ALL, |(test, _)| test.lit_at(k, [x, y]));
+            .map_or(LightSet::ALL, |s| s.test.lit_at(k, [x, y]));
         match (&self.phong, &self.shadows) {
             (Some((tris, shader)), shadows) => {
                 let mut v = match shadows {
-                    Some((test, _)) if lit != LightSet::ALL => {
-                        shader.at_lit(&tris[k], [x, y], |l| test.casters().reaches(lit, l))
+                    Some(s) if lit != LightSet::ALL => {
+                        shader.at_lit(&tris[k], [x, y], |l| s.test.casters().reaches(lit, l))
                     }
                     _ => shader.at(&tris[k], [x, y]),
                 }
@@ -142,12 +165,19 @@ impl Triangles {
                 }
                 v
             }
-            (None, Some((test, screen))) if lit != LightSet::ALL => {
+            (None, Some(s)) if lit != LightSet::ALL => {
                 // Gouraud or flat without the lights that do not reach: the corners relit
-                let t = &screen[k];
-                let shaded = ScreenTriangle {
-                    intensity: test.corners(k, t, lit),
-                    ..*t
+                let made;
+                let shaded = match &s.relit[k] {
+                    Some(t) => t,
+                    None => {
+                        let t = &s.screen[k];
+                        made = ScreenTriangle {
+                            intensity: s.test.corners(k, t, lit),
+                            ..*t
+                        };
+                        &made
+                    }
                 };
                 shaded.intensity_at([x, y], channels).unwrap_or_default()
             }
@@ -158,7 +188,7 @@ impl Triangles {
     /// The summary's geometry row.
     pub fn summary_rows(&self) -> Vec<(&'static str, String)> {
         let mut rows = self.geometry_rows();
-        if let Some((test, _)) = &self.shadows {
+        if let Some(Shadows { test, .. }) = &self.shadows {
             rows.push((
                 "shadows",
                 format!(
@@ -199,7 +229,7 @@ impl Triangles {
             "kind": self.kind,
             "triangles": self.tris.len(),
             "project": self.project,
-            "shadows": self.shadows.as_ref().map(|(test, _)| serde_json::json!({
+            "shadows": self.shadows.as_ref().map(|Shadows { test, .. }| serde_json::json!({
                 "lights": test.casters().lights.len(),
                 "light_triangles": test.light_triangles,
                 "light_fragments": test.light_fragments,
