@@ -2,7 +2,7 @@
 
 mod common;
 
-use common::{cwisim, cwisim_ok, scratch};
+use common::{cwisim, cwisim_ok, scratch, text};
 use cwisim_scene::{parse_scene, Scene};
 use cwisim_ypipe::exact::scene_box_filtered;
 use std::path::Path;
@@ -254,15 +254,15 @@ fn without_host_times(text: &str, csv: bool) -> String {
             column = if csv {
                 fields.iter().position(|f| *f == "host_ms")
             } else {
-                // `host ms`: two words of the header, 13th of a row
-                (fields.first() == Some(&"renderer")).then_some(12)
+                // `host ms`: two words of the header, 14th of a row
+                (fields.first() == Some(&"renderer")).then_some(13)
             };
         }
         let keep: Vec<&str> = fields
             .iter()
             .enumerate()
             .filter(|&(k, _)| {
-                let row = csv || fields.len() >= 16;
+                let row = csv || fields.len() >= 17;
                 !(row && Some(k) == column)
             })
             .map(|(_, f)| *f)
@@ -333,5 +333,86 @@ fn fit_is_the_same_at_any_thread_count() {
     assert!(one.contains("replays"), "{one}");
     for threads in ["2", "3", "0"] {
         assert_eq!(run(threads), one, "--threads {threads}");
+    }
+}
+
+/// The shadows axis: each renderer that draws shadows measured with them on and off, each
+/// row against the exact image with the same shadows (so the exact settings stay exact);
+/// a value that could not be drawn is refused.
+#[test]
+fn the_shadows_axis_measures_each_side_against_its_own_exact_image() {
+    let dir = scratch("tradeoff-shadows");
+    cwisim_ok(
+        &dir,
+        &[
+            "tradeoff",
+            "pot",
+            "--size",
+            "40x40",
+            "--renderers",
+            "vanrij,sbuffer",
+            "--shadows",
+            "on,off",
+            "--repeat",
+            "1",
+            "--numeric",
+            "f64",
+            "--csv",
+            "t.csv",
+        ],
+    );
+    let (header, rows) = read_csv(&dir.join("t.csv"));
+    for renderer in ["vanrij", "sbuffer"] {
+        let of = |on: &str| {
+            rows.iter()
+                .filter(|r| {
+                    r.get(&header, "renderer") == renderer && r.get(&header, "shadows") == on
+                })
+                .count()
+        };
+        assert!(of("on") > 0 && of("on") == of("off"), "{renderer}");
+    }
+    // vanrij's exact box filter is exact with either
+    for on in ["on", "off"] {
+        let exact = rows
+            .iter()
+            .find(|r| {
+                r.get(&header, "renderer") == "vanrij"
+                    && r.get(&header, "shading") == "gouraud"
+                    && r.get(&header, "aa") == "box"
+                    && r.get(&header, "visibility") == "exact"
+                    && r.get(&header, "shadows") == on
+            })
+            .unwrap();
+        let e: f64 = exact.get(&header, "max_error").parse().unwrap();
+        assert!(e < 1e-9, "shadows {on}: {e}");
+    }
+    // the shadows show: the same setting differs between the two
+    let instructions = |on: &str| {
+        rows.iter()
+            .find(|r| {
+                r.get(&header, "renderer") == "vanrij"
+                    && r.get(&header, "shading") == "flat"
+                    && r.get(&header, "aa") == "box"
+                    && r.get(&header, "visibility") == "exact"
+                    && r.get(&header, "shadows") == on
+            })
+            .unwrap()
+            .get(&header, "instructions")
+    };
+    assert_ne!(instructions("on"), instructions("off"));
+    for (args, says) in [
+        (vec!["fig25", "--shadows", "on"], "the scene has no lights"),
+        (
+            vec!["pot", "--shadows", "on,on"],
+            "each of on and off at most once",
+        ),
+    ] {
+        let mut all = vec!["tradeoff"];
+        all.extend(&args);
+        let out = cwisim(&dir, &all);
+        let (_, stderr) = text(&out);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(stderr.contains(says), "{args:?}: {stderr}");
     }
 }

@@ -50,6 +50,9 @@ pub struct Row {
     /// `exact`, `eval0`, or `-` (screen scenes, and renderers that do not read
     /// `--visibility`: the supersampling ones and `nishita`, which resolve it themselves).
     pub visibility: &'static str,
+    /// `on` or `off`: whether the scene's lights cast shadows in this row; `-` for a
+    /// screen scene (nothing lit).
+    pub shadows: &'static str,
     /// Quads per Bézier patch side (scenes with Bézier meshes, when the grid varies it).
     pub tessellate: Option<u32>,
     /// The root tolerance of a renderer that draws the patches directly (`nishita`);
@@ -113,6 +116,9 @@ impl Setting {
         if let Some(n) = s.tessellate {
             words.push(format!("tessellate {n}"));
         }
+        if let (Some(on), true) = (s.shadows, reads(self, Flag::Shadows)) {
+            words.push(if on { "shadows on" } else { "shadows off" }.into());
+        }
         words.push(short_numeric(&self.numeric));
         words.join(" ")
     }
@@ -134,6 +140,11 @@ pub struct Axes {
     /// The scene has Bézier patches: a renderer that draws them directly has something
     /// of its own to draw (without, it would draw exactly as `vanrij`).
     pub patches: bool,
+    /// Some light of the scene casts shadows as the scene says (`"shadows": true`).
+    pub casting: bool,
+    /// The shadows axis, for the renderers that draw shadows: each value a
+    /// `Settings::shadows` to try (empty: as the scene says, one value).
+    pub shadows: Vec<Option<bool>>,
 }
 
 /// The root tolerances of a renderer that draws Bézier patches directly (Nishita et
@@ -164,10 +175,61 @@ pub fn grid(
         axes.tessellations.iter().map(|&n| Some(n)).collect()
     };
     for &renderer in renderers {
-        if renderer.patches && !axes.patches {
-            // no patches to draw: its rows would be vanrij's ([`skipped_renderers`])
+        if skipped(renderer, axes).is_some() {
             continue;
         }
+        // the renderer's block once per shadows value (its numeric formats kept together:
+        // they share a stream)
+        let start = out.len();
+        grid_of(
+            renderer,
+            axes,
+            formats,
+            &tessellations,
+            visibilities,
+            &mut out,
+        );
+        if renderer.uses.contains(&Flag::Shadows) && !axes.shadows.is_empty() {
+            let block: Vec<Setting> = out.drain(start..).collect();
+            for &shadows in &axes.shadows {
+                out.extend(block.iter().map(|s| Setting {
+                    settings: Settings {
+                        shadows,
+                        ..s.settings
+                    },
+                    ..*s
+                }));
+            }
+        }
+    }
+    out
+}
+
+/// Why `renderer` is left out of the grid: a renderer of Bézier patches on a scene
+/// without any (it would draw exactly as `vanrij`), or one that does not draw shadows on
+/// a scene whose lights cast them.
+fn skipped(renderer: &registry::Entry, axes: &Axes) -> Option<String> {
+    if renderer.patches && !axes.patches {
+        return Some("the scene has no Bézier patches, so it would draw exactly as vanrij".into());
+    }
+    // (where the scene casts none, it is measured as drawn: without, beside the shadows
+    // axis's `off` rows)
+    if axes.casting && !renderer.uses.contains(&Flag::Shadows) {
+        return Some("it does not draw shadows, and the scene's lights cast them".into());
+    }
+    None
+}
+
+/// The settings of one renderer ([`grid`]), appended to `out`.
+fn grid_of(
+    renderer: &'static registry::Entry,
+    axes: &Axes,
+    formats: &[Numeric],
+    tessellations: &[Option<u32>],
+    visibilities: &[Visibility],
+    out: &mut Vec<Setting>,
+) {
+    {
         if renderer.patches {
             // patches drawn directly: no tessellation, exact visibility (it reads no
             // other), smooth shading, the box filter (Phong's: `box-centre`); the root
@@ -189,10 +251,10 @@ pub fn grid(
                     }
                 }
             }
-            continue;
+            return;
         }
         if renderer.supersampled {
-            for &tessellate in &tessellations {
+            for &tessellate in tessellations {
                 for shading in [Shading::Phong, Shading::Gouraud, Shading::Flat] {
                     if shading == Shading::Phong && !axes.world {
                         continue;
@@ -214,9 +276,9 @@ pub fn grid(
                     }
                 }
             }
-            continue;
+            return;
         }
-        for &tessellate in &tessellations {
+        for &tessellate in tessellations {
             for &visibility in visibilities {
                 for shading in [Shading::Phong, Shading::Gouraud, Shading::Flat] {
                     if shading == Shading::Phong && !(axes.world && visibility == Visibility::Exact)
@@ -250,7 +312,6 @@ pub fn grid(
             }
         }
     }
-    out
 }
 
 /// The box filter a shading is drawn with in the grid, as `cwisim render --aa` names
@@ -451,21 +512,33 @@ pub enum Step<'a> {
     },
 }
 
-/// The renderers among `entries` that would draw a scene exactly as another, with why:
-/// one that draws Bézier patches directly, on a scene without patches, draws it as
-/// `vanrij` does.
+/// The renderers among `entries` left out of the grid, with why ([`skipped`]): one that
+/// draws Bézier patches directly, on a scene without patches, draws it as `vanrij` does;
+/// one that does not draw shadows cannot draw a scene whose lights cast them.
 pub fn skipped_renderers(
     entries: &[&'static registry::Entry],
     axes: &Axes,
 ) -> Vec<(&'static str, String)> {
     entries
         .iter()
-        .filter(|e| e.patches && !axes.patches)
-        .map(|e| {
-            (
-                e.name,
-                "the scene has no Bézier patches, so it would draw exactly as vanrij".to_string(),
-            )
+        .filter_map(|e| skipped(e, axes).map(|why| (e.name, why)))
+        .collect()
+}
+
+/// The shadows axis for the values `wanted` (`true`: on) on a scene whose lights cast
+/// shadows as `lights` says: `on` every light casting (`--shadows on`), `off` none
+/// (`--shadows off`, or the scene as it is when no light casts). Refused where a value
+/// could not be drawn: shadows in a scene without lights.
+pub fn shadows_axis(wanted: &[bool], lights: &[bool]) -> Result<Vec<Option<bool>>, StudyError> {
+    wanted
+        .iter()
+        .map(|&on| match on {
+            true if lights.is_empty() => Err(StudyError::from(cwisim_render::RenderError::Usage(
+                "--shadows on: the scene has no lights to cast them".into(),
+            ))),
+            true => Ok(Some(true)),
+            false if lights.contains(&true) => Ok(Some(false)),
+            false => Ok(None),
         })
         .collect()
 }
@@ -482,6 +555,7 @@ pub fn tradeoff_rows(
     scene: Option<&Path>,
     size: Option<Size>,
     tessellations: &[u32],
+    shadows: &[bool],
     renderers: &[String],
     formats: &[Numeric],
     machine: &Machine,
@@ -510,7 +584,13 @@ pub fn tradeoff_rows(
             .collect::<Result<_, _>>()?
     };
     let probe = Source::resolve(scene)?.load(size)?.scene;
+    let lights = match &probe {
+        cwisim_world::AnyScene::World(w) => w.spec.lights.iter().map(|l| l.shadows).collect(),
+        cwisim_world::AnyScene::Screen(_) => Vec::new(),
+    };
     let axes = Axes {
+        casting: lights.contains(&true),
+        shadows: shadows_axis(shadows, &lights)?,
         world: probe.kind() == "world",
         size,
         tessellations: if probe.has_patches() {
@@ -539,7 +619,7 @@ pub fn tradeoff_rows(
                 .zip(measured)
                 .map(|(setting, (measured, times))| {
                     let reference = references.get(scene, setting, axes.world)?;
-                    Ok(row_of(setting, &measured, &times, &reference, axes.world))
+                    Ok(row_of(setting, &measured, &times, &reference, &axes))
                 })
                 .collect::<Result<Vec<Row>, StudyError>>()
         },
@@ -603,8 +683,11 @@ fn describe_stream(group: &[Setting]) -> String {
 /// setting that needs it, while the others that need it wait.
 #[derive(Default)]
 struct References {
-    made: std::sync::Mutex<BTreeMap<(bool, Option<u32>), Reference>>,
+    made: std::sync::Mutex<BTreeMap<ReferenceKey, Reference>>,
 }
+
+/// What tells references apart: Phong's or Gouraud's, the tessellation, the shadows.
+type ReferenceKey = (bool, Option<u32>, Option<bool>);
 
 type Reference = std::sync::Arc<std::sync::Mutex<Option<std::sync::Arc<Vec<f64>>>>>;
 
@@ -619,7 +702,11 @@ impl References {
         world: bool,
     ) -> Result<std::sync::Arc<Vec<f64>>, StudyError> {
         let tessellation = reference_tessellation(setting, world);
-        let key = (setting.settings.shading == Shading::Phong, tessellation);
+        let key = (
+            setting.settings.shading == Shading::Phong,
+            tessellation,
+            setting.settings.shadows,
+        );
         let slot = {
             let mut made = self.made.lock().expect("no reference panicked");
             std::sync::Arc::clone(made.entry(key).or_default())
@@ -731,8 +818,9 @@ fn row_of(
     measured: &Measured,
     times: &[Duration],
     reference: &[f64],
-    world: bool,
+    axes: &Axes,
 ) -> Row {
+    let world = axes.world;
     let mut times = times.to_vec();
     times.sort();
     let stats = &measured.stats;
@@ -740,9 +828,20 @@ fn row_of(
     let (max_error, rms_error, psnr_db) = errors(&measured.image, reference);
     let worst = stats.lines.iter().map(|l| l.busy_cycles).max().unwrap_or(0);
     let s = &setting.settings;
+    // shadows as drawn: the setting's, or the scene's own (a renderer that does not draw
+    // them is measured only where the scene casts none)
+    let shadows = match s.shadows {
+        Some(on) if reads(setting, Flag::Shadows) => on,
+        _ => axes.casting,
+    };
     Row {
         renderer: setting.renderer.name,
         shading: s.shading.name(),
+        shadows: match (world, shadows) {
+            (false, _) => "-",
+            (true, true) => "on",
+            (true, false) => "off",
+        },
         aa: if reads(setting, Flag::Aa) {
             s.aa.name()
         } else {
@@ -797,8 +896,8 @@ pub fn name_width<'a>(names: impl Iterator<Item = &'a str>) -> usize {
 pub fn write_table_header(out: &mut dyn Write, rw: usize) -> std::io::Result<()> {
     writeln!(
         out,
-        "{:<rw$} {:>4} {:<8} {:<10} {:>2} {:<5} {:<34} {:>4} {:>8} {:>9} {:>6} {:>4} {:>8} {:>9} {:>9} {:>6} {:>5}  pareto",
-        "renderer", "tess", "shading", "aa", "l", "vis", "numeric", "bits", "instr", "busy cyc", "worst", "late", "host ms", "max err", "RMS err", "PSNR", "ovfl"
+        "{:<rw$} {:>4} {:<8} {:<10} {:>2} {:<5} {:<4} {:<34} {:>4} {:>8} {:>9} {:>6} {:>4} {:>8} {:>9} {:>9} {:>6} {:>5}  pareto",
+        "renderer", "tess", "shading", "aa", "l", "vis", "shad", "numeric", "bits", "instr", "busy cyc", "worst", "late", "host ms", "max err", "RMS err", "PSNR", "ovfl"
     )
 }
 
@@ -807,7 +906,7 @@ pub fn write_table_header(out: &mut dyn Write, rw: usize) -> std::io::Result<()>
 pub fn write_table_row(out: &mut dyn Write, r: &Row, rw: usize) -> std::io::Result<()> {
     writeln!(
             out,
-            "{:<rw$} {:>4} {:<8} {:<10} {:>2} {:<5} {:<34} {:>4} {:>8} {:>9} {:>5.1}% {:>4} {:>8.2} {:>9.2e} {:>9.2e} {:>6} {:>5}  {}",
+            "{:<rw$} {:>4} {:<8} {:<10} {:>2} {:<5} {:<4} {:<34} {:>4} {:>8} {:>9} {:>5.1}% {:>4} {:>8.2} {:>9.2e} {:>9.2e} {:>6} {:>5}  {}",
             r.renderer,
             match (r.tessellate, r.root_tolerance) {
                 (_, Some(t)) => format!("{t:.0e}"),
@@ -818,6 +917,7 @@ pub fn write_table_row(out: &mut dyn Write, r: &Row, rw: usize) -> std::io::Resu
             r.aa,
             r.samples.map_or_else(|| "-".to_string(), |n| n.to_string()),
             r.visibility,
+            r.shadows,
             r.numeric,
             r.register_bits,
             r.instructions,
@@ -850,7 +950,7 @@ pub fn csv(rows: &[Row]) -> String {
         }
     }
     let mut s = String::from(
-        "renderer,tessellate,root_tolerance,shading,aa,samples,visibility,numeric,register_bits,instructions,busy_cycles,worst_line_share,late_lines,host_ms,max_error,rms_error,psnr_db,overflows,pareto",
+        "renderer,tessellate,root_tolerance,shading,aa,samples,visibility,shadows,numeric,register_bits,instructions,busy_cycles,worst_line_share,late_lines,host_ms,max_error,rms_error,psnr_db,overflows,pareto",
     );
     for name in &names {
         s.push_str(",counter_");
@@ -859,7 +959,7 @@ pub fn csv(rows: &[Row]) -> String {
     s.push('\n');
     for r in rows {
         s.push_str(&format!(
-            "{},{},{},{},{},{},{},\"{}\",{},{},{},{},{},{},{:e},{:e},{},{},{}",
+            "{},{},{},{},{},{},{},{},\"{}\",{},{},{},{},{},{},{:e},{:e},{},{},{}",
             r.renderer,
             r.tessellate.map_or_else(String::new, |n| n.to_string()),
             r.root_tolerance
@@ -868,6 +968,7 @@ pub fn csv(rows: &[Row]) -> String {
             r.aa,
             r.samples.map_or_else(String::new, |n| n.to_string()),
             r.visibility,
+            r.shadows,
             r.numeric,
             r.register_bits,
             r.instructions,
@@ -903,6 +1004,7 @@ mod tests {
             aa: "box",
             samples: None,
             visibility: "exact",
+            shadows: "off",
             tessellate: None,
             root_tolerance: None,
             numeric: "f64".into(),
@@ -930,6 +1032,7 @@ mod tests {
             size: None,
             tessellations: vec![4, 8],
             patches: true,
+            ..Axes::default()
         };
         let g = grid(&[vanrij], &world, &f64_only);
         // 2 tessellations × (exact: phong, gouraud, flat; eval0: gouraud, flat) × 2 aa,
@@ -1004,6 +1107,7 @@ mod tests {
                     size,
                     tessellations: vec![4, 8],
                     patches: true,
+                    ..Axes::default()
                 },
             ),
             (
@@ -1012,6 +1116,16 @@ mod tests {
                 Axes {
                     world: true,
                     size,
+                    ..Axes::default()
+                },
+            ),
+            (
+                "pot",
+                &pot,
+                Axes {
+                    world: true,
+                    size,
+                    shadows: shadows_axis(&[true, false], &[false]).unwrap(),
                     ..Axes::default()
                 },
             ),
@@ -1035,7 +1149,7 @@ mod tests {
             let g = grid(&entries, &axes, &[Numeric::F64]);
             assert!(!g.is_empty(), "{name}");
             for setting in &g {
-                let row = row_of(setting, &measured, &[], &[], axes.world);
+                let row = row_of(setting, &measured, &[], &[], &axes);
                 let entry = setting.renderer;
                 let what = format!("{name}: {}", setting.describe());
                 // the flags the row prints, parsed back over the defaults
@@ -1064,6 +1178,11 @@ mod tests {
                 if let Some(t) = row.root_tolerance {
                     given.push(Flag::RootTolerance);
                     parsed.root_tolerance = t;
+                }
+                // shadows printed otherwise than the scene draws them: the flag
+                if row.shadows != "-" && (row.shadows == "on") != axes.casting {
+                    given.push(Flag::Shadows);
+                    parsed.shadows = Some(row.shadows == "on");
                 }
                 assert_eq!(entry.check_given(&given, &parsed), Ok(()), "{what}");
                 assert_eq!(entry.check_scene(&given, scene, name), Ok(()), "{what}");

@@ -5,6 +5,7 @@
 //!
 
 use super::MachineArgs;
+use crate::draw::ShadowsArg;
 use crate::error::CliError;
 use crate::files::{check_outputs, write_atomic};
 use crate::output::write_rgb_png;
@@ -32,6 +33,11 @@ pub struct TradeoffArgs {
     /// comma-separated.
     #[arg(long = "tessellate", value_name = "N,…", value_delimiter = ',', default_values_t = [4u32, 8, 16])]
     pub tessellate: Vec<u32>,
+    /// World scenes: the shadows to try, `on`, `off` or both (`on,off`): every light
+    /// casting shadows, or none, for each renderer that draws them [default: as the scene
+    /// says]. Each row is measured against the exact image with the same shadows.
+    #[arg(long, value_enum, value_name = "on|off,…", value_delimiter = ',')]
+    pub shadows: Vec<ShadowsArg>,
     /// The renderers to try, comma-separated (default: every registered renderer;
     /// `cwisim renderers` lists them).
     #[arg(long, value_name = "LIST", value_delimiter = ',')]
@@ -76,6 +82,12 @@ pub fn run(args: &TradeoffArgs, stdout: &mut dyn Write, progress: bool) -> Resul
         crate::cost_args::check_extension("--csv", p, "csv")?;
     }
     cwisim_scene::budget::check_threads(args.threads).map_err(CliError::Usage)?;
+    let shadows: Vec<bool> = args.shadows.iter().map(|&s| s == ShadowsArg::On).collect();
+    if (1..shadows.len()).any(|k| shadows[..k].contains(&shadows[k])) {
+        return Err(CliError::Usage(
+            "--shadows: each of on and off at most once".into(),
+        ));
+    }
     let machine = args.machine.load()?;
     let formats: Vec<Numeric> = if args.numeric.is_empty() {
         DEFAULT_FORMATS
@@ -94,6 +106,7 @@ pub fn run(args: &TradeoffArgs, stdout: &mut dyn Write, progress: bool) -> Resul
         args.scene.as_deref(),
         args.size,
         &args.tessellate,
+        &shadows,
         &args.renderers,
         &formats,
         &machine,

@@ -623,10 +623,12 @@ impl Scan<'_> {
         let mut figures = Vec::with_capacity(height as usize);
         let l = s.l as usize;
         let mut sublines: Vec<Subline> = vec![Subline::default(); l];
-        // which rules send runs while they fill
+        // which rules send runs while they fill (a Phong run's values are per pixel,
+        // lit and fitted when the line is done: the unset list's runs wait for it too)
         let sends_while_filling = match self.rule {
             Rule::Nearer => self.overdraw,
-            Rule::Unset | Rule::Claim => true,
+            Rule::Unset => self.shading != Shading::Phong,
+            Rule::Claim => true,
             Rule::Paint => false,
         };
         for row in 0..height {
