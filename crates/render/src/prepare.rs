@@ -9,7 +9,7 @@ use crate::source::{LoadedScene, Source};
 use cwisim_scene::{ScreenScene, Shading, Vector};
 use cwisim_world::face::ScreenTriangle;
 use cwisim_world::shade::PhongShader;
-use cwisim_world::shadow::{self, Casters, LightSet, ShadowStats};
+use cwisim_world::shadow::{self, Casters, LightSet, ShadowStats, ShadowTest};
 use cwisim_world::{AnyScene, ProjectStats, Visibility, VisibilityStats};
 use std::time::{Duration, Instant};
 
@@ -93,14 +93,6 @@ impl PhongSurfaces {
     }
 }
 
-/// The lights of `scene` that cast shadows under `settings` (none in a screen scene).
-pub fn shadow_casters(scene: &AnyScene, settings: &Settings) -> Result<Casters, RenderError> {
-    match scene {
-        AnyScene::World(w) => Ok(shadow::casters(&w.spec, settings.shadows)?),
-        AnyScene::Screen(_) => Ok(Casters::default()),
-    }
-}
-
 /// Refuses shadows a scene asks for (`"shadows": true`) in a renderer (`name`) that does
 /// not draw them, naming the one that does (`--shadows` itself is refused by the
 /// command line for a renderer that does not read it).
@@ -109,8 +101,10 @@ pub fn refuse_shadows(
     scene: &AnyScene,
     settings: &Settings,
 ) -> Result<(), RenderError> {
-    let casters = shadow_casters(scene, settings)?;
-    match casters.lights.first() {
+    let AnyScene::World(w) = scene else {
+        return Ok(());
+    };
+    match shadow::casters(&w.spec, settings.shadows)?.lights.first() {
         None => Ok(()),
         Some(&k) => Err(RenderError::Usage(format!(
             "{name} does not draw shadows, and the scene's lights[{k}] casts them (\"shadows\": true): use --renderer vanrij (exact shadow polygons), or set \"shadows\": false"
@@ -135,6 +129,46 @@ pub(crate) fn world_casters(
         )),
         _ => Ok(shadow::casters(&w.spec, settings.shadows)?),
     }
+}
+
+/// For a renderer that tests each sample: what the lights that cast shadows under
+/// `settings` reach of the projected triangles `tris` of `w` (lit for `shading`), and how
+/// long making it took; `None` when no light casts shadows.
+pub(crate) fn sampled_shadows(
+    w: &cwisim_world::WorldScene,
+    tris: &[ScreenTriangle],
+    settings: &Settings,
+) -> Result<Option<(ShadowTest, Duration)>, RenderError> {
+    let casters = world_casters(w, settings)?;
+    if casters.is_empty() {
+        return Ok(None);
+    }
+    let start = Instant::now();
+    let test = ShadowTest::new(w, settings.shading, tris, &casters, settings.threads)?;
+    Ok(Some((test, start.elapsed())))
+}
+
+/// The summary's `shadows` row of a renderer that tests each sample (`how`: what it
+/// tests).
+pub(crate) fn sampled_shadows_row(test: &ShadowTest, how: &str) -> (&'static str, String) {
+    (
+        "shadows",
+        format!(
+            "{} light(s) casting, exact: {how} ({} triangles in the lights' views, {} seen)",
+            test.casters().lights.len(),
+            test.light_triangles,
+            test.light_fragments
+        ),
+    )
+}
+
+/// The `--stats-json` figures of [`sampled_shadows`].
+pub(crate) fn sampled_shadows_json(test: &ShadowTest) -> serde_json::Value {
+    serde_json::json!({
+        "lights": test.casters().lights.len(),
+        "light_triangles": test.light_triangles,
+        "light_fragments": test.light_fragments,
+    })
 }
 
 /// The refusal of Phong shading on a screen scene, the same from every renderer.

@@ -63,6 +63,17 @@ impl ScreenTriangle {
         Some([1.0 - w_b - w_c, w_b, w_c])
     }
 
+    /// The perspective-correct weights of the world corners at screen point `p`, not yet
+    /// divided by their sum (returned beside them): `b_k · (1/z_k)`, `b` the screen
+    /// barycentrics. The world point there is `Σ w_k P_k / sum`. `None` for a degenerate
+    /// triangle or a sum that is zero or not finite.
+    pub fn perspective_weights(&self, p: [f64; 2]) -> Option<([f64; 3], f64)> {
+        let b = self.barycentric(p)?;
+        let w = [0, 1, 2].map(|k| b[k] * self.inv_depth[k]);
+        let sum = w[0] + w[1] + w[2];
+        (sum != 0.0 && sum.is_finite()).then_some((w, sum))
+    }
+
     /// `1 / depth` at screen point `p` (affine; extrapolated outside the triangle).
     pub fn inv_depth_at(&self, p: [f64; 2]) -> Option<f64> {
         let w = self.barycentric(p)?;

@@ -40,12 +40,7 @@ impl PhongShader {
     /// The world point and the unit normal of `t` at screen point `p`; `None` for a
     /// degenerate triangle or where the interpolated normal vanishes.
     pub fn surface_at(&self, t: &ScreenTriangle, p: [f64; 2]) -> Option<(DVec3, DVec3)> {
-        let b = t.barycentric(p)?;
-        let w = [0, 1, 2].map(|k| b[k] * t.inv_depth[k]);
-        let sum = w[0] + w[1] + w[2];
-        if sum == 0.0 || !sum.is_finite() {
-            return None;
-        }
+        let (w, sum) = t.perspective_weights(p)?;
         let s = &t.surface;
         let point = (w[0] * s.world[0] + w[1] * s.world[1] + w[2] * s.world[2]) / sum;
         let normal =

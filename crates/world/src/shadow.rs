@@ -321,14 +321,13 @@ impl LightView {
     }
 }
 
-/// The world point of light-view triangle `t` at its screen point `q`: the corners
-/// weighted by the screen barycentrics times `1/depth` (perspective-correct).
+/// The world point of light-view triangle `t` at its screen point `q`
+/// (perspective-correct, [`ScreenTriangle::perspective_weights`]; a triangle the light
+/// sees has area and lies in front of it, so they exist — its centroid otherwise).
 fn world_at(t: &ScreenTriangle, q: Pt) -> DVec3 {
-    let b = t.barycentric(q).unwrap_or([1.0 / 3.0; 3]);
-    let w = [0, 1, 2].map(|k| b[k] * t.inv_depth[k]);
-    let sum = w[0] + w[1] + w[2];
+    let ([w0, w1, w2], sum) = t.perspective_weights(q).unwrap_or(([1.0; 3], 3.0));
     let s = &t.surface.world;
-    (w[0] * s[0] + w[1] * s[1] + w[2] * s[2]) / sum
+    (w0 * s[0] + w1 * s[1] + w2 * s[2]) / sum
 }
 
 /// How a light reaches one camera triangle.

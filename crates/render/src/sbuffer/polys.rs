@@ -182,17 +182,9 @@ impl Polys {
                 if shading == Shading::Phong {
                     shader = Some(PhongShader::new(&w));
                 }
-                let casters = crate::prepare::world_casters(&w, settings)?;
-                if !casters.is_empty() {
-                    let begun = Instant::now();
-                    shadows = Some(ShadowTest::new(
-                        &w,
-                        shading,
-                        &tris,
-                        &casters,
-                        settings.threads,
-                    )?);
-                    shadow_time = begun.elapsed();
+                if let Some((test, time)) = crate::prepare::sampled_shadows(&w, &tris, settings)? {
+                    shadows = Some(test);
+                    shadow_time = time;
                 }
                 triangles = Some(tris);
                 eye = Some(w.spec.camera.eye);
@@ -252,15 +244,6 @@ impl Polys {
         Some(v)
     }
 
-    /// The lights that reach polygon `p` (of a world scene) at sample `(x, y)`: every
-    /// light without shadows.
-    pub fn lit_at(&self, p: &Poly, x: f64, y: f64) -> LightSet {
-        match &self.shadows {
-            Some(test) => test.lit_at(p.source as usize, [x, y]),
-            None => LightSet::ALL,
-        }
-    }
-
     /// The lights that reach polygon `p` along line `y` (of a world scene with shadows),
     /// ready to be asked at each sample of a span.
     pub fn line_lights(&self, p: &Poly, y: f64) -> Option<LineLights> {
@@ -271,7 +254,7 @@ impl Polys {
 
     /// The lights that reach all of polygon `p`, when that is the same everywhere on it
     /// (every light without shadows); `None` when it must be asked sample by sample
-    /// ([`Self::lit_at`]).
+    /// ([`Self::line_lights`]).
     pub fn uniform_lit(&self, p: &Poly) -> Option<LightSet> {
         match &self.shadows {
             Some(test) => test.uniform(p.source as usize),
@@ -306,14 +289,9 @@ impl Polys {
     pub fn summary_rows(&self) -> Vec<(&'static str, String)> {
         let mut rows = self.geometry_rows();
         if let Some(test) = &self.shadows {
-            rows.push((
-                "shadows",
-                format!(
-                    "{} light(s) casting, exact: each sample a polygon sets is tested against its triangle's lit parts, and a run split where the lights change ({} triangles in the lights' views, {} seen)",
-                    test.casters().lights.len(),
-                    test.light_triangles,
-                    test.light_fragments
-                ),
+            rows.push(crate::prepare::sampled_shadows_row(
+                test,
+                "each sample a polygon sets is tested against its triangle's lit parts, and a run split where the lights change",
             ));
         }
         rows
@@ -348,11 +326,7 @@ impl Polys {
             "polygons": self.polys.len(),
             "degenerate": self.degenerate,
             "project": self.project,
-            "shadows": self.shadows.as_ref().map(|test| serde_json::json!({
-                "lights": test.casters().lights.len(),
-                "light_triangles": test.light_triangles,
-                "light_fragments": test.light_fragments,
-            })),
+            "shadows": self.shadows.as_ref().map(crate::prepare::sampled_shadows_json),
         })
     }
 }

@@ -91,10 +91,8 @@ impl Triangles {
                     })
                     .collect();
                 project = Some(stats);
-                let casters = crate::prepare::world_casters(&w, settings)?;
-                if !casters.is_empty() {
-                    let begun = Instant::now();
-                    let test = ShadowTest::new(&w, shading, &screen, &casters, settings.threads)?;
+                if let Some((test, time)) = crate::prepare::sampled_shadows(&w, &screen, settings)?
+                {
                     let relit = (0..screen.len())
                         .map(|k| match test.uniform(k) {
                             Some(set) if set != LightSet::ALL => Some(ScreenTriangle {
@@ -109,7 +107,7 @@ impl Triangles {
                         screen: screen.clone(),
                         relit,
                     });
-                    shadow_time = begun.elapsed();
+                    shadow_time = time;
                 }
                 if shading == Shading::Phong {
                     phong = Some((screen, PhongShader::new(&w)));
@@ -189,14 +187,9 @@ impl Triangles {
     pub fn summary_rows(&self) -> Vec<(&'static str, String)> {
         let mut rows = self.geometry_rows();
         if let Some(Shadows { test, .. }) = &self.shadows {
-            rows.push((
-                "shadows",
-                format!(
-                    "{} light(s) casting, exact: each shading call tests its sample against the lit parts ({} triangles in the lights' views, {} seen)",
-                    test.casters().lights.len(),
-                    test.light_triangles,
-                    test.light_fragments
-                ),
+            rows.push(crate::prepare::sampled_shadows_row(
+                test,
+                "each shading call tests its sample against the lit parts",
             ));
         }
         rows
@@ -229,11 +222,10 @@ impl Triangles {
             "kind": self.kind,
             "triangles": self.tris.len(),
             "project": self.project,
-            "shadows": self.shadows.as_ref().map(|Shadows { test, .. }| serde_json::json!({
-                "lights": test.casters().lights.len(),
-                "light_triangles": test.light_triangles,
-                "light_fragments": test.light_fragments,
-            })),
+            "shadows": self
+                .shadows
+                .as_ref()
+                .map(|Shadows { test, .. }| crate::prepare::sampled_shadows_json(test)),
         })
     }
 }
