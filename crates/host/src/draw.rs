@@ -14,16 +14,17 @@ use crate::error::CliError;
 use clap::parser::ValueSource;
 use clap::{ArgMatches, Args, ValueEnum};
 use cwisim_render::cp::Increment;
+pub use cwisim_render::draw::Drawn;
+use cwisim_render::draw::SceneInput;
 use cwisim_render::settings::{
     BspOrder, SbufferMode, Setting, Threshold, Unset, DEFAULT_AA_THRESHOLD,
     DEFAULT_GOURAUD_THRESHOLD, DEFAULT_PHONG_ANGLE,
 };
 use cwisim_render::subsample::Grid;
-use cwisim_render::{registry, LoadedScene, Renderer, Settings, Size, Source};
+use cwisim_render::{registry, Settings, Size};
 use cwisim_scene::{Antialias, Shading};
 use cwisim_world::Visibility;
 use std::path::Path;
-use std::time::Duration;
 
 /// `--shading`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
@@ -414,18 +415,6 @@ impl Default for DrawArgs {
     }
 }
 
-/// A scene read and made ready by a renderer.
-pub struct Drawn {
-    /// Where the scene came from.
-    pub source: Source,
-    /// `"screen"` or `"world"`.
-    pub kind: &'static str,
-    /// Wall time of reading it.
-    pub load_time: Duration,
-    /// The renderer, built for it.
-    pub renderer: Box<dyn Renderer>,
-}
-
 /// `--renderer`, or the flag of a [`Setting`], from its long name (`samples`).
 fn flag_of(long: &str) -> Option<&'static str> {
     match long {
@@ -499,41 +488,17 @@ impl DrawArgs {
     /// [`DrawArgs::draw`], preparing the scene on `threads` threads (exact visibility;
     /// 0: one per core): the renderer is the same at any count.
     pub fn draw_on(&self, scene: Option<&Path>, threads: usize) -> Result<Drawn, CliError> {
-        let entry = registry::find(&self.renderer)?;
         let settings = Settings {
             threads,
             ..self.settings()
         };
-        let given = self.given_settings();
-        entry
-            .check_given(&given, &settings)
-            .map_err(CliError::Usage)?;
-        settings.check().map_err(CliError::Usage)?;
-        let loaded = Source::resolve(scene)?.load_for(&settings)?;
-        let name = scene.map_or_else(
-            || cwisim_render::DEFAULT_SCENE.to_string(),
-            |p| p.display().to_string(),
-        );
-        entry
-            .check_scene(&given, &loaded.scene, &name)
-            .map_err(CliError::Usage)?;
-        Ok(build(entry, loaded, &settings)?)
+        Ok(cwisim_render::draw::draw(
+            &self.renderer,
+            SceneInput::Named(scene),
+            &self.given_settings(),
+            &settings,
+        )?)
     }
-}
-
-/// Builds `entry`'s renderer for a loaded scene.
-pub fn build(
-    entry: &registry::Entry,
-    loaded: LoadedScene,
-    settings: &Settings,
-) -> Result<Drawn, cwisim_render::RenderError> {
-    let (source, kind, load_time) = (loaded.source.clone(), loaded.scene.kind(), loaded.load_time);
-    Ok(Drawn {
-        source,
-        kind,
-        load_time,
-        renderer: (entry.build)(loaded, settings)?,
-    })
 }
 
 #[cfg(test)]
@@ -576,6 +541,54 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// The library's [`Setting::set`] (what Python calls) reads every flag's value as the
+    /// command line does: the same settings from the same words.
+    #[test]
+    fn the_library_reads_every_flag_s_value_as_the_command_line_does() {
+        let value = |s: Setting| match s {
+            Setting::Shading => "phong",
+            Setting::Aa => "box-centre",
+            Setting::Visibility => "eval0",
+            Setting::Size => "64x48",
+            Setting::Tessellate | Setting::Samples | Setting::Band | Setting::Subscan => "5",
+            Setting::Grid => "corner",
+            Setting::MergeSubscanlines => "true",
+            Setting::Seed => "7",
+            Setting::CpIncrement => "paper",
+            Setting::Sbuffer => "overdraw",
+            Setting::Order => "back-to-front",
+            Setting::Unset => "eval0",
+            Setting::GouraudThreshold | Setting::AaThreshold => "all",
+            Setting::PhongAngle => "45",
+            Setting::Shadows => "off",
+            _ => "0.25",
+        };
+        for s in Setting::ALL {
+            let mut args = vec!["cwisim", "render", s.flag()];
+            if s != Setting::MergeSubscanlines {
+                args.push(value(s));
+            }
+            let cli = crate::cli::parse(args.iter().map(|&a| a.into()).collect::<Vec<_>>())
+                .unwrap_or_else(|e| panic!("{args:?}: {e}"));
+            let crate::cli::Command::Render(r) = cli.command else {
+                panic!("render");
+            };
+            let mut library = Settings::default();
+            s.set(&mut library, value(s)).unwrap();
+            assert_eq!(r.draw.settings(), library, "{}", s.flag());
+            assert_ne!(library, Settings::default(), "{}", s.flag());
+            assert_eq!(Setting::of_name(&s.name().replace('-', "_")), Some(s));
+        }
+        let mut settings = Settings::default();
+        assert_eq!(
+            Setting::Samples.set(&mut settings, "three"),
+            Err(
+                "expected a whole number ≥ 0, found `three` (invalid digit found in string)".into()
+            )
+        );
+        assert!(Setting::Shadows.set(&mut settings, "maybe").is_err());
     }
 
     #[test]

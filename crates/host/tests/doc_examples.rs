@@ -59,6 +59,18 @@ const SKIPPED: &[(&str, &str)] = &[
         "builds the binary; this test runs the one Cargo built for it (or CWISIM_BIN)",
     ),
     (
+        "crates/python/install.sh",
+        "installs the Python package (PyPI, a release build); .ci/run runs it into a fresh virtual environment",
+    ),
+    (
+        "python3 -c \"import cwisim",
+        "the Python package, installed by crates/python/install.sh; its tests (pytest) check it",
+    ),
+    (
+        "python3 -m pytest",
+        "the Python package's tests; .ci/run runs them after installing it",
+    ),
+    (
         "rustup ",
         "installs a nightly toolchain for cargo-fuzz (network); .ci/run checks the fuzz targets build",
     ),
@@ -177,6 +189,7 @@ const DOCUMENTS: &[&str] = &[
     "docs/ERRATA.md",
     "docs/FUZZING.md",
     "docs/PERFORMANCE.md",
+    "docs/PYTHON.md",
     "docs/RENDERERS.md",
     "docs/REPRODUCTION.md",
     "docs/SHADOWS.md",
@@ -208,6 +221,11 @@ fn fuzzing() {
 #[test]
 fn performance() {
     run_document("docs/PERFORMANCE.md");
+}
+
+#[test]
+fn python() {
+    run_document("docs/PYTHON.md");
 }
 
 #[test]

@@ -284,10 +284,10 @@ fn shadows_on_adds_the_shadow_phase_after_flat() {
         ["flat", "shadows", "gouraud", "phong", "aa"],
         "{out}"
     );
-    // without it, still-life casts none: no shadow phase, and --shadows off is refused
+    // as embedded, still-life's main light casts: the phase is there; off, it is not
     let out = cwisim_ok(&dir, &["refine", "still-life", "--size", "96x64"]);
-    assert!(!out.lines().any(|l| l.starts_with("shadows ")), "{out}");
-    let out = cwisim(
+    assert!(out.lines().any(|l| l.starts_with("shadows ")), "{out}");
+    let out = cwisim_ok(
         &dir,
         &[
             "refine",
@@ -297,6 +297,12 @@ fn shadows_on_adds_the_shadow_phase_after_flat() {
             "--shadows",
             "off",
         ],
+    );
+    assert!(!out.lines().any(|l| l.starts_with("shadows ")), "{out}");
+    // the pot casts none: --shadows off would change nothing, and is refused
+    let out = cwisim(
+        &dir,
+        &["refine", "pot", "--size", "96x64", "--shadows", "off"],
     );
     let (_, stderr) = text(&out);
     assert_eq!(out.status.code(), Some(2), "{stderr}");

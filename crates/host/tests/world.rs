@@ -81,13 +81,22 @@ fn the_pot_matches_its_reference_picture() {
 fn every_embedded_scene_renders_and_scenes_lists_them() {
     let dir = scratch("embedded");
     let list = cwisim_ok(&dir, &["scenes"]);
-    for name in ["pot", "fig25", "cases12", "still-life", "teapot"] {
+    for name in [
+        "pot",
+        "fig25",
+        "cases12",
+        "still-life",
+        "bowl",
+        "teapot",
+        "teapot-floor",
+    ] {
         assert!(list.lines().any(|l| l.starts_with(name)), "{list}");
         let png = format!("{name}.png");
         cwisim_ok(&dir, &["render", name, "-q", "-o", &png]);
         let img = image::open(dir.join(&png)).expect("png");
         let channels = img.color().channel_count();
-        assert_eq!(channels, if name == "still-life" { 3 } else { 1 }, "{name}");
+        let rgb = ["still-life", "bowl"].contains(&name);
+        assert_eq!(channels, if rgb { 3 } else { 1 }, "{name}");
     }
     // `scenes NAME` prints a file that renders the same as the name
     let text = cwisim_ok(&dir, &["scenes", "still-life"]);

@@ -13,6 +13,8 @@
 //!   count, with the renderer's and the array's wall time; [`emit`](fn@emit): the stream
 //!   alone, into a trace.
 //! * [`source`] — which scene ([`Source`]: a file or an embedded name) and reading it.
+//! * [`draw`](mod@draw) — a renderer by name built for a scene ([`draw::draw`]), the settings given
+//!   checked against what it reads: what every face of cwisim (the CLI, Python) calls.
 //! * [`settings`] — how to draw ([`Settings`]), in plain types.
 //! * [`prepare`] — screen-space polygons from any scene ([`PolygonScene`]), what polygon
 //!   renderers start from.
@@ -50,6 +52,7 @@
 pub mod bsp;
 pub mod cp;
 pub mod cpbench;
+pub mod draw;
 pub mod error;
 pub mod nishita;
 pub mod phong;

@@ -93,25 +93,6 @@ impl PhongSurfaces {
     }
 }
 
-/// Refuses shadows a scene asks for (`"shadows": true`) in a renderer (`name`) that does
-/// not draw them, naming the one that does (`--shadows` itself is refused by the
-/// command line for a renderer that does not read it).
-pub fn refuse_shadows(
-    name: &str,
-    scene: &AnyScene,
-    settings: &Settings,
-) -> Result<(), RenderError> {
-    let AnyScene::World(w) = scene else {
-        return Ok(());
-    };
-    match shadow::casters(&w.spec, settings.shadows)?.lights.first() {
-        None => Ok(()),
-        Some(&k) => Err(RenderError::Usage(format!(
-            "{name} does not draw shadows, and the scene's lights[{k}] casts them (\"shadows\": true): use --renderer vanrij (exact shadow polygons), or set \"shadows\": false"
-        ))),
-    }
-}
-
 /// The lights of world scene `w` that cast shadows under `settings`, refusing a
 /// `--shadows` that would change nothing: `on` in a scene without lights, `off` in one
 /// where no light casts shadows.

@@ -234,6 +234,74 @@ impl Setting {
         Setting::ALL.into_iter().find(|s| s.flag() == flag)
     }
 
+    /// Its name: the flag without its dashes (`shade-tolerance`; Python spells it
+    /// `shade_tolerance`).
+    pub fn name(self) -> &'static str {
+        &self.flag()[2..]
+    }
+
+    /// The setting called `name`, spelled with dashes or underscores
+    /// (`shade-tolerance`, `shade_tolerance`).
+    pub fn of_name(name: &str) -> Option<Setting> {
+        let name = name.replace('_', "-");
+        Setting::ALL.into_iter().find(|s| s.name() == name)
+    }
+
+    /// Sets this setting of `settings` from `value`, spelled as on the command line
+    /// (`gouraud`, `box-centre`, `0.01`, `640x480`, `all`; `--merge-subscanlines` takes
+    /// `true` or `false`, `--shadows` `on` or `off`). The ranges are checked with the
+    /// rest by [`Settings::check`].
+    pub fn set(self, settings: &mut Settings, value: &str) -> Result<(), String> {
+        fn parse<T: FromStr>(value: &str, what: &str) -> Result<T, String>
+        where
+            T::Err: fmt::Display,
+        {
+            value
+                .trim()
+                .parse::<T>()
+                .map_err(|e| format!("expected {what}, found `{value}` ({e})"))
+        }
+        let s = settings;
+        let number = "a number";
+        let count = "a whole number ≥ 0";
+        match self {
+            Setting::Shading => s.shading = value.parse()?,
+            Setting::Aa => s.aa = value.parse()?,
+            Setting::Visibility => s.visibility = value.parse()?,
+            Setting::Eval0Tolerance => s.eval0_tolerance = parse(value, number)?,
+            Setting::Size => s.size = Some(value.parse()?),
+            Setting::ShadeTolerance => s.shade_tolerance = parse(value, number)?,
+            Setting::Tessellate => s.tessellate = Some(parse(value, count)?),
+            Setting::Samples => s.samples = parse(value, count)?,
+            Setting::Grid => s.grid = value.parse()?,
+            Setting::MergeSubscanlines => {
+                s.merge_subscanlines = parse(&value.to_ascii_lowercase(), "true or false")?
+            }
+            Setting::ShadeP => s.shade_p = Some(parse(value, number)?),
+            Setting::ShadeContrast => s.shade_contrast = parse(value, number)?,
+            Setting::Seed => s.seed = parse(value, count)?,
+            Setting::CpIncrement => s.cp_increment = value.parse()?,
+            Setting::Sbuffer => s.sbuffer = value.parse()?,
+            Setting::Order => s.bsp_order = value.parse()?,
+            Setting::Unset => s.unset = value.parse()?,
+            Setting::RootTolerance => s.root_tolerance = parse(value, number)?,
+            Setting::Flatness => s.flatness = parse(value, number)?,
+            Setting::Band => s.band = parse(value, count)?,
+            Setting::Subscan => s.subscan = parse(value, count)?,
+            Setting::GouraudThreshold => s.gouraud_threshold = value.parse()?,
+            Setting::AaThreshold => s.aa_threshold = value.parse()?,
+            Setting::PhongAngle => s.phong_angle = value.parse()?,
+            Setting::Shadows => {
+                s.shadows = Some(match value.trim().to_ascii_lowercase().as_str() {
+                    "on" => true,
+                    "off" => false,
+                    _ => return Err(format!("expected on or off, found `{value}`")),
+                })
+            }
+        }
+        Ok(())
+    }
+
     /// It concerns world scenes only: a screen scene has no depth to resolve, nothing to
     /// light per pixel and nothing to refine.
     pub fn world_only(self) -> bool {

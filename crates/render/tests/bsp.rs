@@ -46,7 +46,7 @@ fn by_name(renderer: &str, scene: &str, s: &Settings) -> (Vec<f64>, Counters, u6
 #[test]
 fn every_mode_draws_what_the_s_buffer_and_exact_visibility_draw() {
     for (scene, shadows) in [
-        ("still-life", None),
+        ("still-life", Some(false)),
         ("pot", None),
         ("still-life", Some(true)),
         ("pot", Some(true)),

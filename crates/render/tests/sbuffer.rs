@@ -193,7 +193,7 @@ fn without_depth_a_later_polygon_is_in_front() {
 #[test]
 fn sbuffer_equals_vanrij_exact_visibility_on_flat_world_scenes() {
     for (scene, shadows) in [
-        ("still-life", None),
+        ("still-life", Some(false)),
         ("pot", None),
         ("still-life", Some(true)),
         ("pot", Some(true)),

@@ -375,13 +375,9 @@ mod analytic {
 /// the one that does; `--shadows` that would change nothing is refused.
 #[test]
 fn shadows_that_would_be_dropped_or_a_flag_that_changes_nothing_are_refused() {
-    // still-life with its main light casting shadows
-    let text = embedded("still-life").unwrap().text;
-    let casting = &text.replacen(
-        r#""intensity": [0.8, 0.78, 0.72] }"#,
-        r#""intensity": [0.8, 0.78, 0.72], "shadows": true }"#,
-        1,
-    );
+    // still-life as embedded (its main light casting shadows), and with none casting
+    let casting = embedded("still-life").unwrap().text;
+    let text = &casting.replacen(r#", "shadows": true }"#, " }", 1);
     assert_ne!(casting, text);
     let build = |name: &str, text: &str, settings: &Settings| {
         let loaded = LoadedScene::built("test", AnyScene::World(world(text)));
@@ -397,10 +393,16 @@ fn shadows_that_would_be_dropped_or_a_flag_that_changes_nothing_are_refused() {
     let e = build("nishita", &casting_teapot, &Settings::default()).unwrap_err();
     assert_eq!(
         e.to_string(),
-        "nishita does not draw shadows, and the scene's lights[0] casts them (\"shadows\": true): use --renderer vanrij (exact shadow polygons), or set \"shadows\": false",
+        "nishita does not draw shadows on Bézier patches yet (the paper's §7), and the scene's lights[0] casts them: use --renderer vanrij (exact shadow polygons on the patches tessellated, --tessellate), or set \"shadows\": false",
     );
     assert!(build("nishita", teapot, &Settings::default()).is_ok());
-    for name in RENDERERS.into_iter().chain(["refine"]) {
+    let on = Settings {
+        shadows: Some(true),
+        ..Settings::default()
+    };
+    assert!(build("nishita", teapot, &on).is_err());
+    // on a scene without patches it draws the polygons as vanrij does, shadows and all
+    for name in RENDERERS.into_iter().chain(["refine", "nishita"]) {
         assert!(build(name, casting, &Settings::default()).is_ok(), "{name}");
     }
     let off = Settings {
@@ -431,5 +433,28 @@ fn shadows_that_would_be_dropped_or_a_flag_that_changes_nothing_are_refused() {
                 .starts_with("--shadows on: the scene has no lights"),
             "{name}: {e}"
         );
+    }
+}
+
+/// `nishita` on a scene without Bézier patches draws its polygons as `vanrij` does, with
+/// the same shadow polygons: the same image, value for value, box filter and Phong.
+#[test]
+fn nishita_without_patches_draws_vanrij_s_shadows() {
+    let w = still_life();
+    for shading in [Shading::Gouraud, Shading::Phong] {
+        let s = Settings {
+            shading,
+            ..Settings::default()
+        };
+        let vanrij = rendered(&w, &s);
+        let unshadowed = rendered(
+            &w,
+            &Settings {
+                shadows: Some(false),
+                ..s
+            },
+        );
+        assert_ne!(vanrij, unshadowed, "{shading}: the shadows show");
+        assert_eq!(rendered_by("nishita", &w, &s), vanrij, "{shading}");
     }
 }

@@ -57,10 +57,11 @@ fn stream(loaded: LoadedScene, settings: &Settings) -> Vec<Instruction> {
 /// here and cut into polygons there).
 #[test]
 fn one_sample_per_pixel_is_van_rijs_point_sampling() {
-    // (`bowl`'s light casts shadows of its own)
+    // (`bowl`'s and `still-life`'s main light cast shadows of their own)
     for (name, shadows, casting) in [
         ("pot", None, false),
-        ("still-life", None, false),
+        ("still-life", None, true),
+        ("still-life", Some(false), false),
         ("teapot", None, false),
         ("pot", Some(true), true),
         ("still-life", Some(true), true),

@@ -23,8 +23,12 @@ use cwisim_ypipe::exact::scene_box_filtered;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
+
+/// The tessellations tried by default on a scene with Bézier patches (quads per patch
+/// side).
+pub const DEFAULT_TESSELLATIONS: [u32; 3] = [4, 8, 16];
 
 /// The numeric formats `tradeoff` tries unless told otherwise.
 pub const DEFAULT_FORMATS: &[&str] = &[
@@ -375,12 +379,22 @@ pub fn mark_pareto(rows: &mut [Row]) {
         .iter()
         .map(|r| (r.busy_cycles, r.register_bits, r.rms_error))
         .collect();
-    for (k, row) in rows.iter_mut().enumerate() {
-        let (c, b, e) = points[k];
-        row.pareto = !points
-            .iter()
-            .any(|&(c2, b2, e2)| c2 <= c && b2 <= b && e2 <= e && (c2 < c || b2 < b || e2 < e));
+    for (row, optimal) in rows.iter_mut().zip(pareto(&points)) {
+        row.pareto = optimal;
     }
+}
+
+/// Which of the points (bus cycles, register bits, RMS error) are Pareto-optimal: no
+/// other point is at most as large in all three and smaller in one ([`mark_pareto`]).
+pub fn pareto(points: &[(u64, u32, f64)]) -> Vec<bool> {
+    points
+        .iter()
+        .map(|&(c, b, e)| {
+            !points
+                .iter()
+                .any(|&(c2, b2, e2)| c2 <= c && b2 <= b && e2 <= e && (c2 < c || b2 < b || e2 < e))
+        })
+        .collect()
 }
 
 /// The exact image of the scene SCENE names, at `size`: the box-filtered Gouraud image of
@@ -543,13 +557,115 @@ pub fn shadows_axis(wanted: &[bool], lights: &[bool]) -> Result<Vec<Option<bool>
         .collect()
 }
 
-/// Measures every setting of the grid: `renderers` by name (empty: every registered one),
-/// on `threads` threads (0: one per core). The settings that share a stream (the same
-/// drawing in several numeric formats, [`streams`]) are measured together: the stream is
-/// drawn once and executed in each format ([`measure_stream`]); each reference image is
-/// made once. Streams are measured in parallel, their rows reported to `progress` in the
-/// grid's order as soon as they and every row before them are measured: the rows (but
-/// their host times) are the same at any thread count.
+/// A sweep planned: the grid of settings of one scene, cut into the groups that share a
+/// stream ([`streams`]). Each group is measured alone ([`Plan::measure_group`]), so a
+/// group is a task: a thread's here ([`tradeoff_rows`]), a Dask task's in Python. The
+/// rows of every group, concatenated in group order and marked by [`mark_pareto`], are
+/// the sweep's, whoever measured them.
+pub struct Plan {
+    scene: Option<PathBuf>,
+    /// Every setting, in the grid's order.
+    pub settings: Vec<Setting>,
+    /// The groups: ranges of `settings` that share a stream, in order.
+    pub groups: Vec<std::ops::Range<usize>>,
+    /// The renderers left out of the grid, with why.
+    pub skipped: Vec<(&'static str, String)>,
+    axes: Axes,
+    references: References,
+}
+
+impl Plan {
+    /// The grid of `scene` (a file or an embedded name; `None`: the default): `renderers`
+    /// by name (empty: every registered one-frame renderer) over the axes — `size`, the
+    /// `tessellations` of a scene with patches, the `shadows` values, the numeric
+    /// `formats`.
+    pub fn new(
+        scene: Option<&Path>,
+        size: Option<Size>,
+        tessellations: &[u32],
+        shadows: &[bool],
+        renderers: &[String],
+        formats: &[Numeric],
+    ) -> Result<Plan, StudyError> {
+        // a progressive renderer's frames refine one another: one frame against the exact
+        // image says nothing of it (its phases are measured by its own summary)
+        let entries: Vec<&'static registry::Entry> = if renderers.is_empty() {
+            registry::REGISTRY
+                .iter()
+                .filter(|e| !e.progressive)
+                .collect()
+        } else {
+            renderers
+                .iter()
+                .map(|n| {
+                    registry::find(n).and_then(|e| match e.progressive {
+                        false => Ok(e),
+                        true => Err(cwisim_render::RenderError::Usage(format!(
+                            "`{n}` draws several frames, each refining the previous one: tradeoff measures one-frame renderers against the exact image; `cwisim render --renderer {n}` prints its phases"
+                        ))),
+                    })
+                })
+                .collect::<Result<_, _>>()?
+        };
+        let probe = Source::resolve(scene)?.load(size)?.scene;
+        let lights = match &probe {
+            cwisim_world::AnyScene::World(w) => w.spec.lights.iter().map(|l| l.shadows).collect(),
+            cwisim_world::AnyScene::Screen(_) => Vec::new(),
+        };
+        let axes = Axes {
+            casting: lights.contains(&true),
+            shadows: shadows_axis(shadows, &lights)?,
+            world: probe.kind() == "world",
+            size,
+            tessellations: if probe.has_patches() {
+                tessellations.to_vec()
+            } else {
+                Vec::new()
+            },
+            patches: probe.has_patches(),
+        };
+        let settings = grid(&entries, &axes, formats);
+        Ok(Plan {
+            scene: scene.map(Path::to_path_buf),
+            groups: streams(&settings),
+            skipped: skipped_renderers(&entries, &axes),
+            settings,
+            axes,
+            references: References::default(),
+        })
+    }
+
+    /// The rows of group `g` (in the grid's order; none marked Pareto-optimal yet): its
+    /// stream drawn once and executed in each of its formats, `repeat` times for the host
+    /// times, each against its reference (made once per plan).
+    pub fn measure_group(
+        &self,
+        g: usize,
+        machine: &Machine,
+        repeat: u32,
+    ) -> Result<Vec<Row>, StudyError> {
+        let scene = self.scene.as_deref();
+        let group = &self.settings[self.groups[g].clone()];
+        let measured = measure_stream(scene, group, machine, repeat)?;
+        group
+            .iter()
+            .zip(measured)
+            .map(|(setting, (measured, times))| {
+                let reference = self.references.get(scene, setting, self.axes.world)?;
+                Ok(row_of(setting, &measured, &times, &reference, &self.axes))
+            })
+            .collect()
+    }
+}
+
+/// Measures every setting of the grid ([`Plan`]): `renderers` by name (empty: every
+/// registered one-frame renderer), on `threads` threads (0: one per core). The settings
+/// that share a stream (the same drawing in several numeric formats, [`streams`]) are
+/// measured together: the stream is drawn once and executed in each format
+/// ([`measure_stream`]); each reference image is made once. Streams are measured in
+/// parallel, their rows reported to `progress` in the grid's order as soon as they and
+/// every row before them are measured: the rows (but their host times) are the same at any
+/// thread count.
 #[allow(clippy::too_many_arguments)]
 pub fn tradeoff_rows(
     scene: Option<&Path>,
@@ -563,66 +679,18 @@ pub fn tradeoff_rows(
     threads: usize,
     progress: &mut dyn FnMut(Step<'_>),
 ) -> Result<Vec<Row>, StudyError> {
-    // a progressive renderer's frames refine one another: one frame against the exact
-    // image says nothing of it (its phases are measured by its own summary)
-    let entries: Vec<&'static registry::Entry> = if renderers.is_empty() {
-        registry::REGISTRY
-            .iter()
-            .filter(|e| !e.progressive)
-            .collect()
-    } else {
-        renderers
-            .iter()
-            .map(|n| {
-                registry::find(n).and_then(|e| match e.progressive {
-                    false => Ok(e),
-                    true => Err(cwisim_render::RenderError::Usage(format!(
-                        "`{n}` draws several frames, each refining the previous one: tradeoff measures one-frame renderers against the exact image; `cwisim render --renderer {n}` prints its phases"
-                    ))),
-                })
-            })
-            .collect::<Result<_, _>>()?
-    };
-    let probe = Source::resolve(scene)?.load(size)?.scene;
-    let lights = match &probe {
-        cwisim_world::AnyScene::World(w) => w.spec.lights.iter().map(|l| l.shadows).collect(),
-        cwisim_world::AnyScene::Screen(_) => Vec::new(),
-    };
-    let axes = Axes {
-        casting: lights.contains(&true),
-        shadows: shadows_axis(shadows, &lights)?,
-        world: probe.kind() == "world",
-        size,
-        tessellations: if probe.has_patches() {
-            tessellations.to_vec()
-        } else {
-            Vec::new()
-        },
-        patches: probe.has_patches(),
-    };
-    let settings = grid(&entries, &axes, formats);
+    let plan = Plan::new(scene, size, tessellations, shadows, renderers, formats)?;
+    let settings = &plan.settings;
+    let groups = &plan.groups;
     progress(Step::Start {
         total: settings.len(),
-        skipped: &skipped_renderers(&entries, &axes),
+        skipped: &plan.skipped,
     });
-    let groups = streams(&settings);
-    let references = References::default();
     let mut rows = Vec::with_capacity(settings.len());
     crate::parallel::ordered(
         groups.len(),
         threads,
-        |g| {
-            let group = &settings[groups[g].clone()];
-            let measured = measure_stream(scene, group, machine, repeat)?;
-            group
-                .iter()
-                .zip(measured)
-                .map(|(setting, (measured, times))| {
-                    let reference = references.get(scene, setting, axes.world)?;
-                    Ok(row_of(setting, &measured, &times, &reference, &axes))
-                })
-                .collect::<Result<Vec<Row>, StudyError>>()
-        },
+        |g| plan.measure_group(g, machine, repeat),
         |event| match event {
             crate::parallel::Event::Started(g) => progress(Step::Measuring {
                 index: groups[g].start,

@@ -44,6 +44,11 @@ pub const EMBEDDED: &[Embedded] = &[
         about: "world, grey, 500×500 as in Nishita et al.: the Utah teapot, Newell's 32 bicubic Bézier patches with Crow's bottom, tessellated 8×8 per patch, two-sided (its inside shows through the lid gap)",
         text: include_str!("../scenes/teapot.json"),
     },
+    Embedded {
+        name: "teapot-floor",
+        about: "world, grey, 500×500: the teapot standing on a floor, its light casting the teapot's shadow (Nishita et al.'s §7 scene; vanrij draws the shadows, nishita refuses them on patches)",
+        text: include_str!("../scenes/teapot-floor.json"),
+    },
 ];
 
 /// The embedded scene called `name`.

@@ -505,6 +505,7 @@ impl ShadowTest {
     /// rather than a point-in-polygon test. It agrees with [`Self::lit_at`] except at a
     /// point exactly on a lit part's right-hand edge.
     pub fn line(&self, k: usize, y: f64) -> LineLights {
+        let comparisons = std::cell::Cell::new(0u64);
         let reach = self.reach[k]
             .iter()
             .map(|r| match r {
@@ -523,12 +524,18 @@ impl ShadowTest {
                             }
                         }
                     }
-                    xs.sort_by(f64::total_cmp);
+                    xs.sort_by(|a, b| {
+                        comparisons.set(comparisons.get() + 1);
+                        a.total_cmp(b)
+                    });
                     LineReach::Crossings(xs)
                 }
             })
             .collect();
-        LineLights { reach }
+        LineLights {
+            reach,
+            comparisons: comparisons.get(),
+        }
     }
 
     /// The casters that reach all of camera triangle `k`, when that is the same at every
@@ -564,6 +571,7 @@ impl ShadowTest {
 #[derive(Clone, Debug, PartialEq)]
 pub struct LineLights {
     reach: Vec<LineReach>,
+    comparisons: u64,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -576,6 +584,24 @@ enum LineReach {
 }
 
 impl LineLights {
+    /// How many edges of the lit parts the line crosses, over every caster that reaches a
+    /// part of the triangle: the shadow edges Barkan & Gordon's §5.3 would hold in the
+    /// triangle's active edge list on this line.
+    pub fn crossings(&self) -> u64 {
+        self.reach
+            .iter()
+            .map(|r| match r {
+                LineReach::Crossings(xs) => xs.len() as u64,
+                _ => 0,
+            })
+            .sum()
+    }
+
+    /// The comparisons sorting those crossings took (§5.3's sorting work in `POLINE`).
+    pub fn comparisons(&self) -> u64 {
+        self.comparisons
+    }
+
     /// The casters that reach the line's point at `x`.
     pub fn at(&self, x: f64) -> LightSet {
         let mut set = LightSet::ALL;

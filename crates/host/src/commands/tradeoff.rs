@@ -14,6 +14,7 @@ use clap::Args;
 use cwisim_render::{Size, Source};
 use cwisim_study::tradeoff::{
     csv, name_width, tradeoff_rows, write_table_header, write_table_row, Step, DEFAULT_FORMATS,
+    DEFAULT_TESSELLATIONS,
 };
 use cwisim_study::tradeoff_plot::render_tradeoff_plot;
 use cwisim_xproc::Numeric;
@@ -31,7 +32,7 @@ pub struct TradeoffArgs {
     pub size: Option<Size>,
     /// For scenes with Bézier meshes: the tessellations to try (quads per patch side),
     /// comma-separated.
-    #[arg(long = "tessellate", value_name = "N,…", value_delimiter = ',', default_values_t = [4u32, 8, 16])]
+    #[arg(long = "tessellate", value_name = "N,…", value_delimiter = ',', default_values_t = DEFAULT_TESSELLATIONS)]
     pub tessellate: Vec<u32>,
     /// World scenes: the shadows to try, `on`, `off` or both (`on,off`): every light
     /// casting shadows, or none, for each renderer that draws them [default: as the scene

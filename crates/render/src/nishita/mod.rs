@@ -336,6 +336,36 @@ pub struct Nishita {
     groups: Option<(Vec<u64>, Vec<u32>)>,
 }
 
+/// Whether `w` has a Bézier mesh.
+fn has_patches(w: &WorldScene) -> bool {
+    w.spec.meshes.iter().any(|m| m.bezier.is_some())
+}
+
+/// A world scene is shaded smoothly: its patches' normals are the surface's own.
+fn check_smooth(shading: Shading) -> Result<(), RenderError> {
+    match shading {
+        Shading::Gouraud | Shading::Phong => Ok(()),
+        other => Err(RenderError::Usage(format!(
+            "--renderer nishita shades its patches smoothly: --shading gouraud or phong (found {other})"
+        ))),
+    }
+}
+
+/// Shadows are drawn on a scene without patches (its polygons, as `vanrij` draws them);
+/// on patches (the paper's §7, the light's own scanline over the patches) they are not
+/// yet, and a scene with patches whose lights cast them is refused, naming `vanrij`.
+fn refuse_shadows_on_patches(w: &WorldScene, settings: &Settings) -> Result<(), RenderError> {
+    if !has_patches(w) {
+        return Ok(());
+    }
+    match crate::prepare::world_casters(w, settings)?.lights.first() {
+        None => Ok(()),
+        Some(&k) => Err(RenderError::Usage(format!(
+            "nishita does not draw shadows on Bézier patches yet (the paper's §7), and the scene's lights[{k}] casts them: use --renderer vanrij (exact shadow polygons on the patches tessellated, --tessellate), or set \"shadows\": false"
+        ))),
+    }
+}
+
 impl Nishita {
     /// The renderer of `loaded` under `settings`.
     /// `settings.visibility` is not read (the registry's entry does not list it): the
@@ -348,30 +378,28 @@ impl Nishita {
         };
         let loaded = loaded.drawn_as(settings)?;
         settings.check().map_err(RenderError::Usage)?;
-        let AnyScene::World(w) = &loaded.scene else {
-            // no patches: the polygons as vanrij draws them
-            let scene = PolygonScene::new(loaded, settings)?;
-            return Ok(Nishita {
-                inner: VanRij::from_polygons(scene, settings),
-                stats: BandStats::default(),
-                bands: 0,
-                patches: 0,
-                triangles: 0,
-                settings: *settings,
-                visibility_time: Duration::ZERO,
-                groups: None,
-            });
-        };
-        match settings.shading {
-            Shading::Gouraud | Shading::Phong => {}
-            other => {
-                return Err(RenderError::Usage(format!(
-                    "--renderer nishita shades its patches smoothly: --shading gouraud or phong (found {other})"
-                )))
-            }
+        if let AnyScene::World(w) = &loaded.scene {
+            check_smooth(settings.shading)?;
+            refuse_shadows_on_patches(w, settings)?;
         }
+        let w = match &loaded.scene {
+            AnyScene::World(w) if has_patches(w) => w.clone(),
+            _ => {
+                // no patches: the polygons as vanrij draws them (with its shadows)
+                let scene = PolygonScene::new(loaded, settings)?;
+                return Ok(Nishita {
+                    inner: VanRij::from_polygons(scene, settings),
+                    stats: BandStats::default(),
+                    bands: 0,
+                    patches: 0,
+                    triangles: 0,
+                    settings: *settings,
+                    visibility_time: Duration::ZERO,
+                    groups: None,
+                });
+            }
+        };
         let phong = settings.shading == Shading::Phong;
-        let w = w.clone();
         // meshes that are not patches: projected as vanrij projects them
         let others: Vec<usize> = (0..w.spec.meshes.len())
             .filter(|&k| w.spec.meshes[k].bezier.is_none())
@@ -508,7 +536,6 @@ impl Nishita {
         loaded: LoadedScene,
         settings: &Settings,
     ) -> Result<Box<dyn Renderer>, RenderError> {
-        crate::prepare::refuse_shadows("nishita", &loaded.scene, settings)?;
         Ok(Box::new(Nishita::new(loaded, settings)?))
     }
 

@@ -146,6 +146,12 @@ pub(crate) struct RowCounts {
     pub(crate) eval3: u64,
     pub(crate) fit_candidates: u64,
     pub(crate) instructions: u64,
+    /// Spans of a partly lit polygon, tested sample by sample against the lit parts.
+    pub(crate) shadow_spans: u64,
+    /// The lit parts' edges those spans' lines cross (§5.3's shadow edges in `P.AET`).
+    pub(crate) shadow_crossings: u64,
+    /// The comparisons sorting them took.
+    pub(crate) shadow_comparisons: u64,
 }
 
 impl RowCounts {
@@ -166,6 +172,9 @@ impl RowCounts {
         self.eval3 += o.eval3;
         self.fit_candidates += o.fit_candidates;
         self.instructions += o.instructions;
+        self.shadow_spans += o.shadow_spans;
+        self.shadow_crossings += o.shadow_crossings;
+        self.shadow_comparisons += o.shadow_comparisons;
     }
 
     fn spans_fitted(&mut self, s: &SpanStats) {
@@ -176,8 +185,9 @@ impl RowCounts {
         self.instructions += s.pieces();
     }
 
+    /// Its counters; the shadow ones only where some span was tested against lit parts.
     pub(crate) fn counters(&self) -> Counters {
-        Counters::default()
+        let c = Counters::default()
             .with("polygons_walked", self.polygons_walked)
             .with("walks_stopped", self.walks_stopped)
             .with("unset_list_visits", self.list_visits)
@@ -193,7 +203,13 @@ impl RowCounts {
             .with("eval2", self.eval2)
             .with("eval3", self.eval3)
             .with("fit_candidates", self.fit_candidates)
-            .with("instructions", self.instructions)
+            .with("instructions", self.instructions);
+        if self.shadow_spans == 0 {
+            return c;
+        }
+        c.with("shadow_spans", self.shadow_spans)
+            .with("shadow_crossings", self.shadow_crossings)
+            .with("shadow_sort_comparisons", self.shadow_comparisons)
     }
 }
 
@@ -353,6 +369,9 @@ impl Scan<'_> {
                         Some(set) => lights.resize(end - first, set),
                         None => {
                             if let Some(line) = self.scene.line_lights(p, y) {
+                                counts.shadow_spans += 1;
+                                counts.shadow_crossings += line.crossings();
+                                counts.shadow_comparisons += line.comparisons();
                                 lights.extend((first..end).map(|c| line.at(s.column_x(c))));
                             }
                         }

@@ -1,0 +1,318 @@
+"""cwisim in Python: a cycle-level simulator of the CWI display architecture.
+
+Scenes in, NumPy out. The drawing settings keep the command line's names
+(``shade_tolerance`` for ``--shade-tolerance``) and spellings; errors are exceptions
+carrying the command line's located message. docs/PYTHON.md documents the API.
+
+>>> import cwisim
+>>> r = cwisim.render("pot")
+>>> r.image.shape
+(400, 400, 1)
+>>> int(r.lines["late"].sum())
+0
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass, field
+from typing import Any, Dict, List, Mapping, Optional, Tuple, Union
+
+import numpy as np
+
+from . import _native
+from ._native import CwisimError, SceneError, UsageError
+
+__all__ = [
+    "CwisimError",
+    "SceneError",
+    "UsageError",
+    "Render",
+    "RendererInfo",
+    "render",
+    "renderers",
+    "scene",
+    "scenes",
+    "setting_names",
+    "tradeoff",
+    "mark_pareto",
+    "frame",
+]
+
+#: A scene: an embedded scene's name or a scene file's path (``None``: the default,
+#: ``pot``), or the scene itself as Python data (the JSON scene as dicts and lists).
+SceneLike = Union[str, "os.PathLike[str]", Mapping[str, Any], None]
+
+
+def scenes() -> Dict[str, str]:
+    """The embedded scenes: name → one line about it, in ``cwisim scenes``' order."""
+    return dict(_native.scenes())
+
+
+def scene(name: str) -> Dict[str, Any]:
+    """The embedded scene ``name`` as Python data (what ``cwisim scenes NAME`` prints),
+    ready to change and pass to :func:`render`."""
+    return json.loads(_native.scene_text(name))
+
+
+@dataclass(frozen=True)
+class RendererInfo:
+    """A registered renderer: its name, one line about it, and the settings it reads
+    (by their Python names); :func:`render` refuses any other setting for it."""
+
+    name: str
+    about: str
+    settings: Tuple[str, ...]
+
+
+def renderers() -> List[RendererInfo]:
+    """The registered renderers, in ``cwisim renderers``' order."""
+    return [RendererInfo(n, a, tuple(s)) for n, a, s in _native.renderers()]
+
+
+def setting_names() -> List[str]:
+    """Every drawing setting's Python name, in the command line's order."""
+    return list(_native.setting_names())
+
+
+@dataclass
+class Render:
+    """What :func:`render` gives back.
+
+    ``image``: the array's output, ``float64``, shape ``(scanlines, width, channels)``
+    (every frame's scanlines, top to bottom; the same values as ``cwisim render --npy``).
+    ``lines``: one record per scanline (a NumPy structured array: ``line``, ``frame``,
+    ``row``, ``instructions``, ``busy_cycles``, ``stall_cycles``, ``first_issue``,
+    ``ready``, ``deadline``, ``slack``, ``late``, ``overflows``, ``suppressed``, … and a
+    count per opcode, ``SetI`` … ``Nop``). ``counters``: the renderer's own figures by
+    name; ``totals``: the array's (instructions, cycles, late lines, …); ``summary``: the
+    renderer's summary rows, as ``cwisim render`` prints them.
+    """
+
+    image: np.ndarray
+    lines: np.ndarray
+    counters: Dict[str, int]
+    totals: Dict[str, Any]
+    machine: Dict[str, Any]
+    summary: List[Tuple[str, str]]
+    renderer: str
+    phrase: str
+    scene: str
+    kind: str
+    width: int
+    height: int
+    channels: int
+    frames: int
+    line_period: int
+    numeric: str
+    settings: Dict[str, str] = field(default_factory=dict)
+
+    def frame(self, k: int) -> np.ndarray:
+        """Frame ``k``'s image, ``(height, width, channels)`` (a view, not a copy)."""
+        if not 0 <= k < self.frames:
+            raise IndexError(f"frame {k} of a render of {self.frames} frame(s)")
+        return self.image[k * self.height : (k + 1) * self.height]
+
+    def lines_frame(self):
+        """The per-scanline records as a pandas DataFrame (pandas is not a dependency
+        of cwisim: install it to use this)."""
+        import pandas as pd  # noqa: PLC0415 (optional)
+
+        return pd.DataFrame(self.lines)
+
+    def __repr__(self) -> str:
+        late = int(self.lines["late"].sum()) if len(self.lines) else 0
+        return (
+            f"<cwisim.Render {self.scene} by {self.renderer}: {self.width}×{self.height}"
+            f"×{self.channels}, {self.frames} frame(s), "
+            f"{self.totals.get('instructions', 0)} instructions, {late} late scanline(s)>"
+        )
+
+
+def _spelled(name: str, value: Any) -> str:
+    """A setting's value as the command line spells it."""
+    if isinstance(value, bool):
+        if name == "shadows":
+            return "on" if value else "off"
+        return "true" if value else "false"
+    if name == "size" and isinstance(value, (tuple, list)) and len(value) == 2:
+        return f"{int(value[0])}x{int(value[1])}"
+    if isinstance(value, float):
+        return repr(value)
+    return str(value)
+
+
+def render(
+    scene: SceneLike = None,
+    renderer: str = "vanrij",
+    *,
+    numeric: str = "f64",
+    timing: str = "fast",
+    machine: Optional[Union[str, "os.PathLike[str]"]] = None,
+    threads: int = 1,
+    **settings: Any,
+) -> Render:
+    """Draws ``scene`` with ``renderer`` and runs the instructions through the simulated
+    X-processor array, as ``cwisim render`` does.
+
+    ``scene``: an embedded scene's name (:func:`scenes`), a scene file's path, or the
+    scene as Python data (a dict, as :func:`scene` returns). ``renderer``: a name from
+    :func:`renderers`. ``numeric``: the array's registers (``"f64"``, ``"f32"``,
+    ``"fixed:I=…"``); ``timing``: ``"fast"`` or ``"stepped"`` (the same results);
+    ``machine``: a machine model JSON file; ``threads``: as ``--threads`` (the results are
+    the same at any count). Every other keyword is a drawing setting by its Python name,
+    valued as on the command line (``shading="phong"``, ``aa="box-centre"``,
+    ``samples=4``, ``size=(640, 480)`` or ``"640x480"``, ``shadows=True`` or ``"on"``);
+    ``None`` leaves a setting at its default. A setting the renderer does not read, or
+    that the others leave idle, raises :class:`UsageError` naming what would use it.
+
+    Runs without the GIL. Raises :class:`SceneError` for a scene that cannot be read (the
+    message locates it) and :class:`UsageError` for names, settings or sizes refused.
+    """
+    given = [(k, _spelled(k, v)) for k, v in settings.items() if v is not None]
+    if isinstance(scene, Mapping):
+        # indented, so that a located error's line and column point into
+        # json.dumps(scene, indent=2)
+        where = {"scene_json": json.dumps(scene, indent=2), "name": str(scene.get("name", "scene"))}
+    else:
+        where = {"scene": None if scene is None else os.fspath(scene)}
+    out = _native.render(
+        **where,
+        renderer=renderer,
+        settings=given,
+        numeric=numeric,
+        timing=timing,
+        machine=None if machine is None else os.fspath(machine),
+        threads=threads,
+    )
+    return Render(
+        image=out["image"],
+        lines=_records(out["lines"]),
+        counters=dict(out["counters"]),
+        totals=json.loads(out["totals"]),
+        machine=json.loads(out["machine"]),
+        summary=[tuple(r) for r in out["summary"]],
+        renderer=out["renderer"],
+        phrase=out["phrase"],
+        scene=out["scene"],
+        kind=out["kind"],
+        width=out["width"],
+        height=out["height"],
+        channels=out["channels"],
+        frames=out["frames"],
+        line_period=out["line_period"],
+        numeric=out["numeric"],
+        settings=dict(given),
+    )
+
+
+def _records(columns: Mapping[str, np.ndarray]) -> np.ndarray:
+    """Named columns of equal length as one structured array."""
+    names = list(columns)
+    n = len(columns[names[0]]) if names else 0
+    out = np.empty(n, dtype=[(k, columns[k].dtype) for k in names])
+    for k in names:
+        out[k] = columns[k]
+    return out
+
+
+def _plan_args(scene, size, tessellate, shadows, renderers, numeric, machine) -> Dict[str, Any]:
+    """The arguments of a tradeoff plan, as plain (picklable) Python values."""
+    if isinstance(scene, Mapping):
+        raise UsageError(
+            "tradeoff takes a scene file or an embedded scene's name (write a dict to a "
+            "file first: every task reads the scene itself)"
+        )
+    if size is not None and not isinstance(size, str):
+        size = f"{int(size[0])}x{int(size[1])}"
+    if isinstance(shadows, bool):
+        shadows = [shadows]
+    if isinstance(numeric, str):
+        numeric = [numeric]
+    if isinstance(renderers, str):
+        renderers = [renderers]
+    return {
+        "scene": None if scene is None else os.fspath(scene),
+        "size": size,
+        "tessellate": list(_native.default_tessellations() if tessellate is None else tessellate),
+        "shadows": [bool(v) for v in (shadows or [])],
+        "renderers": list(renderers or []),
+        "numeric": list(_native.default_formats() if numeric is None else numeric),
+        "machine": None if machine is None else os.fspath(machine),
+    }
+
+
+def tradeoff(
+    scene: SceneLike = None,
+    *,
+    size: Optional[Union[str, Tuple[int, int]]] = None,
+    tessellate: Optional[List[int]] = None,
+    shadows: Optional[Union[bool, List[bool]]] = None,
+    renderers: Optional[List[str]] = None,
+    numeric: Optional[Union[str, List[str]]] = None,
+    machine: Optional[Union[str, "os.PathLike[str]"]] = None,
+    repeat: int = 3,
+    threads: int = 1,
+    client: Any = None,
+) -> List[Dict[str, Any]]:
+    """``cwisim tradeoff``: one scene drawn over a grid of settings, each measured (what
+    it costs the array and the host against its error from the exact image), the Pareto
+    front of bus cycles, register bits and RMS error marked. Returns the rows, in the
+    grid's order, as dicts with the CSV's fields (and the renderer's ``counters``);
+    :func:`frame` makes a pandas DataFrame of them.
+
+    The axes default to the command line's: every one-frame renderer, ``tessellate``
+    (4, 8, 16) on a scene with patches, the scene's own shadows, the five default
+    ``numeric`` formats. ``threads``: measured on that many threads in this process.
+    ``client``: a ``dask.distributed.Client``: each group of settings that shares a
+    stream becomes a Dask task, run on the cluster's workers, and the rows gathered in
+    the same order — equal to the local sweep's, row for row, but for the host times.
+    """
+    args = _plan_args(scene, size, tessellate, shadows, renderers, numeric, machine)
+    if client is not None:
+        from . import sweep  # noqa: PLC0415 (Dask is optional)
+
+        return sweep.tradeoff_on(client, args, repeat)
+    plan = _native.TradeoffPlan(**args)
+    rows: List[Dict[str, Any]] = []
+    if threads == 1:
+        for g in range(plan.groups()):
+            rows.extend(rows_of(plan.measure(g, repeat)))
+    else:
+        from concurrent.futures import ThreadPoolExecutor  # noqa: PLC0415
+
+        workers = threads if threads > 0 else (os.cpu_count() or 1)
+        with ThreadPoolExecutor(workers) as pool:
+            for group in pool.map(lambda g: plan.measure(g, repeat), range(plan.groups())):
+                rows.extend(rows_of(group))
+    return mark_pareto(rows)
+
+
+def rows_of(text: str) -> List[Dict[str, Any]]:
+    """Rows from the native module's JSON: an exact image's PSNR (infinite, which JSON
+    cannot say) back to ``inf``."""
+    rows = json.loads(text)
+    for r in rows:
+        if r.get("psnr_db") is None:
+            r["psnr_db"] = float("inf")
+    return rows
+
+
+def mark_pareto(rows: List[Dict[str, Any]]) -> List[Dict[str, Any]]:
+    """Marks ``rows["pareto"]`` as ``tradeoff`` does (over bus cycles, register bits and
+    RMS error), in place; returns the rows."""
+    flags = _native.pareto(
+        [(r["busy_cycles"], r["register_bits"], r["rms_error"]) for r in rows]
+    )
+    for r, f in zip(rows, flags):
+        r["pareto"] = f
+    return rows
+
+
+def frame(rows: List[Dict[str, Any]]):
+    """Rows (of :func:`tradeoff`) as a pandas DataFrame, the renderer's counters left out
+    (pandas is not a dependency of cwisim: install it to use this)."""
+    import pandas as pd  # noqa: PLC0415 (optional)
+
+    return pd.DataFrame([{k: v for k, v in r.items() if k != "counters"} for r in rows])

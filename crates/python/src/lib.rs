@@ -1,0 +1,441 @@
+//! # cwisim-python — the native module of the `cwisim` Python package
+//!
+//! `cwisim._native`, built by maturin over PyO3 against the stable ABI (one wheel for
+//! every CPython from 3.9). Like the command line, it converts and dispatches only: the
+//! scene is read, the settings checked and the renderer built by
+//! [`cwisim_render::draw::draw`], the frame rendered by [`cwisim_render::render`], and
+//! what comes back is handed to Python as NumPy arrays (the image without a copy) and
+//! plain dictionaries. The Python layer (`python/cwisim/__init__.py`) wraps these in the
+//! documented API (docs/PYTHON.md); the settings keep the command line's names
+//! (`shade_tolerance` for `--shade-tolerance`) and spellings.
+//!
+//! Errors are Python exceptions carrying the command line's located message:
+//! `SceneError` (a scene that cannot be read: file, line or JSON path, what was
+//! expected), `UsageError` (unknown names, settings that do not go together or exceed a
+//! limit), both `CwisimError`s; a fault of cwisim's own is a plain `CwisimError`. The
+//! render runs without the GIL.
+
+use cwisim_render::draw::{draw, SceneInput};
+use cwisim_render::settings::Setting;
+use cwisim_render::{
+    registry, render as render_frames, ArrayConfig, RenderError, Rendered, Settings, Taps,
+};
+use cwisim_study::error::StudyError;
+use cwisim_study::tradeoff;
+use cwisim_xproc::{Image, ImageSink, LineStats, Machine, Numeric, Timing};
+use numpy::{PyArray1, PyArrayMethods};
+use pyo3::create_exception;
+use pyo3::exceptions::PyException;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use std::path::Path;
+
+create_exception!(
+    _native,
+    CwisimError,
+    PyException,
+    "Anything cwisim refuses or fails at; the message says what and where."
+);
+create_exception!(
+    _native,
+    SceneError,
+    CwisimError,
+    "A scene that cannot be read: the message locates it (the file, the line or JSON path) and says what was expected."
+);
+create_exception!(
+    _native,
+    UsageError,
+    CwisimError,
+    "An unknown name, settings that do not go together, or a size over a limit: the command line's exit 2."
+);
+
+/// The Python exception for a render error: the same message as the command line's.
+fn to_py(e: RenderError) -> PyErr {
+    let message = e.to_string();
+    match e {
+        RenderError::Scene(_) => SceneError::new_err(message),
+        RenderError::Usage(_)
+        | RenderError::UnknownRenderer { .. }
+        | RenderError::Machine(_)
+        | RenderError::ImageLimit(_)
+        | RenderError::Overflow { .. } => UsageError::new_err(message),
+        RenderError::Renderer { .. } | RenderError::Array(_) => CwisimError::new_err(message),
+    }
+}
+
+/// The embedded scenes: `(name, one line about it)`, in `cwisim scenes`' order.
+#[pyfunction]
+fn scenes() -> Vec<(&'static str, &'static str)> {
+    cwisim_world::embedded::EMBEDDED
+        .iter()
+        .map(|e| (e.name, e.about))
+        .collect()
+}
+
+/// The JSON text of the embedded scene `name` (what `cwisim scenes NAME` prints).
+#[pyfunction]
+fn scene_text(name: &str) -> PyResult<&'static str> {
+    cwisim_world::embedded::embedded(name)
+        .map(|e| e.text)
+        .ok_or_else(|| {
+            let names: Vec<&str> = cwisim_world::embedded::EMBEDDED
+                .iter()
+                .map(|e| e.name)
+                .collect();
+            UsageError::new_err(format!(
+                "no embedded scene `{name}` (embedded: {})",
+                names.join(", ")
+            ))
+        })
+}
+
+/// The registered renderers: `(name, about, the settings it reads)`, settings by their
+/// Python names.
+#[pyfunction]
+fn renderers() -> Vec<(&'static str, &'static str, Vec<String>)> {
+    registry::REGISTRY
+        .iter()
+        .map(|e| {
+            let uses = e.uses.iter().map(|s| python_name(*s)).collect();
+            (e.name, e.about, uses)
+        })
+        .collect()
+}
+
+/// Every drawing setting's Python name, in the command line's order.
+#[pyfunction]
+fn setting_names() -> Vec<String> {
+    Setting::ALL.into_iter().map(python_name).collect()
+}
+
+fn python_name(s: Setting) -> String {
+    s.name().replace('-', "_")
+}
+
+/// The settings `given` (Python name → the command line's spelling of the value) over
+/// the defaults, with `threads`; the settings given, for the renderer to check.
+fn settings_of(given: &[(String, String)], threads: usize) -> PyResult<(Settings, Vec<Setting>)> {
+    let mut settings = Settings {
+        threads,
+        ..Settings::default()
+    };
+    let mut named = Vec::new();
+    for (name, value) in given {
+        let setting = Setting::of_name(name).ok_or_else(|| {
+            UsageError::new_err(format!(
+                "unknown setting `{name}`; known: {}",
+                setting_names().join(", ")
+            ))
+        })?;
+        setting
+            .set(&mut settings, value)
+            .map_err(|e| UsageError::new_err(format!("{name}: {e}")))?;
+        named.push(setting);
+    }
+    Ok((settings, named))
+}
+
+/// The per-scanline records as named columns.
+fn line_columns<'py>(py: Python<'py>, lines: &[LineStats]) -> PyResult<Bound<'py, PyDict>> {
+    let out = PyDict::new(py);
+    let column = |f: &dyn Fn(&LineStats) -> u64| -> Vec<u64> { lines.iter().map(f).collect() };
+    let columns: [(&str, Vec<u64>); 13] = [
+        ("line", column(&|l| l.line)),
+        ("frame", column(&|l| l.frame)),
+        ("row", column(&|l| l.row)),
+        ("instructions", column(&|l| l.instructions)),
+        ("processor_updates", column(&|l| l.processor_updates)),
+        ("dropped_negative", column(&|l| l.dropped_negative)),
+        ("suppressed", column(&|l| l.suppressed)),
+        ("overflows", column(&|l| l.overflows)),
+        ("busy_cycles", column(&|l| l.busy_cycles)),
+        ("stall_cycles", column(&|l| l.stall_cycles)),
+        ("first_issue", column(&|l| l.first_issue)),
+        ("ready", column(&|l| l.ready)),
+        ("deadline", column(&|l| l.deadline)),
+    ];
+    for (name, values) in columns {
+        out.set_item(name, PyArray1::from_vec(py, values))?;
+    }
+    let slack: Vec<i64> = lines.iter().map(|l| l.slack).collect();
+    out.set_item("slack", PyArray1::from_vec(py, slack))?;
+    let late: Vec<bool> = lines.iter().map(|l| l.slack < 0).collect();
+    out.set_item("late", PyArray1::from_vec(py, late))?;
+    for op in cwisim_isa::Opcode::ALL {
+        let counts: Vec<u64> = lines.iter().map(|l| l.opcodes.get(*op)).collect();
+        out.set_item(op.name(), PyArray1::from_vec(py, counts))?;
+    }
+    Ok(out)
+}
+
+/// What [`render`] makes without the GIL: everything but the Python objects.
+struct Done {
+    image: Image,
+    rendered: Rendered,
+    summary: Vec<(&'static str, String)>,
+    renderer: &'static str,
+    phrase: String,
+    scene: String,
+    kind: &'static str,
+    height: u32,
+    frames: u32,
+}
+
+/// The scene drawn by the renderer (as the command line's `render` does) and rendered
+/// into the array `array`, its image collected; the image's memory checked against the
+/// budget before it is allocated.
+fn drawn_and_rendered(
+    renderer: &str,
+    input: SceneInput<'_>,
+    given: &[Setting],
+    settings: &Settings,
+    array: &ArrayConfig,
+) -> Result<Done, RenderError> {
+    let drawn = draw(renderer, input, given, settings)?;
+    let r = &*drawn.renderer;
+    let h = r.header();
+    let frames_lines = u64::from(h.lines) * u64::from(r.frames());
+    let bytes = frames_lines
+        .saturating_mul(u64::from(h.width))
+        .saturating_mul(h.channel_count() as u64)
+        .saturating_mul(8);
+    cwisim_scene::budget::Budget::current()
+        .check_memory(
+            &format!(
+                "the image of {frames_lines} scanline(s) of {} × {} value(s)",
+                h.width,
+                h.channel_count()
+            ),
+            bytes,
+        )
+        .map_err(|e| RenderError::Usage(e.to_string()))?;
+    let mut sink = ImageSink::new(h.width as usize, h.channel_count(), bytes.max(1));
+    let rendered = render_frames(r, array, settings.threads, &mut sink, Taps::default())?;
+    Ok(Done {
+        image: sink.finish()?,
+        summary: r.summary_rows(&rendered.counters, &rendered.stats),
+        rendered,
+        renderer: r.name(),
+        phrase: r.settings_phrase(),
+        scene: drawn.source.name(),
+        kind: drawn.kind,
+        height: h.lines,
+        frames: r.frames(),
+    })
+}
+
+/// Renders a scene: `scene` a file or an embedded name (`None`: the default scene), or
+/// `scene_json` the scene itself as JSON text (named `name`); `settings` the drawing
+/// settings by Python name, each value spelled as on the command line. Returns a dict:
+/// `image` (scanlines × width × channels, float64), `counters` (the renderer's),
+/// `totals` and `machine` (JSON text), `lines` (per-scanline columns), `summary` (the
+/// renderer's summary rows), `renderer`, `phrase` (the settings in words), `scene`,
+/// `kind`, `width`, `height`, `channels`, `frames`, `line_period`.
+#[pyfunction]
+#[pyo3(signature = (scene=None, scene_json=None, name="scene", renderer="vanrij", settings=Vec::new(), numeric="f64", timing="fast", machine=None, threads=1))]
+#[allow(clippy::too_many_arguments)]
+fn render<'py>(
+    py: Python<'py>,
+    scene: Option<&str>,
+    scene_json: Option<&str>,
+    name: &str,
+    renderer: &str,
+    settings: Vec<(String, String)>,
+    numeric: &str,
+    timing: &str,
+    machine: Option<&str>,
+    threads: usize,
+) -> PyResult<Bound<'py, PyDict>> {
+    cwisim_scene::budget::check_threads(threads).map_err(UsageError::new_err)?;
+    let (settings, given) = settings_of(&settings, threads)?;
+    let numeric: Numeric = numeric
+        .parse()
+        .map_err(|e| UsageError::new_err(format!("numeric: {e}")))?;
+    let timing = match timing {
+        "fast" => Timing::Fast,
+        "stepped" => Timing::Stepped,
+        other => {
+            return Err(UsageError::new_err(format!(
+                "timing: unknown timing `{other}`; expected fast or stepped"
+            )))
+        }
+    };
+    let machine = match machine {
+        Some(path) => Machine::from_file(Path::new(path)).map_err(|e| to_py(e.into()))?,
+        None => Machine::default(),
+    };
+    let input = match (scene, scene_json) {
+        (_, Some(text)) => SceneInput::Text { name, text },
+        (path, None) => SceneInput::Named(path.map(Path::new)),
+    };
+    let array = ArrayConfig {
+        machine,
+        numeric,
+        timing,
+    };
+    let done = py
+        .detach(|| drawn_and_rendered(renderer, input, &given, &settings, &array))
+        .map_err(to_py)?;
+    let image = done.image;
+    let out = PyDict::new(py);
+    let shape = [image.lines, image.width, image.channels];
+    out.set_item("image", PyArray1::from_vec(py, image.data).reshape(shape)?)?;
+    let counters = PyDict::new(py);
+    for (k, v) in done.rendered.counters.iter() {
+        counters.set_item(k, v)?;
+    }
+    out.set_item("counters", counters)?;
+    let json = |v: serde_json::Result<String>| v.map_err(|e| CwisimError::new_err(e.to_string()));
+    let stats = &done.rendered.stats;
+    out.set_item("totals", json(serde_json::to_string(&stats.totals))?)?;
+    out.set_item("machine", json(serde_json::to_string(&array.machine))?)?;
+    out.set_item("lines", line_columns(py, &stats.lines)?)?;
+    out.set_item("summary", PyList::new(py, done.summary)?)?;
+    out.set_item("renderer", done.renderer)?;
+    out.set_item("phrase", done.phrase)?;
+    out.set_item("scene", done.scene)?;
+    out.set_item("kind", done.kind)?;
+    out.set_item("width", image.width)?;
+    out.set_item("height", done.height)?;
+    out.set_item("channels", image.channels)?;
+    out.set_item("frames", done.frames)?;
+    out.set_item("line_period", stats.line_period)?;
+    out.set_item("numeric", numeric.to_string())?;
+    Ok(out)
+}
+
+/// The Python exception for a study error.
+fn study_to_py(e: StudyError) -> PyErr {
+    match e {
+        StudyError::Render(e) => to_py(e),
+        StudyError::Trace(e) => SceneError::new_err(e.to_string()),
+        StudyError::Machine(_) | StudyError::ImageLimit(_) | StudyError::Usage(_) => {
+            UsageError::new_err(e.to_string())
+        }
+        StudyError::Array(_) | StudyError::Plot(_) => CwisimError::new_err(e.to_string()),
+    }
+}
+
+/// The array's numeric formats `tradeoff` tries by default.
+#[pyfunction]
+fn default_formats() -> Vec<&'static str> {
+    tradeoff::DEFAULT_FORMATS.to_vec()
+}
+
+/// The tessellations `tradeoff` tries by default on a scene with Bézier patches.
+#[pyfunction]
+fn default_tessellations() -> Vec<u32> {
+    tradeoff::DEFAULT_TESSELLATIONS.to_vec()
+}
+
+/// A `tradeoff` sweep planned ([`tradeoff::Plan`]): its groups of settings, each measured
+/// alone (`measure`), so that each can be a task of its own (a Dask task). The rows of
+/// every group in order, marked by [`pareto`], are the sweep's.
+#[pyclass(frozen, module = "cwisim._native")]
+struct TradeoffPlan {
+    plan: tradeoff::Plan,
+    machine: Machine,
+}
+
+#[pymethods]
+impl TradeoffPlan {
+    /// The plan of `scene` (a file or an embedded name; `None`: the default) over the
+    /// axes, as `cwisim tradeoff` takes them.
+    #[new]
+    #[pyo3(signature = (scene=None, size=None, tessellate=Vec::new(), shadows=Vec::new(), renderers=Vec::new(), numeric=Vec::new(), machine=None))]
+    #[allow(clippy::too_many_arguments)] // Python's keywords: the command line's flags
+    fn new(
+        py: Python<'_>,
+        scene: Option<&str>,
+        size: Option<&str>,
+        tessellate: Vec<u32>,
+        shadows: Vec<bool>,
+        renderers: Vec<String>,
+        numeric: Vec<String>,
+        machine: Option<&str>,
+    ) -> PyResult<TradeoffPlan> {
+        let size = size
+            .map(|s| s.parse::<cwisim_render::Size>())
+            .transpose()
+            .map_err(|e| UsageError::new_err(format!("size: {e}")))?;
+        let formats = numeric
+            .iter()
+            .map(|f| f.parse::<Numeric>())
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|e| UsageError::new_err(format!("numeric: {e}")))?;
+        let machine = match machine {
+            Some(path) => Machine::from_file(Path::new(path)).map_err(|e| to_py(e.into()))?,
+            None => Machine::default(),
+        };
+        let plan = py
+            .detach(|| {
+                tradeoff::Plan::new(
+                    scene.map(Path::new),
+                    size,
+                    &tessellate,
+                    &shadows,
+                    &renderers,
+                    &formats,
+                )
+            })
+            .map_err(study_to_py)?;
+        Ok(TradeoffPlan { plan, machine })
+    }
+
+    /// The number of groups (tasks).
+    fn groups(&self) -> usize {
+        self.plan.groups.len()
+    }
+
+    /// The number of settings (rows).
+    fn settings(&self) -> usize {
+        self.plan.settings.len()
+    }
+
+    /// The renderers left out of the grid, with why.
+    fn skipped(&self) -> Vec<(&'static str, String)> {
+        self.plan.skipped.clone()
+    }
+
+    /// The rows of group `g` as JSON (none marked Pareto-optimal yet), measured without
+    /// the GIL, host times the median of `repeat`.
+    #[pyo3(signature = (g, repeat=3))]
+    fn measure(&self, py: Python<'_>, g: usize, repeat: u32) -> PyResult<String> {
+        if g >= self.plan.groups.len() {
+            return Err(UsageError::new_err(format!(
+                "group {g} of a plan of {}",
+                self.plan.groups.len()
+            )));
+        }
+        let rows = py
+            .detach(|| self.plan.measure_group(g, &self.machine, repeat))
+            .map_err(study_to_py)?;
+        serde_json::to_string(&rows).map_err(|e| CwisimError::new_err(e.to_string()))
+    }
+}
+
+/// Which points `(bus cycles, register bits, RMS error)` are Pareto-optimal, as
+/// `tradeoff` marks its rows.
+#[pyfunction]
+fn pareto(points: Vec<(u64, u32, f64)>) -> Vec<bool> {
+    tradeoff::pareto(&points)
+}
+
+/// The module.
+#[pymodule]
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("CwisimError", py.get_type::<CwisimError>())?;
+    m.add("SceneError", py.get_type::<SceneError>())?;
+    m.add("UsageError", py.get_type::<UsageError>())?;
+    m.add_function(wrap_pyfunction!(scenes, m)?)?;
+    m.add_function(wrap_pyfunction!(scene_text, m)?)?;
+    m.add_function(wrap_pyfunction!(renderers, m)?)?;
+    m.add_function(wrap_pyfunction!(setting_names, m)?)?;
+    m.add_function(wrap_pyfunction!(render, m)?)?;
+    m.add_function(wrap_pyfunction!(default_formats, m)?)?;
+    m.add_function(wrap_pyfunction!(default_tessellations, m)?)?;
+    m.add_function(wrap_pyfunction!(pareto, m)?)?;
+    m.add_class::<TradeoffPlan>()?;
+    Ok(())
+}

@@ -1,0 +1,166 @@
+"""The Python package against the command line it must not drift from: the same images,
+the same refusals with the same messages, the same per-scanline records.
+
+The command line is the release binary (``cargo build --release``), or ``$CWISIM_BIN``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import threading
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import cwisim
+
+ROOT = Path(__file__).resolve().parents[3]
+
+
+def cli_binary() -> Path:
+    path = Path(os.environ.get("CWISIM_BIN", ROOT / "target" / "release" / "cwisim"))
+    if not path.exists():
+        pytest.fail(f"{path}: no cwisim binary; build it with `cargo build --release`")
+    return path
+
+
+def cli(*args: str, cwd: Path) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [str(cli_binary()), *args], cwd=cwd, capture_output=True, text=True, check=False
+    )
+
+
+SCENES = list(cwisim.scenes())
+RENDERERS = [r.name for r in cwisim.renderers()]
+
+
+def test_the_embedded_scenes_and_renderers_are_the_command_line_s(tmp_path):
+    listed = cli("scenes", cwd=tmp_path).stdout
+    for name in SCENES:
+        assert any(line.split()[0] == name for line in listed.splitlines() if line.strip())
+    named = cli("renderers", cwd=tmp_path).stdout
+    assert [line.split()[0] for line in named.splitlines() if line.strip()] == RENDERERS
+    for name in SCENES:
+        assert cwisim.scene(name) == json.loads(cli("scenes", name, cwd=tmp_path).stdout)
+
+
+@pytest.mark.parametrize("scene", SCENES)
+@pytest.mark.parametrize("renderer", RENDERERS)
+def test_every_image_is_the_command_line_s_npy_byte_for_byte(tmp_path, scene, renderer):
+    """Each embedded scene by each renderer: the same values, bit for bit, or the same
+    refusal with the same message."""
+    out = cli("render", scene, "--renderer", renderer, "-q", "--npy", "a.npy", cwd=tmp_path)
+    if out.returncode != 0:
+        assert out.returncode == 2, out.stderr
+        with pytest.raises(cwisim.UsageError) as refused:
+            cwisim.render(scene, renderer)
+        assert out.stderr.strip() == f"error: {refused.value}"
+        return
+    r = cwisim.render(scene, renderer)
+    expected = np.load(tmp_path / "a.npy")
+    assert r.image.dtype == expected.dtype == np.float64
+    assert r.image.shape == expected.shape
+    assert r.image.tobytes() == expected.tobytes()
+
+
+def test_the_records_are_the_stats_json_s(tmp_path):
+    out = cli(
+        "render", "still-life", "--renderer", "sbuffer", "-q", "--stats-json", "s.json",
+        cwd=tmp_path,
+    )
+    assert out.returncode == 0, out.stderr
+    stats = json.loads((tmp_path / "s.json").read_text())
+    r = cwisim.render("still-life", "sbuffer")
+    assert r.totals == stats["stats"]["totals"]
+    assert r.counters == stats["counters"]
+    assert r.line_period == stats["stats"]["line_period"]
+    lines = stats["stats"]["lines"]
+    assert len(r.lines) == len(lines) == r.height
+    for field in ["busy_cycles", "stall_cycles", "ready", "deadline", "slack", "instructions"]:
+        assert r.lines[field].tolist() == [line[field] for line in lines], field
+    assert r.lines["Eval2"].tolist() == [line["opcodes"]["Eval2"] for line in lines]
+    assert int(r.lines["late"].sum()) == r.totals["late_lines"]
+
+
+def test_settings_take_python_values_and_the_command_line_s_spellings():
+    a = cwisim.render("teapot-floor", size=(96, 96), shading="phong", aa="box-centre",
+                      shade_tolerance=1 / 512, shadows=False)
+    b = cwisim.render("teapot-floor", size="96x96", shading="PHONG", aa="box-centre",
+                      shade_tolerance="0.001953125", shadows="off")
+    assert a.image.tobytes() == b.image.tobytes()
+    assert a.image.shape == (96, 96, 1)
+    c = cwisim.render("teapot-floor", size=(96, 96), shading="phong", aa="box-centre")
+    assert c.image.tobytes() != a.image.tobytes()  # its light casts the teapot's shadow
+    assert cwisim.render("pot", shading=None).image.shape == (400, 400, 1)
+
+
+def test_a_scene_as_python_data_draws_as_its_file(tmp_path):
+    data = cwisim.scene("still-life")
+    data["lights"][0]["shadows"] = False
+    path = tmp_path / "mine.json"
+    path.write_text(json.dumps(data))
+    from_data = cwisim.render(data, size=(120, 80))
+    from_file = cwisim.render(path, size=(120, 80))
+    assert from_data.image.tobytes() == from_file.image.tobytes()
+    assert from_file.scene == "mine"
+    assert from_data.image.tobytes() != cwisim.render("still-life", size=(120, 80)).image.tobytes()
+
+
+def test_bad_input_raises_the_located_error():
+    with pytest.raises(cwisim.SceneError, match=r"missing field `height`"):
+        cwisim.render({"kind": "world", "width": 8})
+    data = cwisim.scene("still-life")
+    data["meshes"][0]["vertices"][3] = [3, "x", -2]
+    with pytest.raises(cwisim.SceneError) as bad:
+        cwisim.render(data)
+    # located in the scene as json.dumps(data, indent=2) prints it
+    line = json.dumps(data, indent=2).splitlines()[int(str(bad.value).split(":")[0]) - 1]
+    assert '"x"' in line, (str(bad.value), line)
+    with pytest.raises(cwisim.UsageError, match=r"unknown renderer `nope`; known: vanrij"):
+        cwisim.render("pot", "nope")
+    with pytest.raises(cwisim.UsageError, match=r"unknown setting `colour`"):
+        cwisim.render("pot", colour="red")
+    with pytest.raises(cwisim.UsageError, match=r"^samples: expected a whole number"):
+        cwisim.render("pot", "woo-chall", samples="three")
+    with pytest.raises(cwisim.UsageError, match=r"no such scene file, and no embedded scene"):
+        cwisim.render("no-such-scene")
+    with pytest.raises(cwisim.UsageError, match=r"^numeric: "):
+        cwisim.render("pot", numeric="f16")
+    with pytest.raises(cwisim.UsageError, match=r"^--size 60000x60000: the image would hold"):
+        cwisim.render("pot", size=(60000, 60000))
+    assert issubclass(cwisim.SceneError, cwisim.CwisimError)
+    assert issubclass(cwisim.UsageError, cwisim.CwisimError)
+
+
+def test_a_render_lets_other_python_threads_run():
+    """The render runs without the GIL: a Python thread counts while it runs."""
+    ticks = 0
+    done = threading.Event()
+
+    def count():
+        nonlocal ticks
+        while not done.is_set():
+            ticks += 1
+
+    t = threading.Thread(target=count)
+    t.start()
+    try:
+        before = ticks
+        cwisim.render("teapot", "woo-chall", samples=2)
+        during = ticks - before
+    finally:
+        done.set()
+        t.join()
+    assert during > 1000
+
+
+def test_frames_and_threads():
+    r = cwisim.render("pot", "refine", threads=2)
+    assert r.frames == 4 and r.image.shape == (4 * 400, 400, 1)
+    assert np.shares_memory(r.frame(3), r.image)
+    assert r.frame(3).tobytes() == cwisim.render("pot", "refine").frame(3).tobytes()
+    with pytest.raises(IndexError):
+        r.frame(4)
