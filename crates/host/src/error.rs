@@ -84,9 +84,10 @@ impl From<RenderError> for CliError {
             RenderError::Scene(e) => CliError::Scene(e),
             RenderError::Machine(e) => CliError::Machine(e),
             RenderError::ImageLimit(e) => CliError::ImageLimit(e),
-            e @ (RenderError::Renderer { .. } | RenderError::Array(_)) => {
-                CliError::Internal(e.to_string())
-            }
+            // (the command line never asks to cancel: its Ctrl-C ends the process)
+            e @ (RenderError::Renderer { .. }
+            | RenderError::Array(_)
+            | RenderError::Cancelled { .. }) => CliError::Internal(e.to_string()),
             e @ (RenderError::Usage(_)
             | RenderError::UnknownRenderer { .. }
             | RenderError::Overflow { .. }) => CliError::Usage(e.to_string()),

@@ -13,7 +13,8 @@
 //! `SceneError` (a scene that cannot be read: file, line or JSON path, what was
 //! expected), `UsageError` (unknown names, settings that do not go together or exceed a
 //! limit), both `CwisimError`s; a fault of cwisim's own is a plain `CwisimError`. The
-//! render runs without the GIL.
+//! render runs without the GIL, and stops after the scanline during which Ctrl-C came
+//! (`KeyboardInterrupt`).
 
 use cwisim_render::draw::{draw, SceneInput};
 use cwisim_render::settings::Setting;
@@ -25,7 +26,7 @@ use cwisim_study::tradeoff;
 use cwisim_xproc::{Image, ImageSink, LineStats, Machine, Numeric, Timing};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::create_exception;
-use pyo3::exceptions::PyException;
+use pyo3::exceptions::{PyException, PyKeyboardInterrupt};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use std::path::Path;
@@ -59,6 +60,7 @@ fn to_py(e: RenderError) -> PyErr {
         | RenderError::Machine(_)
         | RenderError::ImageLimit(_)
         | RenderError::Overflow { .. } => UsageError::new_err(message),
+        RenderError::Cancelled { .. } => PyKeyboardInterrupt::new_err(message),
         RenderError::Renderer { .. } | RenderError::Array(_) => CwisimError::new_err(message),
     }
 }
@@ -210,7 +212,13 @@ fn drawn_and_rendered(
         )
         .map_err(|e| RenderError::Usage(e.to_string()))?;
     let mut sink = ImageSink::new(h.width as usize, h.channel_count(), bytes.max(1));
-    let rendered = render_frames(r, array, settings.threads, &mut sink, Taps::default())?;
+    // Ctrl-C: Python's signal handler runs when asked, after each scanline
+    let interrupted = || Python::attach(|py| py.check_signals().is_err());
+    let taps = Taps {
+        cancel: Some(&interrupted),
+        ..Taps::default()
+    };
+    let rendered = render_frames(r, array, settings.threads, &mut sink, taps)?;
     Ok(Done {
         image: sink.finish()?,
         summary: r.summary_rows(&rendered.counters, &rendered.stats),

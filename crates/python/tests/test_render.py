@@ -164,3 +164,20 @@ def test_frames_and_threads():
     assert r.frame(3).tobytes() == cwisim.render("pot", "refine").frame(3).tobytes()
     with pytest.raises(IndexError):
         r.frame(4)
+
+
+def test_ctrl_c_stops_a_render_after_a_scanline():
+    """SIGINT during a render: KeyboardInterrupt, soon, naming the scanlines done."""
+    import signal
+    import time
+
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
+    start = time.perf_counter()
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt, match=r"cancelled after \d+ scanline"):
+            cwisim.render("teapot", "woo-chall", samples=6, size=(1000, 1000))
+    finally:
+        timer.cancel()
+    assert time.perf_counter() - start < 5.0

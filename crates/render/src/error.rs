@@ -43,6 +43,13 @@ pub enum RenderError {
     /// or failed, or a tap beside it (a cost map) did.
     #[error("the array failed: {0}")]
     Array(std::io::Error),
+    /// The caller asked the render to stop ([`crate::Taps::cancel`]: a Python caller's
+    /// Ctrl-C), and it stopped after a scanline.
+    #[error("interrupted: the render was cancelled after {lines} scanline(s)")]
+    Cancelled {
+        /// Scanlines the array had output.
+        lines: u64,
+    },
     /// A value the renderer made for the array is not finite: the scene's values, each
     /// within its limit, still overflow `f64` in the renderer's arithmetic. Bad input, like
     /// a scene over a limit (the CLI's exit 2), found where the value was made (per-pixel

@@ -49,6 +49,9 @@ pub struct Taps<'a> {
     pub also: Option<&'a mut dyn TraceWrite>,
     /// Told the number of scanlines done after each one.
     pub progress: Option<&'a mut dyn FnMut(u64)>,
+    /// Asked after each scanline the array outputs: `true` stops the render, which then
+    /// fails with [`RenderError::Cancelled`] (how the Python package honours Ctrl-C).
+    pub cancel: Option<&'a dyn Fn() -> bool>,
 }
 
 /// What a render gives besides the scanlines.
@@ -312,6 +315,8 @@ struct ScanlineFeed<'a, 's> {
     rows: Rows,
     /// An instruction refused for a value that is not finite: bad input, not a fault.
     overflow: Option<RenderError>,
+    /// The cancel tap said stop.
+    cancelled: bool,
 }
 
 impl<'a, 's> ScanlineFeed<'a, 's> {
@@ -344,6 +349,7 @@ impl<'a, 's> ScanlineFeed<'a, 's> {
             fault: None,
             rows,
             overflow: None,
+            cancelled: false,
         })
     }
 
@@ -379,10 +385,20 @@ impl<'a, 's> ScanlineFeed<'a, 's> {
         self.array_time += start.elapsed();
         r?;
         for _ in 0..std::mem::take(&mut self.buffered_lines) {
-            self.lines += 1;
-            if let Some(p) = self.taps.progress.as_deref_mut() {
-                p(self.lines);
-            }
+            self.line_done()?;
+        }
+        Ok(())
+    }
+
+    /// One more scanline output: the progress tap told, the cancel tap asked.
+    fn line_done(&mut self) -> io::Result<()> {
+        self.lines += 1;
+        if let Some(p) = self.taps.progress.as_deref_mut() {
+            p(self.lines);
+        }
+        if self.taps.cancel.is_some_and(|stop| stop()) {
+            self.cancelled = true;
+            return Err(io::Error::new(io::ErrorKind::Interrupted, "cancelled"));
         }
         Ok(())
     }
@@ -435,10 +451,7 @@ impl<'a, 's> ScanlineFeed<'a, 's> {
         }
         self.bands_taken = true;
         for _ in 0..band.scanlines() {
-            self.lines += 1;
-            if let Some(p) = self.taps.progress.as_deref_mut() {
-                p(self.lines);
-            }
+            self.line_done()?;
         }
         Ok(true)
     }
@@ -451,6 +464,9 @@ impl<'a, 's> ScanlineFeed<'a, 's> {
     /// What an error of the array's (or a tap's) is: the refusal of a value that is not
     /// finite (bad input), or the array's own fault.
     fn array_fault(&mut self, e: io::Error) -> RenderError {
+        if self.cancelled {
+            return RenderError::Cancelled { lines: self.lines };
+        }
         match self.overflow.take() {
             Some(o) => {
                 self.fault = None;
@@ -468,6 +484,9 @@ impl<'a, 's> ScanlineFeed<'a, 's> {
         e: io::Error,
         fault: &dyn Fn(io::Error) -> RenderError,
     ) -> RenderError {
+        if self.cancelled {
+            return RenderError::Cancelled { lines: self.lines };
+        }
         if let Some(o) = self.overflow.take() {
             self.fault = None;
             return o;

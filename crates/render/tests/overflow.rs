@@ -483,6 +483,7 @@ fn an_overflowing_renderer_is_refused_as_bad_input_at_its_row() {
                 let taps = Taps {
                     also: tapped.then_some(&mut seen as &mut dyn TraceWrite),
                     progress: None,
+                    cancel: None,
                 };
                 let e = render(&r, &ArrayConfig::default(), threads, &mut sink, taps)
                     .expect_err("refused");

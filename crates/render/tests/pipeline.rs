@@ -287,6 +287,7 @@ fn tapped(
         Taps {
             also: hear.then_some(&mut heard as &mut dyn TraceWrite),
             progress: Some(&mut progress),
+            cancel: None,
         },
     )
     .unwrap();
@@ -394,4 +395,56 @@ fn bands_that_start_with_negative_accumulation_on_are_byte_identical() {
         assert_eq!(bits(&again), bits(&image), "{threads} threads");
         assert_eq!(d.stats, done.stats, "{threads} threads");
     }
+}
+
+/// The cancel tap stops a render after the scanline it says stop at, on any number of
+/// threads, with [`RenderError::Cancelled`] (no image, no statistics).
+#[test]
+fn a_render_stops_when_the_cancel_tap_says_so() {
+    for (threads, hear) in [(1, true), (1, false), (2, true), (2, false), (3, false)] {
+        let output = std::cell::Cell::new(0u64);
+        let asked = std::cell::Cell::new(0u64);
+        let mut heard: Vec<Instruction> = Vec::new();
+        let stop = || {
+            asked.set(asked.get() + 1);
+            asked.get() == 5
+        };
+        let e = render(
+            &Single(Stripes),
+            &ArrayConfig::default(),
+            threads,
+            &mut Counting(&output),
+            Taps {
+                also: hear.then_some(&mut heard as &mut dyn TraceWrite),
+                progress: None,
+                cancel: Some(&stop),
+            },
+        )
+        .expect_err("cancelled");
+        let what = format!("{threads} threads, hearing {hear}");
+        assert!(
+            matches!(e, RenderError::Cancelled { lines: 5 }),
+            "{what}: {e}"
+        );
+        assert_eq!(asked.get(), 5, "{what}: asked once per scanline, no more");
+        assert!(
+            output.get() >= 5 && output.get() < u64::from(Stripes::LINES),
+            "{what}"
+        );
+    }
+    // never asked to stop: the whole frame, as without the tap
+    let never = || false;
+    let output = std::cell::Cell::new(0u64);
+    render(
+        &Single(Stripes),
+        &ArrayConfig::default(),
+        2,
+        &mut Counting(&output),
+        Taps {
+            cancel: Some(&never),
+            ..Taps::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(output.get(), u64::from(Stripes::LINES));
 }

@@ -54,6 +54,7 @@ fn run(r: &dyn Renderer, threads: usize) -> Run {
         Taps {
             also: Some(&mut stream),
             progress: None,
+            cancel: None,
         },
     )
     .unwrap();

@@ -233,6 +233,7 @@ fn pass(
         Taps {
             also: Some(&mut tap),
             progress: Some(&mut report),
+            cancel: None,
         },
     )?;
     let image = sink.finish()?;

@@ -185,6 +185,7 @@ pub fn run_render(
         Taps {
             also: cost.as_mut().map(|c| c as &mut dyn TraceWrite),
             progress: Some(&mut |lines| progress.update(lines)),
+            cancel: None,
         },
     )?;
     drop(progress);
