@@ -16,6 +16,7 @@
 //! render runs without the GIL, and stops after the scanline during which Ctrl-C came
 //! (`KeyboardInterrupt`).
 
+use cwisim_isa::{Encoding, FileReader, Instruction, Opcode, TraceError, TraceHeader, TraceRead};
 use cwisim_render::draw::{draw, SceneInput};
 use cwisim_render::settings::Setting;
 use cwisim_render::{
@@ -23,12 +24,12 @@ use cwisim_render::{
 };
 use cwisim_study::error::StudyError;
 use cwisim_study::tradeoff;
-use cwisim_xproc::{Image, ImageSink, LineStats, Machine, Numeric, Timing};
-use numpy::{PyArray1, PyArrayMethods};
+use cwisim_xproc::{Image, ImageSink, LineStats, Machine, Numeric, ReplayError, Timing};
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray3};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyException, PyKeyboardInterrupt};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
+use pyo3::types::{PyBytes, PyDict, PyList};
 use std::path::Path;
 
 create_exception!(
@@ -170,6 +171,272 @@ fn line_columns<'py>(py: Python<'py>, lines: &[LineStats]) -> PyResult<Bound<'py
     Ok(out)
 }
 
+/// What a run of the array gives, for Python: `image` (scanlines × width × channels,
+/// handed to NumPy without a copy), `totals` and `machine` (JSON text), `lines` (the
+/// per-scanline columns), `width`, `channels`, `line_period`, `numeric`.
+fn run_dict<'py>(
+    py: Python<'py>,
+    image: Image,
+    stats: &cwisim_xproc::RunStats,
+    array: &ArrayConfig,
+    numeric: &Numeric,
+) -> PyResult<Bound<'py, PyDict>> {
+    let out = PyDict::new(py);
+    let shape = [image.lines, image.width, image.channels];
+    out.set_item("width", image.width)?;
+    out.set_item("channels", image.channels)?;
+    out.set_item("image", PyArray1::from_vec(py, image.data).reshape(shape)?)?;
+    let json = |v: serde_json::Result<String>| v.map_err(|e| CwisimError::new_err(e.to_string()));
+    out.set_item("totals", json(serde_json::to_string(&stats.totals))?)?;
+    out.set_item("machine", json(serde_json::to_string(&array.machine))?)?;
+    out.set_item("lines", line_columns(py, &stats.lines)?)?;
+    out.set_item("line_period", stats.line_period)?;
+    out.set_item("numeric", numeric.to_string())?;
+    Ok(out)
+}
+
+/// The array of `numeric` (`f64`, `f32`, `fixed:…`), `timing` (`fast`, `stepped`) and
+/// the machine model in the file `machine` (`None`: the default machine).
+fn array_config(numeric: &str, timing: &str, machine: Option<&str>) -> PyResult<ArrayConfig> {
+    let numeric: Numeric = numeric
+        .parse()
+        .map_err(|e| UsageError::new_err(format!("numeric: {e}")))?;
+    let timing = match timing {
+        "fast" => Timing::Fast,
+        "stepped" => Timing::Stepped,
+        other => {
+            return Err(UsageError::new_err(format!(
+                "timing: unknown timing `{other}`; expected fast or stepped"
+            )))
+        }
+    };
+    let machine = match machine {
+        Some(path) => Machine::from_file(Path::new(path)).map_err(|e| to_py(e.into()))?,
+        None => Machine::default(),
+    };
+    Ok(ArrayConfig {
+        machine,
+        numeric,
+        timing,
+    })
+}
+
+/// A stream as columns: `width`, `lines`, `channels` (the header), `code` (each
+/// instruction's opcode, its binary code), `x`, `dx`, and `values` (instructions × 3 ×
+/// channels: `I`, `dI`, `ddI`, NaN in a slot the opcode does not carry).
+fn stream_dict<'py>(
+    py: Python<'py>,
+    header: &TraceHeader,
+    stream: &[Instruction],
+) -> PyResult<Bound<'py, PyDict>> {
+    let ch = usize::from(header.channels);
+    let out = PyDict::new(py);
+    out.set_item("width", header.width)?;
+    out.set_item("lines", header.lines)?;
+    out.set_item("channels", ch)?;
+    let code: Vec<u8> = stream.iter().map(|i| i.op.code()).collect();
+    let x: Vec<u32> = stream.iter().map(|i| i.x).collect();
+    let dx: Vec<u32> = stream.iter().map(|i| i.dx).collect();
+    let mut values = vec![f64::NAN; stream.len() * 3 * ch];
+    for (k, i) in stream.iter().enumerate() {
+        for slot in 0..3 {
+            let v = i.value(slot);
+            if !v.is_empty() {
+                values[(k * 3 + slot) * ch..][..ch].copy_from_slice(v);
+            }
+        }
+    }
+    out.set_item("code", PyArray1::from_vec(py, code))?;
+    out.set_item("x", PyArray1::from_vec(py, x))?;
+    out.set_item("dx", PyArray1::from_vec(py, dx))?;
+    out.set_item(
+        "values",
+        PyArray1::from_vec(py, values).reshape([stream.len(), 3, ch])?,
+    )?;
+    Ok(out)
+}
+
+/// The opcodes: `(binary code, name)`, in code order.
+#[pyfunction]
+fn opcodes() -> Vec<(u8, &'static str)> {
+    Opcode::ALL.iter().map(|o| (o.code(), o.name())).collect()
+}
+
+/// The instruction stream a renderer sends for a scene (as [`render`] draws it), as
+/// columns ([`stream_dict`]). A renderer that draws each frame from the previous one's
+/// output has no stream without the array, and is refused.
+#[pyfunction]
+#[pyo3(signature = (scene=None, scene_json=None, name="scene", renderer="vanrij", settings=Vec::new(), threads=1))]
+fn emit_stream<'py>(
+    py: Python<'py>,
+    scene: Option<&str>,
+    scene_json: Option<&str>,
+    name: &str,
+    renderer: &str,
+    settings: Vec<(String, String)>,
+    threads: usize,
+) -> PyResult<Bound<'py, PyDict>> {
+    cwisim_scene::budget::check_threads(threads).map_err(UsageError::new_err)?;
+    let (settings, given) = settings_of(&settings, threads)?;
+    let input = match (scene, scene_json) {
+        (_, Some(text)) => SceneInput::Text { name, text },
+        (path, None) => SceneInput::Named(path.map(Path::new)),
+    };
+    let (header, stream) = py
+        .detach(|| {
+            let drawn = draw(renderer, input, &given, &settings)?;
+            let mut stream: Vec<Instruction> = Vec::new();
+            cwisim_render::emit(&*drawn.renderer, &mut stream)?;
+            Ok::<_, RenderError>((drawn.renderer.header(), stream))
+        })
+        .map_err(to_py)?;
+    stream_dict(py, &header, &stream)
+}
+
+/// The trace file `path` (`.cwt`, `.jsonl` or `.cwb`), read and checked, as columns
+/// ([`stream_dict`]); a trace that cannot be read raises `SceneError` with its location.
+#[pyfunction]
+fn read_trace<'py>(py: Python<'py>, path: &str) -> PyResult<Bound<'py, PyDict>> {
+    let (header, stream) = py
+        .detach(|| {
+            let mut reader = FileReader::open(Path::new(path))?;
+            let stream = cwisim_isa::io::read_all(&mut reader)?;
+            Ok::<_, TraceError>((*reader.header(), stream))
+        })
+        .map_err(|e| SceneError::new_err(e.to_string()))?;
+    stream_dict(py, &header, &stream)
+}
+
+/// Columns ([`stream_dict`]'s) encoded as a trace of `encoding` (`cwt`, `jsonl`, `cwb`),
+/// every instruction checked against the header first: one that does not fit raises
+/// `UsageError` naming it (its index, what is wrong).
+#[pyfunction]
+#[allow(clippy::too_many_arguments)] // the stream's columns
+fn encode_trace<'py>(
+    py: Python<'py>,
+    width: u32,
+    lines: u32,
+    channels: u8,
+    code: PyReadonlyArray1<'py, u8>,
+    x: PyReadonlyArray1<'py, u32>,
+    dx: PyReadonlyArray1<'py, u32>,
+    values: PyReadonlyArray3<'py, f64>,
+    encoding: &str,
+) -> PyResult<Bound<'py, PyBytes>> {
+    let header = TraceHeader::new(width, lines, channels)
+        .map_err(|e| UsageError::new_err(format!("header: {e}")))?;
+    let encoding = Encoding::ALL
+        .iter()
+        .find(|(_, ext)| *ext == encoding)
+        .map(|(e, _)| *e)
+        .ok_or_else(|| {
+            UsageError::new_err(format!(
+                "unknown trace encoding `{encoding}`; expected cwt, jsonl or cwb"
+            ))
+        })?;
+    let (code, x, dx, values) = (
+        code.as_slice()?,
+        x.as_slice()?,
+        dx.as_slice()?,
+        values.as_slice()?,
+    );
+    let ch = usize::from(channels);
+    let n = code.len();
+    if x.len() != n || dx.len() != n || values.len() != n * 3 * ch {
+        return Err(UsageError::new_err(format!(
+            "the columns disagree: {n} opcodes, {} x, {} dx, {} values (expected {} = {n} × 3 × {ch})",
+            x.len(),
+            dx.len(),
+            values.len(),
+            n * 3 * ch
+        )));
+    }
+    let mut stream = Vec::with_capacity(n);
+    for k in 0..n {
+        let op = Opcode::from_code(code[k]).ok_or_else(|| {
+            UsageError::new_err(format!(
+                "instruction {k}: no opcode has the code {}",
+                code[k]
+            ))
+        })?;
+        let i =
+            Instruction::from_operands(op, x[k], dx[k], dx[k], &values[k * 3 * ch..][..3 * ch], ch);
+        i.check(&header).map_err(|e| {
+            UsageError::new_err(format!("instruction {k} ({}): {}", op.name(), e.message()))
+        })?;
+        stream.push(i);
+    }
+    let mut bytes = Vec::new();
+    {
+        let mut w = encoding
+            .writer(&mut bytes, &header)
+            .map_err(|e| CwisimError::new_err(e.to_string()))?;
+        for i in &stream {
+            w.write(i)
+                .map_err(|e| CwisimError::new_err(e.to_string()))?;
+        }
+        w.finish()
+            .map_err(|e| CwisimError::new_err(e.to_string()))?;
+    }
+    Ok(PyBytes::new(py, &bytes))
+}
+
+/// Why a replay was refused, made without the GIL: the trace's fault (`SceneError`) or
+/// the settings' (`UsageError`).
+enum Refused {
+    Input(String),
+    Usage(String),
+}
+
+/// Replays the trace file `path` through the array, as `cwisim run` does: the run's
+/// [`run_dict`], and `frames` and `height` (scanlines per frame). A trace that cannot be
+/// read raises `SceneError` with its location.
+#[pyfunction]
+#[pyo3(signature = (path, numeric="f64", timing="fast", machine=None))]
+fn replay<'py>(
+    py: Python<'py>,
+    path: &str,
+    numeric: &str,
+    timing: &str,
+    machine: Option<&str>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let array = array_config(numeric, timing, machine)?;
+    let budget = cwisim_scene::budget::Budget::current();
+    let (header, image, stats) = py
+        .detach(|| {
+            let mut reader =
+                FileReader::open(Path::new(path)).map_err(|e| Refused::Input(e.to_string()))?;
+            let header = *reader.header();
+            let mut sink = ImageSink::new(
+                header.width as usize,
+                usize::from(header.channels),
+                budget.memory_bytes,
+            );
+            let stats = cwisim_xproc::replay_numeric(
+                &mut reader,
+                &array.machine,
+                array.timing,
+                &array.numeric,
+                &mut sink,
+                &mut |_| {},
+            )
+            .map_err(|e| match e {
+                ReplayError::Trace(e) => Refused::Input(e.to_string()),
+                other => Refused::Usage(other.to_string()),
+            })?;
+            let image = sink.finish().map_err(|e| Refused::Usage(e.to_string()))?;
+            Ok::<_, Refused>((header, image, stats))
+        })
+        .map_err(|e| match e {
+            Refused::Input(m) => SceneError::new_err(m),
+            Refused::Usage(m) => UsageError::new_err(m),
+        })?;
+    let out = run_dict(py, image, &stats, &array, &array.numeric)?;
+    out.set_item("height", header.lines)?;
+    out.set_item("frames", stats.totals.frames)?;
+    Ok(out)
+}
+
 /// What [`render`] makes without the GIL: everything but the Python objects.
 struct Done {
     image: Image,
@@ -256,59 +523,27 @@ fn render<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     cwisim_scene::budget::check_threads(threads).map_err(UsageError::new_err)?;
     let (settings, given) = settings_of(&settings, threads)?;
-    let numeric: Numeric = numeric
-        .parse()
-        .map_err(|e| UsageError::new_err(format!("numeric: {e}")))?;
-    let timing = match timing {
-        "fast" => Timing::Fast,
-        "stepped" => Timing::Stepped,
-        other => {
-            return Err(UsageError::new_err(format!(
-                "timing: unknown timing `{other}`; expected fast or stepped"
-            )))
-        }
-    };
-    let machine = match machine {
-        Some(path) => Machine::from_file(Path::new(path)).map_err(|e| to_py(e.into()))?,
-        None => Machine::default(),
-    };
+    let array = array_config(numeric, timing, machine)?;
     let input = match (scene, scene_json) {
         (_, Some(text)) => SceneInput::Text { name, text },
         (path, None) => SceneInput::Named(path.map(Path::new)),
     };
-    let array = ArrayConfig {
-        machine,
-        numeric,
-        timing,
-    };
     let done = py
         .detach(|| drawn_and_rendered(renderer, input, &given, &settings, &array))
         .map_err(to_py)?;
-    let image = done.image;
-    let out = PyDict::new(py);
-    let shape = [image.lines, image.width, image.channels];
-    out.set_item("image", PyArray1::from_vec(py, image.data).reshape(shape)?)?;
+    let out = run_dict(py, done.image, &done.rendered.stats, &array, &array.numeric)?;
     let counters = PyDict::new(py);
     for (k, v) in done.rendered.counters.iter() {
         counters.set_item(k, v)?;
     }
     out.set_item("counters", counters)?;
-    let json = |v: serde_json::Result<String>| v.map_err(|e| CwisimError::new_err(e.to_string()));
-    let stats = &done.rendered.stats;
-    out.set_item("totals", json(serde_json::to_string(&stats.totals))?)?;
-    out.set_item("machine", json(serde_json::to_string(&array.machine))?)?;
-    out.set_item("lines", line_columns(py, &stats.lines)?)?;
     out.set_item("summary", PyList::new(py, done.summary)?)?;
     out.set_item("renderer", done.renderer)?;
     out.set_item("phrase", done.phrase)?;
     out.set_item("scene", done.scene)?;
     out.set_item("kind", done.kind)?;
-    out.set_item("width", image.width)?;
     out.set_item("height", done.height)?;
-    out.set_item("channels", image.channels)?;
     out.set_item("frames", done.frames)?;
-    out.set_item("line_period", stats.line_period)?;
-    out.set_item("numeric", numeric.to_string())?;
     Ok(out)
 }
 
@@ -441,6 +676,11 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(renderers, m)?)?;
     m.add_function(wrap_pyfunction!(setting_names, m)?)?;
     m.add_function(wrap_pyfunction!(render, m)?)?;
+    m.add_function(wrap_pyfunction!(opcodes, m)?)?;
+    m.add_function(wrap_pyfunction!(emit_stream, m)?)?;
+    m.add_function(wrap_pyfunction!(read_trace, m)?)?;
+    m.add_function(wrap_pyfunction!(encode_trace, m)?)?;
+    m.add_function(wrap_pyfunction!(replay, m)?)?;
     m.add_function(wrap_pyfunction!(default_formats, m)?)?;
     m.add_function(wrap_pyfunction!(default_tessellations, m)?)?;
     m.add_function(wrap_pyfunction!(pareto, m)?)?;

@@ -17,6 +17,7 @@ from __future__ import annotations
 import json
 import os
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any, Dict, List, Mapping, Optional, Tuple, Union
 
 import numpy as np
@@ -38,6 +39,10 @@ __all__ = [
     "tradeoff",
     "mark_pareto",
     "frame",
+    "Stream",
+    "emit",
+    "read_trace",
+    "replay",
 ]
 
 #: A scene: an embedded scene's name or a scene file's path (``None``: the default,
@@ -143,6 +148,15 @@ def _spelled(name: str, value: Any) -> str:
     return str(value)
 
 
+def _where(scene: SceneLike) -> Dict[str, Any]:
+    """The native module's arguments naming a scene."""
+    if isinstance(scene, Mapping):
+        # indented, so that a located error's line and column point into
+        # json.dumps(scene, indent=2)
+        return {"scene_json": json.dumps(scene, indent=2), "name": str(scene.get("name", "scene"))}
+    return {"scene": None if scene is None else os.fspath(scene)}
+
+
 def render(
     scene: SceneLike = None,
     renderer: str = "vanrij",
@@ -171,14 +185,8 @@ def render(
     message locates it) and :class:`UsageError` for names, settings or sizes refused.
     """
     given = [(k, _spelled(k, v)) for k, v in settings.items() if v is not None]
-    if isinstance(scene, Mapping):
-        # indented, so that a located error's line and column point into
-        # json.dumps(scene, indent=2)
-        where = {"scene_json": json.dumps(scene, indent=2), "name": str(scene.get("name", "scene"))}
-    else:
-        where = {"scene": None if scene is None else os.fspath(scene)}
     out = _native.render(
-        **where,
+        **_where(scene),
         renderer=renderer,
         settings=given,
         numeric=numeric,
@@ -186,24 +194,29 @@ def render(
         machine=None if machine is None else os.fspath(machine),
         threads=threads,
     )
+    return _render_of(out, settings=dict(given))
+
+
+def _render_of(out: Mapping[str, Any], **more: Any) -> Render:
+    """A :class:`Render` from the native module's dict."""
     return Render(
         image=out["image"],
         lines=_records(out["lines"]),
-        counters=dict(out["counters"]),
+        counters=dict(out.get("counters", {})),
         totals=json.loads(out["totals"]),
         machine=json.loads(out["machine"]),
-        summary=[tuple(r) for r in out["summary"]],
-        renderer=out["renderer"],
-        phrase=out["phrase"],
-        scene=out["scene"],
-        kind=out["kind"],
+        summary=[tuple(r) for r in out.get("summary", [])],
+        renderer=out.get("renderer", "-"),
+        phrase=out.get("phrase", ""),
+        scene=out.get("scene", "-"),
+        kind=out.get("kind", "trace"),
         width=out["width"],
         height=out["height"],
         channels=out["channels"],
         frames=out["frames"],
         line_period=out["line_period"],
         numeric=out["numeric"],
-        settings=dict(given),
+        **more,
     )
 
 
@@ -316,3 +329,129 @@ def frame(rows: List[Dict[str, Any]]):
     import pandas as pd  # noqa: PLC0415 (optional)
 
     return pd.DataFrame([{k: v for k, v in r.items() if k != "counters"} for r in rows])
+
+
+#: Opcode names by binary code (``Stream.instructions["op"]`` holds the names).
+OPCODES: Dict[int, str] = dict(_native.opcodes())
+
+
+@dataclass
+class Stream:
+    """An instruction stream: the trace header (``width`` processors, ``lines`` per
+    frame, ``channels``) and the instructions as a NumPy structured array with fields
+    ``op`` (the opcode's name: ``"Eval2"``), ``x`` (first processor), ``dx`` (count or
+    period), and ``I``, ``dI``, ``ddI`` (one value per channel; NaN in a slot the opcode
+    does not carry)."""
+
+    width: int
+    lines: int
+    channels: int
+    instructions: np.ndarray
+
+    def write(self, path: Union[str, "os.PathLike[str]"]) -> None:
+        """Writes the stream as a trace file, its encoding by the extension (``.cwt``
+        annotated text, ``.jsonl``, ``.cwb`` binary); every instruction is checked first
+        (one that does not fit raises :class:`UsageError` naming it). All or nothing: the
+        file is written beside its place and renamed over it, and a path that is not a
+        regular file (a device, a FIFO, a symlink) is refused."""
+        path = Path(path)
+        ins = self.instructions
+        codes = {name: code for code, name in OPCODES.items()}
+        try:
+            code = np.array([codes[str(op)] for op in ins["op"]], dtype=np.uint8)
+        except KeyError as e:
+            raise UsageError(f"no opcode is called {e}") from None
+        values = np.stack([ins["I"], ins["dI"], ins["ddI"]], axis=1).reshape(
+            len(ins), 3, self.channels
+        )
+        data = _native.encode_trace(
+            self.width,
+            self.lines,
+            self.channels,
+            code,
+            np.ascontiguousarray(ins["x"], dtype=np.uint32),
+            np.ascontiguousarray(ins["dx"], dtype=np.uint32),
+            np.ascontiguousarray(values, dtype=np.float64),
+            path.suffix.lstrip("."),
+        )
+        _write_whole(path, data)
+
+    def __len__(self) -> int:
+        return len(self.instructions)
+
+
+def _stream_of(out: Mapping[str, Any]) -> Stream:
+    ch = out["channels"]
+    n = len(out["code"])
+    names = np.array([OPCODES.get(c, "?") for c in range(256)], dtype="U8")
+    ins = np.empty(
+        n,
+        dtype=[("op", "U8"), ("x", "u4"), ("dx", "u4"), ("I", "f8", (ch,)), ("dI", "f8", (ch,)), ("ddI", "f8", (ch,))],
+    )
+    ins["op"] = names[out["code"]]
+    ins["x"] = out["x"]
+    ins["dx"] = out["dx"]
+    values = out["values"]
+    ins["I"], ins["dI"], ins["ddI"] = values[:, 0, :], values[:, 1, :], values[:, 2, :]
+    return Stream(out["width"], out["lines"], ch, ins)
+
+
+def _write_whole(path: Path, data: bytes) -> None:
+    """``data`` to ``path``, all or nothing; only a regular file (or none) is replaced."""
+    if path.is_symlink() or (path.exists() and not path.is_file()):
+        raise UsageError(f"{path}: not a regular file; it is not replaced")
+    temp = path.with_name(f".{path.name}.{os.getpid()}.partial")
+    try:
+        temp.write_bytes(data)
+        os.replace(temp, path)
+    finally:
+        if temp.exists():
+            temp.unlink()
+
+
+def emit(
+    scene: SceneLike = None,
+    renderer: str = "vanrij",
+    *,
+    threads: int = 1,
+    **settings: Any,
+) -> Stream:
+    """The instruction stream ``renderer`` sends for ``scene`` (what ``cwisim emit``
+    writes), settings as for :func:`render`; ``.write(path)`` saves it as a trace."""
+    given = [(k, _spelled(k, v)) for k, v in settings.items() if v is not None]
+    return _stream_of(
+        _native.emit_stream(**_where(scene), renderer=renderer, settings=given, threads=threads)
+    )
+
+
+def read_trace(path: Union[str, "os.PathLike[str]"]) -> Stream:
+    """A trace file (``.cwt``, ``.jsonl``, ``.cwb``) as a :class:`Stream`. A trace that
+    cannot be read raises :class:`SceneError` with the file and the line or byte offset."""
+    return _stream_of(_native.read_trace(os.fspath(path)))
+
+
+def replay(
+    trace: Union[str, "os.PathLike[str]", Stream],
+    *,
+    numeric: str = "f64",
+    timing: str = "fast",
+    machine: Optional[Union[str, "os.PathLike[str]"]] = None,
+) -> Render:
+    """Replays a trace through the array (``cwisim run``): a trace file, or a
+    :class:`Stream` (written to a temporary ``.cwb`` first). Returns a :class:`Render`
+    (its ``renderer`` is ``"-"``, it has no counters)."""
+    if isinstance(trace, Stream):
+        import tempfile  # noqa: PLC0415
+
+        with tempfile.TemporaryDirectory() as d:
+            path = Path(d) / "stream.cwb"
+            trace.write(path)
+            return replay(path, numeric=numeric, timing=timing, machine=machine)
+    out = _native.replay(
+        os.fspath(trace),
+        numeric=numeric,
+        timing=timing,
+        machine=None if machine is None else os.fspath(machine),
+    )
+    out["scene"] = Path(os.fspath(trace)).stem
+    return _render_of(out)
