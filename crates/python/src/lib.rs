@@ -18,13 +18,20 @@
 
 use cwisim_isa::{Encoding, FileReader, Instruction, Opcode, TraceError, TraceHeader, TraceRead};
 use cwisim_render::draw::{draw, SceneInput};
+use cwisim_render::refine::parse_phases;
 use cwisim_render::settings::Setting;
 use cwisim_render::{
     registry, render as render_frames, ArrayConfig, RenderError, Rendered, Settings, Taps,
 };
 use cwisim_study::error::StudyError;
+use cwisim_study::fit::{fit_scene, q, REGISTERS};
+use cwisim_study::history::pixel_history_with_progress;
+use cwisim_study::refine::{run_refine, PhaseRow, RefineSetup};
 use cwisim_study::tradeoff;
-use cwisim_xproc::{Image, ImageSink, LineStats, Machine, Numeric, ReplayError, Timing};
+use cwisim_xproc::numeric::Overflow;
+use cwisim_xproc::{
+    Image, ImageSink, LineStats, Machine, Numeric, ProcessorState, ReplayError, Timing,
+};
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray3};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyException, PyKeyboardInterrupt};
@@ -664,6 +671,251 @@ fn pareto(points: Vec<(u64, u32, f64)>) -> Vec<bool> {
     tradeoff::pareto(&points)
 }
 
+/// `cwisim fit`: the narrowest fixed-point registers with which `renderer`'s stream for
+/// the scene (a file or an embedded name) stays within `max_error` of the f64 array.
+/// Returns a dict: `numeric` (the format, as `--numeric` takes it), `error`,
+/// `exact_error`, `f64_error`, `registers` (name → `(int_bits, frac_bits, max error with
+/// one fraction bit fewer)`), `bits`, `replays`, `instructions`.
+#[pyfunction]
+#[pyo3(signature = (scene=None, renderer="vanrij", settings=Vec::new(), max_error=1.0/512.0, overflow="saturate", machine=None, threads=0))]
+#[allow(clippy::too_many_arguments)] // Python's keywords: the command line's flags
+fn fit<'py>(
+    py: Python<'py>,
+    scene: Option<&str>,
+    renderer: &str,
+    settings: Vec<(String, String)>,
+    max_error: f64,
+    overflow: &str,
+    machine: Option<&str>,
+    threads: usize,
+) -> PyResult<Bound<'py, PyDict>> {
+    cwisim_scene::budget::check_threads(threads).map_err(UsageError::new_err)?;
+    if !(max_error.is_finite() && max_error > 0.0) {
+        return Err(UsageError::new_err(format!(
+            "max_error: the error budget must be finite and > 0, found {max_error}"
+        )));
+    }
+    let overflow = match overflow {
+        "saturate" => Overflow::Saturate,
+        "wrap" => Overflow::Wrap,
+        other => {
+            return Err(UsageError::new_err(format!(
+                "overflow: unknown `{other}`; expected saturate or wrap"
+            )))
+        }
+    };
+    let (settings, given) = settings_of(&settings, threads)?;
+    let array = array_config("f64", "fast", machine)?;
+    let found = py
+        .detach(|| {
+            let drawn = draw(
+                renderer,
+                SceneInput::Named(scene.map(Path::new)),
+                &given,
+                &settings,
+            )?;
+            fit_scene(
+                &*drawn.renderer,
+                scene.map(Path::new),
+                settings.size,
+                &array.machine,
+                max_error,
+                overflow,
+                threads,
+            )
+        })
+        .map_err(study_to_py)?;
+    let f = &found.fit;
+    let out = PyDict::new(py);
+    out.set_item("numeric", Numeric::Fixed(f.format).to_string())?;
+    out.set_item("error", f.error)?;
+    out.set_item("exact_error", f.exact_error)?;
+    out.set_item("f64_error", f.f64_error)?;
+    let registers = PyDict::new(py);
+    let mut bits = 0;
+    for (k, name) in REGISTERS.iter().enumerate() {
+        let qk = q(&f.format, k);
+        bits += qk.int_bits + qk.frac_bits;
+        registers.set_item(*name, (qk.int_bits, qk.frac_bits, f.one_bit_less[k]))?;
+    }
+    out.set_item("registers", registers)?;
+    out.set_item("bits", bits)?;
+    out.set_item("replays", f.runs)?;
+    out.set_item("instructions", found.instructions)?;
+    Ok(out)
+}
+
+/// A phase's figures, for Python.
+fn phase_dict<'py>(py: Python<'py>, r: &PhaseRow) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("phase", r.phase)?;
+    d.set_item("pixels", r.pixels)?;
+    d.set_item("instructions", r.instructions)?;
+    d.set_item("regenerated", r.regenerated)?;
+    d.set_item("busy_cycles", r.busy_cycles)?;
+    d.set_item("cumulative_cycles", r.cumulative_cycles)?;
+    d.set_item("worst_line_cycles", r.worst_line_cycles)?;
+    d.set_item("late_lines", r.late_lines)?;
+    d.set_item("rms", r.rms)?;
+    d.set_item("psnr_db", r.psnr)?;
+    d.set_item("display_list_bytes", r.display_list_bytes)?;
+    Ok(d)
+}
+
+/// `cwisim refine`: Bergman et al.'s adaptive refinement of a world scene (a file or an
+/// embedded name), each phase a complete frame. `phases` as `--phases` takes them;
+/// `settings` those `refine` reads (thresholds, `size`, `tessellate`,
+/// `shade_tolerance`, `shadows`). Returns a dict: `phases` and `naive` (one dict per
+/// phase: pixels, instructions, regenerated, busy and cumulative cycles, worst line, late
+/// lines, RMS and PSNR against the full-quality image, display-list bytes), `frames`
+/// (frames × lines × width × channels), `busy_per_line` (frames × lines), `counters`,
+/// `polygons`, `highlight` (passing, visible), `line_period`, `frame_buffer_bytes`.
+#[pyfunction]
+#[pyo3(signature = (scene=None, phases="flat,gouraud,phong,aa", settings=Vec::new(), machine=None, threads=1))]
+fn refine<'py>(
+    py: Python<'py>,
+    scene: Option<&str>,
+    phases: &str,
+    settings: Vec<(String, String)>,
+    machine: Option<&str>,
+    threads: usize,
+) -> PyResult<Bound<'py, PyDict>> {
+    cwisim_scene::budget::check_threads(threads).map_err(UsageError::new_err)?;
+    let phases = parse_phases(phases).map_err(UsageError::new_err)?;
+    let (settings, given) = settings_of(&settings, 1)?;
+    registry::find("refine")
+        .map_err(to_py)?
+        .check_given(&given, &settings)
+        .map_err(UsageError::new_err)?;
+    settings.check().map_err(UsageError::new_err)?;
+    let array = array_config("f64", "fast", machine)?;
+    let setup = RefineSetup {
+        scene: scene.map(Path::new),
+        settings,
+        phases,
+        machine: array.machine,
+        naive: true,
+        cost_maps: false,
+        ids: false,
+        threads,
+    };
+    let mut run = py
+        .detach(|| run_refine(&setup, None, None))
+        .map_err(study_to_py)?;
+    let out = PyDict::new(py);
+    let rows = PyList::empty(py);
+    for r in &run.rows {
+        rows.append(phase_dict(py, r)?)?;
+    }
+    out.set_item("phases", rows)?;
+    let naive = PyList::empty(py);
+    for r in &run.naive {
+        naive.append(phase_dict(py, r)?)?;
+    }
+    out.set_item("naive", naive)?;
+    let frames = run.frames.len();
+    let mut data = Vec::with_capacity(frames * run.lines * run.width * run.channels);
+    for f in std::mem::take(&mut run.frames) {
+        data.extend_from_slice(&f.data);
+    }
+    out.set_item(
+        "frames",
+        PyArray1::from_vec(py, data).reshape([frames, run.lines, run.width, run.channels])?,
+    )?;
+    let busy: Vec<u64> = run.busy_per_line.iter().flatten().copied().collect();
+    out.set_item(
+        "busy_per_line",
+        PyArray1::from_vec(py, busy).reshape([run.busy_per_line.len(), run.lines])?,
+    )?;
+    let counters = PyDict::new(py);
+    for (k, v) in run.counters.iter() {
+        counters.set_item(k, v)?;
+    }
+    out.set_item("counters", counters)?;
+    out.set_item("polygons", run.polygons)?;
+    out.set_item("highlight", run.highlight)?;
+    out.set_item("line_period", run.line_period)?;
+    out.set_item("frame_buffer_bytes", run.frame_buffer_bytes)?;
+    out.set_item("scene", run.scene)?;
+    Ok(out)
+}
+
+/// A processor's state, for Python.
+fn state_dict<'py>(py: Python<'py>, s: &ProcessorState) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("acc", s.acc.clone())?;
+    d.set_item("I", s.reg[0].clone())?;
+    d.set_item("dI", s.reg[1].clone())?;
+    d.set_item("ddI", s.reg[2].clone())?;
+    d.set_item("has", s.has)?;
+    d.set_item("locked", s.locked)?;
+    d.set_item("masked", s.masked)?;
+    d.set_item("negative_enabled", s.negative_enabled)?;
+    Ok(d)
+}
+
+/// `cwisim history`: every visit of a token to processor `x` on scanline `line` of the
+/// trace file `path`, on the cycle-stepped engine, registers in `numeric`. A list of
+/// dicts: `cycle`, `index` (the instruction's, in the trace), `instruction` (as the text
+/// form writes it), `op`, `addressed`, `before` and `after` (the processor's registers
+/// and flags), `note` (what the visit amounted to, when not a plain action),
+/// `provenance` (the note the trace attaches to the instruction: which row, polygon,
+/// case). A scanline the trace does not reach raises `UsageError`.
+#[pyfunction]
+#[pyo3(signature = (path, x, line, numeric="f64", machine=None))]
+fn history<'py>(
+    py: Python<'py>,
+    path: &str,
+    x: usize,
+    line: u64,
+    numeric: &str,
+    machine: Option<&str>,
+) -> PyResult<Bound<'py, PyList>> {
+    let array = array_config(numeric, "stepped", machine)?;
+    let found = py
+        .detach(|| {
+            let mut reader = FileReader::open(Path::new(path))?;
+            let width = reader.header().width as usize;
+            if x >= width {
+                return Err(StudyError::Usage(format!(
+                    "x {x}: the trace has processors 0..{width}"
+                )));
+            }
+            pixel_history_with_progress(
+                &mut reader,
+                &array.machine,
+                &array.numeric,
+                x,
+                line,
+                &mut |_| {},
+            )
+        })
+        .map_err(study_to_py)?
+        .map_err(|lines| {
+            UsageError::new_err(format!(
+                "line {line}: the trace outputs {lines} scanline(s), 0..{lines}"
+            ))
+        })?;
+    let out = PyList::empty(py);
+    for v in &found.visits {
+        let d = PyDict::new(py);
+        d.set_item("cycle", v.cycle)?;
+        d.set_item("index", v.index)?;
+        d.set_item("instruction", v.instr.to_string())?;
+        d.set_item("op", v.instr.op.name())?;
+        d.set_item("addressed", v.addressed)?;
+        d.set_item("before", state_dict(py, &v.before)?)?;
+        d.set_item("after", state_dict(py, &v.after)?)?;
+        d.set_item("note", v.note())?;
+        d.set_item(
+            "provenance",
+            found.provenance(v).map(|n| n.text.to_string()),
+        )?;
+        out.append(d)?;
+    }
+    Ok(out)
+}
+
 /// The module.
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -681,6 +933,9 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read_trace, m)?)?;
     m.add_function(wrap_pyfunction!(encode_trace, m)?)?;
     m.add_function(wrap_pyfunction!(replay, m)?)?;
+    m.add_function(wrap_pyfunction!(fit, m)?)?;
+    m.add_function(wrap_pyfunction!(refine, m)?)?;
+    m.add_function(wrap_pyfunction!(history, m)?)?;
     m.add_function(wrap_pyfunction!(default_formats, m)?)?;
     m.add_function(wrap_pyfunction!(default_tessellations, m)?)?;
     m.add_function(wrap_pyfunction!(pareto, m)?)?;

@@ -95,3 +95,24 @@ def test_bad_traces_and_streams_are_refused_located(tmp_path):
     assert (tmp_path / "target.cwb").read_bytes() == b"kept"
     with pytest.raises(cwisim.UsageError, match="previous frame"):
         cwisim.emit("pot", "refine")
+
+
+def test_a_pixel_s_history_is_the_command_line_s(tmp_path):
+    trace = ROOT / "traces" / "visibility.cwt"
+    out = cli("history", str(trace), "--x", "9", "--line", "0", "--all", cwd=tmp_path)
+    assert out.returncode == 0, out.stderr
+    printed = [line.split() for line in out.stdout.splitlines() if line.startswith("cycle")]
+    visits = cwisim.history(trace, 9, 0)
+    assert [(int(p[1]), p[2], p[3]) for p in printed] == [
+        (v["cycle"], f"#{v['index']}", v["op"]) for v in visits
+    ]
+    assert visits[0]["note"] == "passes through" and not visits[0]["addressed"]
+    assert visits[2]["after"]["acc"] == [0.375] and visits[2]["before"]["acc"] == [0.0]
+    assert visits[0]["provenance"].startswith("near object")
+    # a Stream's history is its file's
+    same = cwisim.history(cwisim.read_trace(trace), 9, 0)
+    assert [(v["cycle"], v["after"]) for v in same] == [(v["cycle"], v["after"]) for v in visits]
+    with pytest.raises(cwisim.UsageError, match="line 99: the trace outputs"):
+        cwisim.history(trace, 9, 99)
+    with pytest.raises(cwisim.UsageError, match="x 99: the trace has processors"):
+        cwisim.history(trace, 99, 0)

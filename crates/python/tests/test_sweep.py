@@ -83,5 +83,5 @@ def test_a_bad_sweep_is_refused_before_any_task():
         cwisim.tradeoff("pot", renderers=["refine"])
     with pytest.raises(cwisim.UsageError, match="^numeric: "):
         cwisim.tradeoff("pot", numeric="f16")
-    with pytest.raises(cwisim.UsageError, match="write a dict to a file"):
+    with pytest.raises(cwisim.UsageError, match="tradeoff takes a scene file"):
         cwisim.tradeoff(cwisim.scene("pot"))

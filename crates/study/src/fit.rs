@@ -530,3 +530,40 @@ mod tests {
         );
     }
 }
+
+/// A scene's fit ([`fit_scene`]): the fit, and the stream it was found for.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneFit {
+    /// The fit.
+    pub fit: Fit,
+    /// The stream's header.
+    pub header: cwisim_isa::TraceHeader,
+    /// Instructions in the stream.
+    pub instructions: usize,
+}
+
+/// What `cwisim fit` does: the stream `renderer` draws for the scene SCENE names (a file
+/// or an embedded name, at `size`), its exact image, and the narrowest format found for
+/// it within `max_error` of the f64 array ([`fit_format`]), candidates replayed on
+/// `threads` threads (the result the same at any count).
+pub fn fit_scene(
+    renderer: &dyn cwisim_render::Renderer,
+    scene: Option<&std::path::Path>,
+    size: Option<cwisim_render::Size>,
+    machine: &Machine,
+    max_error: f64,
+    overflow: Overflow,
+    threads: usize,
+) -> Result<SceneFit, StudyError> {
+    let exact = crate::tradeoff::exact_image(scene, size)?;
+    let header = renderer.header();
+    let mut instructions: Vec<Instruction> = Vec::new();
+    cwisim_render::emit(renderer, &mut instructions)?;
+    let mut bench = Bench::new(header, &instructions, machine, &exact)?.threads(threads);
+    let fit = fit_format(&mut bench, max_error, overflow)?;
+    Ok(SceneFit {
+        fit,
+        header,
+        instructions: instructions.len(),
+    })
+}

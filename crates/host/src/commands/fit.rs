@@ -7,9 +7,7 @@ use super::MachineArgs;
 use crate::draw::DrawArgs;
 use crate::error::CliError;
 use clap::Args;
-use cwisim_isa::Instruction;
-use cwisim_study::fit::{fit_format, q, Bench, REGISTERS};
-use cwisim_study::tradeoff::exact_image;
+use cwisim_study::fit::{fit_scene, q, SceneFit, REGISTERS};
 use cwisim_xproc::numeric::{Numeric, Overflow};
 use std::io::Write;
 use std::path::PathBuf;
@@ -82,17 +80,24 @@ pub fn run(args: &FitArgs, stdout: &mut dyn Write, progress: bool) -> Result<(),
     let machine = args.machine.load()?;
     let stage = crate::progress::Stage::new(progress, "fit: drawing the scene");
     let drawn = args.draw.draw_on(args.scene.as_deref(), args.threads)?;
-    let exact = exact_image(args.scene.as_deref(), args.draw.size)?;
-    let header = drawn.renderer.header();
-    let mut instructions: Vec<Instruction> = Vec::new();
-    cwisim_render::emit(&*drawn.renderer, &mut instructions)?;
-    let mut bench = Bench::new(header, &instructions, &machine, &exact)?.threads(args.threads);
     let overflow = match args.overflow {
         OverflowArg::Wrap => Overflow::Wrap,
         OverflowArg::Saturate => Overflow::Saturate,
     };
     stage.message("fit: replaying the stream in candidate formats");
-    let fit = fit_format(&mut bench, args.max_error, overflow)?;
+    let SceneFit {
+        fit,
+        header,
+        instructions,
+    } = fit_scene(
+        &*drawn.renderer,
+        args.scene.as_deref(),
+        args.draw.size,
+        &machine,
+        args.max_error,
+        overflow,
+        args.threads,
+    )?;
     drop(stage);
     let out = stdout;
     let w = |out: &mut dyn Write, label: &str, value: String| writeln!(out, "{label:<16}{value}");
@@ -107,7 +112,7 @@ pub fn run(args: &FitArgs, stdout: &mut dyn Write, progress: bool) -> Result<(),
                 header.width,
                 header.lines,
                 header.channels,
-                instructions.len()
+                instructions
             ),
         )?;
         w(out, "budget", format!("the registers may add at most {:.4e} to any value (against the f64 array)", args.max_error))?;

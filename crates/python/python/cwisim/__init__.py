@@ -14,8 +14,10 @@ carrying the command line's located message. docs/PYTHON.md documents the API.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
+import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Dict, List, Mapping, Optional, Tuple, Union
@@ -43,6 +45,9 @@ __all__ = [
     "emit",
     "read_trace",
     "replay",
+    "fit",
+    "refine",
+    "history",
 ]
 
 #: A scene: an embedded scene's name or a scene file's path (``None``: the default,
@@ -154,7 +159,35 @@ def _where(scene: SceneLike) -> Dict[str, Any]:
         # indented, so that a located error's line and column point into
         # json.dumps(scene, indent=2)
         return {"scene_json": json.dumps(scene, indent=2), "name": str(scene.get("name", "scene"))}
-    return {"scene": None if scene is None else os.fspath(scene)}
+    return {"scene": _path(scene)}
+
+
+def _given(settings: Mapping[str, Any]) -> List[Tuple[str, str]]:
+    """The settings given (``None``: left at the default), spelled for the native module."""
+    return [(k, _spelled(k, v)) for k, v in settings.items() if v is not None]
+
+
+def _path(path: Optional[Union[str, "os.PathLike[str]"]]) -> Optional[str]:
+    return None if path is None else os.fspath(path)
+
+
+def _named(scene: SceneLike, what: str) -> Optional[str]:
+    """A scene named by a file or an embedded name, for the calls that read it themselves
+    (every task of a sweep, every replay of a fit)."""
+    if isinstance(scene, Mapping):
+        raise UsageError(
+            f"{what} takes a scene file or an embedded scene's name (write a dict to a file first)"
+        )
+    return _path(scene)
+
+
+@contextlib.contextmanager
+def _written(stream: "Stream"):
+    """``stream`` as a temporary ``.cwb`` file, for the calls that read a trace file."""
+    with tempfile.TemporaryDirectory() as d:
+        path = Path(d) / "stream.cwb"
+        stream.write(path)
+        yield path
 
 
 def render(
@@ -184,14 +217,14 @@ def render(
     Runs without the GIL. Raises :class:`SceneError` for a scene that cannot be read (the
     message locates it) and :class:`UsageError` for names, settings or sizes refused.
     """
-    given = [(k, _spelled(k, v)) for k, v in settings.items() if v is not None]
+    given = _given(settings)
     out = _native.render(
         **_where(scene),
         renderer=renderer,
         settings=given,
         numeric=numeric,
         timing=timing,
-        machine=None if machine is None else os.fspath(machine),
+        machine=_path(machine),
         threads=threads,
     )
     return _render_of(out, settings=dict(given))
@@ -232,11 +265,7 @@ def _records(columns: Mapping[str, np.ndarray]) -> np.ndarray:
 
 def _plan_args(scene, size, tessellate, shadows, renderers, numeric, machine) -> Dict[str, Any]:
     """The arguments of a tradeoff plan, as plain (picklable) Python values."""
-    if isinstance(scene, Mapping):
-        raise UsageError(
-            "tradeoff takes a scene file or an embedded scene's name (write a dict to a "
-            "file first: every task reads the scene itself)"
-        )
+    scene = _named(scene, "tradeoff")
     if size is not None and not isinstance(size, str):
         size = f"{int(size[0])}x{int(size[1])}"
     if isinstance(shadows, bool):
@@ -246,13 +275,13 @@ def _plan_args(scene, size, tessellate, shadows, renderers, numeric, machine) ->
     if isinstance(renderers, str):
         renderers = [renderers]
     return {
-        "scene": None if scene is None else os.fspath(scene),
+        "scene": scene,
         "size": size,
         "tessellate": list(_native.default_tessellations() if tessellate is None else tessellate),
         "shadows": [bool(v) for v in (shadows or [])],
         "renderers": list(renderers or []),
         "numeric": list(_native.default_formats() if numeric is None else numeric),
-        "machine": None if machine is None else os.fspath(machine),
+        "machine": _path(machine),
     }
 
 
@@ -420,7 +449,7 @@ def emit(
     writes), settings as for :func:`render`; ``.write(path)`` saves it as a trace."""
     given = [(k, _spelled(k, v)) for k, v in settings.items() if v is not None]
     return _stream_of(
-        _native.emit_stream(**_where(scene), renderer=renderer, settings=given, threads=threads)
+        _native.emit_stream(**_where(scene), renderer=renderer, settings=_given(settings), threads=threads)
     )
 
 
@@ -441,17 +470,99 @@ def replay(
     :class:`Stream` (written to a temporary ``.cwb`` first). Returns a :class:`Render`
     (its ``renderer`` is ``"-"``, it has no counters)."""
     if isinstance(trace, Stream):
-        import tempfile  # noqa: PLC0415
-
-        with tempfile.TemporaryDirectory() as d:
-            path = Path(d) / "stream.cwb"
-            trace.write(path)
+        with _written(trace) as path:
             return replay(path, numeric=numeric, timing=timing, machine=machine)
     out = _native.replay(
         os.fspath(trace),
         numeric=numeric,
         timing=timing,
-        machine=None if machine is None else os.fspath(machine),
+        machine=_path(machine),
     )
     out["scene"] = Path(os.fspath(trace)).stem
     return _render_of(out)
+
+
+def fit(
+    scene: SceneLike = None,
+    renderer: str = "vanrij",
+    *,
+    max_error: float = 1 / 512,
+    overflow: str = "saturate",
+    machine: Optional[Union[str, "os.PathLike[str]"]] = None,
+    threads: int = 0,
+    **settings: Any,
+) -> Dict[str, Any]:
+    """``cwisim fit``: the narrowest fixed-point registers with which the renderer's
+    stream for ``scene`` (a file or an embedded name) stays within ``max_error`` of the
+    f64 array — model only what the scene requires. Settings as for :func:`render`.
+    Returns ``numeric`` (the format, as ``render(numeric=…)`` takes it), ``error``,
+    ``exact_error``, ``f64_error``, ``registers`` (name → ``(int_bits, frac_bits, max error
+    with one fraction bit fewer)``), ``bits`` (in all), ``replays``, ``instructions``."""
+    return dict(
+        _native.fit(
+            scene=_named(scene, "fit"),
+            renderer=renderer,
+            settings=_given(settings),
+            max_error=float(max_error),
+            overflow=overflow,
+            machine=_path(machine),
+            threads=threads,
+        )
+    )
+
+
+def refine(
+    scene: SceneLike = None,
+    *,
+    phases: str = "flat,gouraud,phong,aa",
+    machine: Optional[Union[str, "os.PathLike[str]"]] = None,
+    threads: int = 1,
+    **settings: Any,
+) -> Dict[str, Any]:
+    """``cwisim refine``: Bergman et al.'s adaptive refinement of a world scene (a file or
+    an embedded name), each phase a complete frame, beside the naive sequence (every
+    phase in full). ``phases`` as ``--phases`` takes them; settings: ``gouraud_threshold``,
+    ``phong_angle``, ``aa_threshold``, ``size``, ``tessellate``, ``shade_tolerance``,
+    ``shadows``. Returns ``phases`` and ``naive`` (a dict per phase: ``pixels``,
+    ``instructions``, ``regenerated``, ``busy_cycles``, ``cumulative_cycles``,
+    ``worst_line_cycles``, ``late_lines``, ``rms``, ``psnr_db``, ``display_list_bytes``),
+    ``frames`` (frames × lines × width × channels), ``busy_per_line`` (frames × lines),
+    ``counters``, ``polygons``, ``highlight``, ``line_period``, ``frame_buffer_bytes``."""
+    return dict(
+        _native.refine(
+            scene=_named(scene, "refine"),
+            phases=phases,
+            settings=_given(settings),
+            machine=_path(machine),
+            threads=threads,
+        )
+    )
+
+
+def history(
+    trace: Union[str, "os.PathLike[str]", Stream],
+    x: int,
+    line: int,
+    *,
+    numeric: str = "f64",
+    machine: Optional[Union[str, "os.PathLike[str]"]] = None,
+) -> List[Dict[str, Any]]:
+    """``cwisim history``: every visit of a token to processor ``x`` on scanline ``line``
+    of a trace (a file, or a :class:`Stream`), in order, on the cycle-stepped engine: a
+    dict per visit with ``cycle``, ``index`` (the instruction's), ``instruction`` (its
+    text), ``op``, ``addressed``, ``before`` and ``after`` (``acc``, ``I``, ``dI``,
+    ``ddI``, ``has``, ``locked``, ``masked``, ``negative_enabled``), ``note`` (``"passes
+    through"``, ``"suppressed: …"`` or ``None``) and ``provenance`` (the trace's note on
+    the instruction, when it has one)."""
+    if isinstance(trace, Stream):
+        with _written(trace) as path:
+            return history(path, x, line, numeric=numeric, machine=machine)
+    return list(
+        _native.history(
+            os.fspath(trace),
+            x,
+            line,
+            numeric=numeric,
+            machine=_path(machine),
+        )
+    )

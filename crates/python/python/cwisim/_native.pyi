@@ -69,3 +69,22 @@ class TradeoffPlan:
     def settings(self) -> int: ...
     def skipped(self) -> List[Tuple[str, str]]: ...
     def measure(self, g: int, repeat: int = 3) -> str: ...
+def fit(
+    scene: Optional[str] = None,
+    renderer: str = "vanrij",
+    settings: Sequence[Tuple[str, str]] = (),
+    max_error: float = ...,
+    overflow: str = "saturate",
+    machine: Optional[str] = None,
+    threads: int = 0,
+) -> Dict[str, Any]: ...
+def refine(
+    scene: Optional[str] = None,
+    phases: str = "flat,gouraud,phong,aa",
+    settings: Sequence[Tuple[str, str]] = (),
+    machine: Optional[str] = None,
+    threads: int = 1,
+) -> Dict[str, Any]: ...
+def history(
+    path: str, x: int, line: int, numeric: str = "f64", machine: Optional[str] = None
+) -> List[Dict[str, Any]]: ...
