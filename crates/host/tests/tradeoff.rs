@@ -416,3 +416,59 @@ fn the_shadows_axis_measures_each_side_against_its_own_exact_image() {
         assert!(stderr.contains(says), "{args:?}: {stderr}");
     }
 }
+
+/// `--shard I/N` parts joined by `--merge` are the sweep in one go, row for row (host
+/// times aside); a part alone marks no Pareto front.
+#[test]
+fn shards_joined_by_merge_are_the_whole_sweep() {
+    let dir = scratch("tradeoff-shards");
+    let grid = [
+        "fig25",
+        "--renderers",
+        "vanrij,sbuffer",
+        "--numeric",
+        "f64;f32",
+        "--repeat",
+        "1",
+    ];
+    let run = |extra: &[&str]| cwisim_ok(&dir, &[&["tradeoff"][..], &grid, extra].concat());
+    run(&["--csv", "whole.csv"]);
+    for k in 0..3 {
+        let part = format!("part-{k}.csv");
+        let out = run(&["--shard", &format!("{k}/3"), "--csv", &part]);
+        assert!(out.contains(&format!("part {k} of 3")), "{out}");
+        let (header, rows) = read_csv(&dir.join(&part));
+        assert!(rows.iter().all(|r| r.get(&header, "pareto") == "false"));
+    }
+    let out = cwisim_ok(
+        &dir,
+        &[
+            "tradeoff",
+            "--merge",
+            "part-0.csv",
+            "part-1.csv",
+            "part-2.csv",
+            "--csv",
+            "merged.csv",
+        ],
+    );
+    assert!(out.contains("3 parts joined"), "{out}");
+    let (h1, whole) = read_csv(&dir.join("whole.csv"));
+    let (h2, merged) = read_csv(&dir.join("merged.csv"));
+    assert_eq!(h1, h2);
+    assert_eq!(whole.len(), merged.len());
+    for (a, b) in whole.iter().zip(&merged) {
+        for name in h1.iter().filter(|n| *n != "host_ms") {
+            assert_eq!(a.get(&h1, name), b.get(&h2, name), "{name}");
+        }
+    }
+    // a file that is not a part is refused, located
+    std::fs::write(dir.join("other.csv"), "x,y\n1,2\n").unwrap();
+    let out = cwisim(&dir, &["tradeoff", "--merge", "part-0.csv", "other.csv"]);
+    let (_, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("other.csv:1: not a tradeoff CSV"),
+        "{stderr}"
+    );
+}

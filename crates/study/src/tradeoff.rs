@@ -680,37 +680,97 @@ pub fn tradeoff_rows(
     progress: &mut dyn FnMut(Step<'_>),
 ) -> Result<Vec<Row>, StudyError> {
     let plan = Plan::new(scene, size, tessellations, shadows, renderers, formats)?;
+    let mut rows = measure_groups(
+        &plan,
+        0..plan.groups.len(),
+        machine,
+        repeat,
+        threads,
+        progress,
+    )?;
+    mark_pareto(&mut rows);
+    Ok(rows)
+}
+
+/// The rows of `plan`'s groups `groups` (a [`Shard`]'s, or all of them), measured on
+/// `threads` threads and reported to `progress` in the grid's order; none marked
+/// Pareto-optimal (that needs every row: [`mark_pareto`], or [`merge_csv`] of the shards).
+pub fn measure_groups(
+    plan: &Plan,
+    groups: std::ops::Range<usize>,
+    machine: &Machine,
+    repeat: u32,
+    threads: usize,
+    progress: &mut dyn FnMut(Step<'_>),
+) -> Result<Vec<Row>, StudyError> {
     let settings = &plan.settings;
-    let groups = &plan.groups;
+    let first = groups.start;
+    let ranges = &plan.groups[groups];
+    let total: usize = ranges.iter().map(|r| r.len()).sum();
+    let base = ranges.first().map_or(0, |r| r.start);
     progress(Step::Start {
-        total: settings.len(),
+        total,
         skipped: &plan.skipped,
     });
-    let mut rows = Vec::with_capacity(settings.len());
+    let mut rows = Vec::with_capacity(total);
     crate::parallel::ordered(
-        groups.len(),
+        ranges.len(),
         threads,
-        |g| plan.measure_group(g, machine, repeat),
+        |g| plan.measure_group(first + g, machine, repeat),
         |event| match event {
             crate::parallel::Event::Started(g) => progress(Step::Measuring {
-                index: groups[g].start,
-                total: settings.len(),
-                setting: describe_stream(&settings[groups[g].clone()]),
+                index: ranges[g].start - base,
+                total,
+                setting: describe_stream(&settings[ranges[g].clone()]),
             }),
             crate::parallel::Event::Done(g, group) => {
-                for (index, row) in groups[g].clone().zip(group) {
+                for (index, row) in ranges[g].clone().zip(group) {
                     rows.push(row);
                     progress(Step::Measured {
-                        index,
-                        total: settings.len(),
+                        index: index - base,
+                        total,
                         row: rows.last().expect("just pushed"),
                     });
                 }
             }
         },
     )?;
-    mark_pareto(&mut rows);
     Ok(rows)
+}
+
+/// One of `count` parts of a sweep (`--shard index/count`), for batch systems: each part
+/// a job (a Slurm array task, say) measuring its consecutive share of the plan's groups,
+/// the parts' CSVs then merged in order ([`merge_csv`]) into the whole sweep's.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Shard {
+    /// Which part, from 0.
+    pub index: usize,
+    /// How many.
+    pub count: usize,
+}
+
+impl Shard {
+    /// Its groups among `groups`: consecutive, the parts' sizes within one of each other.
+    pub fn groups(self, groups: usize) -> std::ops::Range<usize> {
+        groups * self.index / self.count..groups * (self.index + 1) / self.count
+    }
+}
+
+impl std::str::FromStr for Shard {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Shard, String> {
+        let bad = || format!("expected I/N with 0 ≤ I < N (the part and how many), found `{s}`");
+        let (i, n) = s.split_once('/').ok_or_else(bad)?;
+        let (index, count): (usize, usize) = (
+            i.trim().parse().map_err(|_| bad())?,
+            n.trim().parse().map_err(|_| bad())?,
+        );
+        if index >= count {
+            return Err(bad());
+        }
+        Ok(Shard { index, count })
+    }
 }
 
 /// The settings of `settings` that draw one stream — the same renderer and drawing
@@ -1005,6 +1065,31 @@ pub fn write_table_row(out: &mut dyn Write, r: &Row, rw: usize) -> std::io::Resu
         )
 }
 
+/// The fixed columns of [`csv`], in order; the renderers' counters follow, one column
+/// `counter_NAME` each.
+pub const CSV_COLUMNS: [&str; 20] = [
+    "renderer",
+    "tessellate",
+    "root_tolerance",
+    "shading",
+    "aa",
+    "samples",
+    "visibility",
+    "shadows",
+    "numeric",
+    "register_bits",
+    "instructions",
+    "busy_cycles",
+    "worst_line_share",
+    "late_lines",
+    "host_ms",
+    "max_error",
+    "rms_error",
+    "psnr_db",
+    "overflows",
+    "pareto",
+];
+
 /// The table as CSV (one header line, one line per setting). After the fixed columns
 /// come the renderers' own counters, one column `counter_NAME` per name (the union over
 /// the rows, in the order first met), empty where a row's renderer does not count it.
@@ -1017,9 +1102,7 @@ pub fn csv(rows: &[Row]) -> String {
             }
         }
     }
-    let mut s = String::from(
-        "renderer,tessellate,root_tolerance,shading,aa,samples,visibility,shadows,numeric,register_bits,instructions,busy_cycles,worst_line_share,late_lines,host_ms,max_error,rms_error,psnr_db,overflows,pareto",
-    );
+    let mut s = CSV_COLUMNS.join(",");
     for name in &names {
         s.push_str(",counter_");
         s.push_str(name);
@@ -1061,9 +1144,287 @@ pub fn csv(rows: &[Row]) -> String {
     s
 }
 
+/// One CSV record's fields ([`csv`]'s: a field in double quotes may hold commas).
+fn csv_fields(line: &str) -> Result<Vec<String>, String> {
+    let mut out = Vec::new();
+    let mut field = String::new();
+    let mut quoted = false;
+    let mut chars = line.chars().peekable();
+    while let Some(c) = chars.next() {
+        match (c, quoted) {
+            ('"', true) if chars.peek() == Some(&'"') => {
+                field.push('"');
+                chars.next();
+            }
+            ('"', _) => quoted = !quoted,
+            (',', false) => out.push(std::mem::take(&mut field)),
+            (c, _) => field.push(c),
+        }
+    }
+    if quoted {
+        return Err("a quoted field is not closed".into());
+    }
+    out.push(field);
+    Ok(out)
+}
+
+/// A row of [`csv`] read back, without its counters (for the table and the plot).
+fn row_of_fields(f: &[String]) -> Result<Row, String> {
+    let col = |k: usize| -> &str { &f[k] };
+    let what = |k: usize, expected: &str| {
+        format!(
+            "column `{}`: expected {expected}, found `{}`",
+            CSV_COLUMNS[k],
+            col(k)
+        )
+    };
+    let int = |k: usize| col(k).parse::<u64>().map_err(|_| what(k, "a whole number"));
+    let real = |k: usize| col(k).parse::<f64>().map_err(|_| what(k, "a number"));
+    let optional = |k: usize| -> Result<Option<u64>, String> {
+        if col(k).is_empty() {
+            Ok(None)
+        } else {
+            int(k).map(Some)
+        }
+    };
+    let small = |v: u64, k: usize| u32::try_from(v).map_err(|_| what(k, "a smaller number"));
+    let dash_or = |k: usize, known: &[&'static str]| -> Result<&'static str, String> {
+        known
+            .iter()
+            .chain(&["-"])
+            .find(|n| n.eq_ignore_ascii_case(col(k)))
+            .copied()
+            .ok_or_else(|| what(k, &known.join(" or ")))
+    };
+    let shadings: Vec<&'static str> = Shading::ALL.iter().map(|s| s.name()).collect();
+    let filters: Vec<&'static str> = Antialias::ALL.iter().map(|a| a.name()).collect();
+    let visibilities: Vec<&'static str> = Visibility::ALL.iter().map(|v| v.name()).collect();
+    Ok(Row {
+        renderer: registry::find(col(0))
+            .map_err(|e| format!("column `renderer`: {e}"))?
+            .name,
+        tessellate: optional(1)?.map(|v| small(v, 1)).transpose()?,
+        root_tolerance: if col(2).is_empty() {
+            None
+        } else {
+            Some(real(2)?)
+        },
+        shading: dash_or(3, &shadings)?,
+        aa: dash_or(4, &filters)?,
+        samples: optional(5)?.map(|v| small(v, 5)).transpose()?,
+        visibility: dash_or(6, &visibilities)?,
+        shadows: dash_or(7, &["on", "off"])?,
+        numeric: col(8).to_string(),
+        register_bits: small(int(9)?, 9)?,
+        instructions: int(10)?,
+        busy_cycles: int(11)?,
+        worst_line_share: real(12)?,
+        late_lines: int(13)?,
+        host_ms: real(14)?,
+        max_error: real(15)?,
+        rms_error: real(16)?,
+        psnr_db: real(17)?,
+        overflows: int(18)?,
+        counters: cwisim_render::Counters::default(),
+        pareto: match col(19) {
+            "true" => true,
+            "false" => false,
+            _ => return Err(what(19, "true or false")),
+        },
+    })
+}
+
+/// A row of a part's CSV: its fixed fields, and its counters by name.
+type CsvRecord = (Vec<String>, Vec<(String, String)>);
+
+/// Shards' CSVs (`--shard`, each `(its name, its text)`, in shard order) merged into the
+/// whole sweep's: the rows concatenated in order, the counters' columns united (in the
+/// order first seen), and the Pareto column marked again over every row — the CSV a
+/// sweep in one go writes, but for the host times. Also the rows, without their counters,
+/// for the table and the plot. A file that is not such a CSV is refused, located
+/// (`name:line`, the column).
+pub fn merge_csv(parts: &[(String, String)]) -> Result<(String, Vec<Row>), StudyError> {
+    let mut counters: Vec<String> = Vec::new();
+    let mut records: Vec<CsvRecord> = Vec::new();
+    let mut rows = Vec::new();
+    for (name, text) in parts {
+        let mut lines = text.lines().enumerate();
+        let header = match lines.next() {
+            Some((_, h)) => {
+                csv_fields(h).map_err(|e| StudyError::Usage(format!("{name}:1: {e}")))?
+            }
+            None => {
+                return Err(StudyError::Usage(format!(
+                    "{name}: empty, not a tradeoff CSV"
+                )))
+            }
+        };
+        if header.len() < CSV_COLUMNS.len() || header[..CSV_COLUMNS.len()] != CSV_COLUMNS {
+            return Err(StudyError::Usage(format!(
+                "{name}:1: not a tradeoff CSV (its columns start {}; expected {})",
+                header.iter().take(3).cloned().collect::<Vec<_>>().join(","),
+                CSV_COLUMNS[..3].join(",")
+            )));
+        }
+        let own: Vec<String> = header[CSV_COLUMNS.len()..]
+            .iter()
+            .map(|c| c.strip_prefix("counter_").unwrap_or(c).to_string())
+            .collect();
+        for c in &own {
+            if !counters.contains(c) {
+                counters.push(c.clone());
+            }
+        }
+        for (k, line) in lines {
+            let at = |e: String| StudyError::Usage(format!("{name}:{}: {e}", k + 1));
+            let fields = csv_fields(line).map_err(at)?;
+            if fields.len() != header.len() {
+                return Err(at(format!(
+                    "{} fields, the header has {}",
+                    fields.len(),
+                    header.len()
+                )));
+            }
+            rows.push(row_of_fields(&fields).map_err(at)?);
+            let (fixed, theirs) = fields.split_at(CSV_COLUMNS.len());
+            records.push((
+                fixed.to_vec(),
+                own.iter().cloned().zip(theirs.iter().cloned()).collect(),
+            ));
+        }
+    }
+    mark_pareto(&mut rows);
+    let mut out = CSV_COLUMNS.join(",");
+    for c in &counters {
+        out.push_str(",counter_");
+        out.push_str(c);
+    }
+    out.push('\n');
+    for ((fixed, theirs), row) in records.iter().zip(&rows) {
+        for (k, v) in fixed.iter().enumerate() {
+            if k > 0 {
+                out.push(',');
+            }
+            match CSV_COLUMNS[k] {
+                "pareto" => out.push_str(if row.pareto { "true" } else { "false" }),
+                "numeric" => {
+                    out.push('"');
+                    out.push_str(v);
+                    out.push('"');
+                }
+                _ => out.push_str(v),
+            }
+        }
+        for c in &counters {
+            out.push(',');
+            if let Some((_, v)) = theirs.iter().find(|(n, _)| n == c) {
+                out.push_str(v);
+            }
+        }
+        out.push('\n');
+    }
+    Ok((out, rows))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `text` with the host times blanked (they are the machine's, not the sweep's).
+    fn without_host_times(text: &str) -> String {
+        let at = CSV_COLUMNS.iter().position(|c| *c == "host_ms").unwrap();
+        text.lines()
+            .map(|l| {
+                let mut f = csv_fields(l).unwrap();
+                f[at].clear();
+                f.iter()
+                    .map(|v| {
+                        if v.contains(',') {
+                            format!("\"{v}\"")
+                        } else {
+                            v.clone()
+                        }
+                    })
+                    .collect::<Vec<_>>()
+                    .join(",")
+            })
+            .collect::<Vec<_>>()
+            .join("\n")
+    }
+
+    #[test]
+    fn shards_merged_are_the_whole_sweep() {
+        let formats: Vec<Numeric> = ["f64", "fixed:I=10.14,dI=4.20,ddI=1.27"]
+            .iter()
+            .map(|f| f.parse().unwrap())
+            .collect();
+        let renderers = ["vanrij".to_string(), "woo-chall".to_string()];
+        let size = Some(Size {
+            width: 40,
+            height: 30,
+        });
+        let plan = Plan::new(
+            Some(Path::new("still-life")),
+            size,
+            &[],
+            &[],
+            &renderers,
+            &formats,
+        )
+        .unwrap();
+        let machine = Machine::default();
+        let whole = tradeoff_rows(
+            Some(Path::new("still-life")),
+            size,
+            &[],
+            &[],
+            &renderers,
+            &formats,
+            &machine,
+            1,
+            1,
+            &mut |_| {},
+        )
+        .unwrap();
+        for count in [2, 5] {
+            let mut parts = Vec::new();
+            let mut covered = 0;
+            for index in 0..count {
+                let shard = Shard { index, count };
+                let groups = shard.groups(plan.groups.len());
+                assert_eq!(groups.start, covered);
+                covered = groups.end;
+                let rows = measure_groups(&plan, groups, &machine, 1, 2, &mut |_| {}).unwrap();
+                assert!(rows.iter().all(|r| !r.pareto));
+                parts.push((format!("part-{index}.csv"), csv(&rows)));
+            }
+            assert_eq!(covered, plan.groups.len());
+            let (merged, rows) = merge_csv(&parts).unwrap();
+            assert_eq!(rows.len(), whole.len());
+            assert_eq!(
+                without_host_times(&merged),
+                without_host_times(&csv(&whole)),
+                "{count} shards"
+            );
+        }
+        assert_eq!("1/3".parse::<Shard>(), Ok(Shard { index: 1, count: 3 }));
+        for bad in ["3/3", "1", "a/2", "1/0"] {
+            assert!(bad.parse::<Shard>().is_err(), "{bad}");
+        }
+        let e = merge_csv(&[("x.csv".into(), "a,b\n1,2\n".into())]).unwrap_err();
+        assert!(
+            e.to_string().starts_with("x.csv:1: not a tradeoff CSV"),
+            "{e}"
+        );
+        let mut broken = csv(&whole);
+        broken = broken.replacen("vanrij", "vanrij-typo", 1);
+        let e = merge_csv(&[("y.csv".into(), broken)]).unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("y.csv:2: column `renderer`: unknown renderer"),
+            "{e}"
+        );
+    }
 
     fn row(busy: u64, rms: f64) -> Row {
         Row {

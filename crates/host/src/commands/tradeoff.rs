@@ -13,8 +13,8 @@ use crate::progress::Progress;
 use clap::Args;
 use cwisim_render::{Size, Source};
 use cwisim_study::tradeoff::{
-    csv, name_width, tradeoff_rows, write_table_header, write_table_row, Step, DEFAULT_FORMATS,
-    DEFAULT_TESSELLATIONS,
+    csv, mark_pareto, measure_groups, merge_csv, name_width, write_table_header, write_table_row,
+    Plan, Shard, Step, DEFAULT_FORMATS, DEFAULT_TESSELLATIONS,
 };
 use cwisim_study::tradeoff_plot::render_tradeoff_plot;
 use cwisim_xproc::Numeric;
@@ -62,6 +62,21 @@ pub struct TradeoffArgs {
     /// N but for the host times.
     #[arg(long, default_value_t = 0, value_name = "N")]
     pub threads: usize,
+    /// Measure only part I of N of the grid (from 0: `--shard 0/4` … `--shard 3/4`), for a
+    /// batch system's array of jobs, each writing its rows with --csv; `--merge` then
+    /// joins the parts. A part's rows are not marked Pareto-optimal: that needs them all.
+    #[arg(long, value_name = "I/N", requires = "csv")]
+    pub shard: Option<Shard>,
+    /// Join the CSVs of a sweep's parts (`--shard`), given in part order, into the whole
+    /// sweep's: the rows in the grid's order, the Pareto front marked over them all,
+    /// printed and written with --csv and --plot. Nothing is measured.
+    #[arg(
+        long,
+        value_name = "PART.csv",
+        num_args = 1..,
+        conflicts_with_all = ["scene", "size", "tessellate", "shadows", "renderers", "numeric", "repeat", "threads", "shard"]
+    )]
+    pub merge: Vec<PathBuf>,
     /// The machine model.
     #[command(flatten)]
     pub machine: MachineArgs,
@@ -81,6 +96,9 @@ pub fn run(args: &TradeoffArgs, stdout: &mut dyn Write, progress: bool) -> Resul
     }
     if let Some(p) = &args.csv {
         crate::cost_args::check_extension("--csv", p, "csv")?;
+    }
+    if !args.merge.is_empty() {
+        return merge(args, stdout);
     }
     cwisim_scene::budget::check_threads(args.threads).map_err(CliError::Usage)?;
     let shadows: Vec<bool> = args.shadows.iter().map(|&s| s == ShadowsArg::On).collect();
@@ -103,13 +121,21 @@ pub fn run(args: &TradeoffArgs, stdout: &mut dyn Write, progress: bool) -> Resul
     let width = name_width(cwisim_render::registry::REGISTRY.iter().map(|e| e.name));
     let mut bar: Option<Progress> = None;
     let mut failed: Option<std::io::Error> = None;
-    let rows = tradeoff_rows(
+    let plan = Plan::new(
         args.scene.as_deref(),
         args.size,
         &args.tessellate,
         &shadows,
         &args.renderers,
         &formats,
+    )?;
+    let groups = match args.shard {
+        Some(shard) => shard.groups(plan.groups.len()),
+        None => 0..plan.groups.len(),
+    };
+    let mut rows = measure_groups(
+        &plan,
+        groups,
         &machine,
         args.repeat,
         args.threads,
@@ -154,6 +180,87 @@ pub fn run(args: &TradeoffArgs, stdout: &mut dyn Write, progress: bool) -> Resul
     if let Some(e) = failed {
         return Err(CliError::Stdout(e));
     }
+    let name = Source::resolve(args.scene.as_deref())?.name();
+    match args.shard {
+        None => mark_pareto(&mut rows),
+        Some(shard) => writeln!(
+            stdout,
+            "\npart {} of {} ({} of the grid's {} settings); the Pareto front is marked when the parts are joined: cwisim tradeoff --merge",
+            shard.index,
+            shard.count,
+            rows.len(),
+            plan.settings.len()
+        )
+        .map_err(CliError::Stdout)?,
+    }
+    finish(args, stdout, &rows, csv(&rows), &name, args.shard.is_none())
+}
+
+/// Runs `cwisim tradeoff --merge`.
+fn merge(args: &TradeoffArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
+    let mut parts = Vec::with_capacity(args.merge.len());
+    for path in &args.merge {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| CliError::Usage(format!("{}: cannot be read: {e}", path.display())))?;
+        parts.push((path.display().to_string(), text));
+    }
+    let (text, rows) = merge_csv(&parts)?;
+    let width = name_width(cwisim_render::registry::REGISTRY.iter().map(|e| e.name));
+    write_table_header(stdout, width).map_err(CliError::Stdout)?;
+    for row in &rows {
+        write_table_row(stdout, row, width).map_err(CliError::Stdout)?;
+    }
+    writeln!(
+        stdout,
+        "\n{} parts joined: {} settings",
+        parts.len(),
+        rows.len()
+    )
+    .map_err(CliError::Stdout)?;
+    let name = args.merge[0]
+        .file_stem()
+        .map_or_else(|| "merged".into(), |s| s.to_string_lossy().into_owned());
+    finish(args, stdout, &rows, text, &name, true)
+}
+
+/// The Pareto front printed (`front`), and the CSV (`text`) and the plot written.
+fn finish(
+    args: &TradeoffArgs,
+    stdout: &mut dyn Write,
+    rows: &[cwisim_study::tradeoff::Row],
+    text: String,
+    name: &str,
+    front: bool,
+) -> Result<(), CliError> {
+    let width = name_width(cwisim_render::registry::REGISTRY.iter().map(|e| e.name));
+    if front {
+        print_front(stdout, rows, width)?;
+    }
+    let mut written = Vec::new();
+    if let Some(path) = &args.csv {
+        write_atomic(path, |w| {
+            w.write_all(text.as_bytes())
+                .map_err(|e| CliError::write(path, e))
+        })?;
+        written.push(path.display().to_string());
+    }
+    if let Some(path) = &args.plot {
+        let img = render_tradeoff_plot(rows, name).map_err(CliError::Usage)?;
+        write_rgb_png(path, &img)?;
+        written.push(path.display().to_string());
+    }
+    if !written.is_empty() {
+        writeln!(stdout, "wrote {}", written.join(", ")).map_err(CliError::Stdout)?;
+    }
+    stdout.flush().map_err(CliError::Stdout)
+}
+
+/// The Pareto front of `rows`, as a table.
+fn print_front(
+    stdout: &mut dyn Write,
+    rows: &[cwisim_study::tradeoff::Row],
+    width: usize,
+) -> Result<(), CliError> {
     let front: Vec<_> = rows.iter().filter(|r| r.pareto).collect();
     writeln!(
         stdout,
@@ -167,23 +274,5 @@ all at once): {} of {} settings",
     for row in front {
         write_table_row(stdout, row, width).map_err(CliError::Stdout)?;
     }
-    let mut written = Vec::new();
-    if let Some(path) = &args.csv {
-        let text = csv(&rows);
-        write_atomic(path, |w| {
-            w.write_all(text.as_bytes())
-                .map_err(|e| CliError::write(path, e))
-        })?;
-        written.push(path.display().to_string());
-    }
-    if let Some(path) = &args.plot {
-        let name = Source::resolve(args.scene.as_deref())?.name();
-        let img = render_tradeoff_plot(&rows, &name).map_err(CliError::Usage)?;
-        write_rgb_png(path, &img)?;
-        written.push(path.display().to_string());
-    }
-    if !written.is_empty() {
-        writeln!(stdout, "wrote {}", written.join(", ")).map_err(CliError::Stdout)?;
-    }
-    stdout.flush().map_err(CliError::Stdout)
+    Ok(())
 }
