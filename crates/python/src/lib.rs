@@ -28,6 +28,7 @@ use cwisim_study::fit::{fit_scene, q, REGISTERS};
 use cwisim_study::history::pixel_history_with_progress;
 use cwisim_study::refine::{run_refine, PhaseRow, RefineSetup};
 use cwisim_study::tradeoff;
+use cwisim_study::vcd::record_scanline_with_progress;
 use cwisim_xproc::numeric::Overflow;
 use cwisim_xproc::{
     Image, ImageSink, LineStats, Machine, Numeric, ProcessorState, ReplayError, Timing,
@@ -312,6 +313,16 @@ fn read_trace<'py>(py: Python<'py>, path: &str) -> PyResult<Bound<'py, PyDict>> 
         })
         .map_err(|e| SceneError::new_err(e.to_string()))?;
     stream_dict(py, &header, &stream)
+}
+
+/// The header of the trace file `path`: `(width, lines, channels)`, read without the
+/// instructions.
+#[pyfunction]
+fn trace_header(path: &str) -> PyResult<(u32, u32, u8)> {
+    let reader =
+        FileReader::open(Path::new(path)).map_err(|e| SceneError::new_err(e.to_string()))?;
+    let h = reader.header();
+    Ok((h.width, h.lines, h.channels))
 }
 
 /// Columns ([`stream_dict`]'s) encoded as a trace of `encoding` (`cwt`, `jsonl`, `cwb`),
@@ -840,6 +851,13 @@ fn refine<'py>(
     Ok(out)
 }
 
+/// Scanline `line` asked of a trace that outputs only `lines`.
+fn beyond_trace(line: u64, lines: u64) -> PyErr {
+    UsageError::new_err(format!(
+        "line {line}: the trace outputs {lines} scanline(s), 0..{lines}"
+    ))
+}
+
 /// A processor's state, for Python.
 fn state_dict<'py>(py: Python<'py>, s: &ProcessorState) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
@@ -891,11 +909,7 @@ fn history<'py>(
             )
         })
         .map_err(study_to_py)?
-        .map_err(|lines| {
-            UsageError::new_err(format!(
-                "line {line}: the trace outputs {lines} scanline(s), 0..{lines}"
-            ))
-        })?;
+        .map_err(|lines| beyond_trace(line, lines))?;
     let out = PyList::empty(py);
     for v in &found.visits {
         let d = PyDict::new(py);
@@ -913,6 +927,62 @@ fn history<'py>(
         )?;
         out.append(d)?;
     }
+    Ok(out)
+}
+
+/// `cwisim vcd`: the per-cycle waveform of scanline `line` of the trace file `path`, for
+/// processors `first..=last` (on the cycle-stepped engine, registers in `numeric`). A
+/// dict: `start` and `end` (the window's cycles), `signals` (`scope.name` → (cycles,
+/// values): the value at `start` and at each cycle it changes; bits 0 or 1, words
+/// their value or NaN when nothing drives them, reals themselves).
+#[pyfunction]
+#[pyo3(signature = (path, line, first, last, numeric="f64", machine=None))]
+fn waveform<'py>(
+    py: Python<'py>,
+    path: &str,
+    line: u64,
+    first: usize,
+    last: usize,
+    numeric: &str,
+    machine: Option<&str>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let array = array_config(numeric, "stepped", machine)?;
+    let wave = py
+        .detach(|| {
+            let mut reader = FileReader::open(Path::new(path))?;
+            let width = reader.header().width as usize;
+            if first > last || last >= width {
+                return Err(StudyError::Usage(format!(
+                    "processors {first}..={last}: the trace has processors 0..{width}"
+                )));
+            }
+            record_scanline_with_progress(
+                &mut reader,
+                &array.machine,
+                &array.numeric,
+                line,
+                first,
+                last,
+                &mut |_| {},
+            )
+        })
+        .map_err(study_to_py)?
+        .map_err(|lines| beyond_trace(line, lines))?;
+    let out = PyDict::new(py);
+    let (start, end) = wave.window();
+    out.set_item("start", start)?;
+    out.set_item("end", end)?;
+    let signals = PyDict::new(py);
+    for (name, cycles, values) in wave.signals() {
+        signals.set_item(
+            name,
+            (
+                PyArray1::from_vec(py, cycles),
+                PyArray1::from_vec(py, values),
+            ),
+        )?;
+    }
+    out.set_item("signals", signals)?;
     Ok(out)
 }
 
@@ -936,6 +1006,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fit, m)?)?;
     m.add_function(wrap_pyfunction!(refine, m)?)?;
     m.add_function(wrap_pyfunction!(history, m)?)?;
+    m.add_function(wrap_pyfunction!(waveform, m)?)?;
+    m.add_function(wrap_pyfunction!(trace_header, m)?)?;
     m.add_function(wrap_pyfunction!(default_formats, m)?)?;
     m.add_function(wrap_pyfunction!(default_tessellations, m)?)?;
     m.add_function(wrap_pyfunction!(pareto, m)?)?;

@@ -116,3 +116,55 @@ def test_a_pixel_s_history_is_the_command_line_s(tmp_path):
         cwisim.history(trace, 9, 99)
     with pytest.raises(cwisim.UsageError, match="x 99: the trace has processors"):
         cwisim.history(trace, 99, 0)
+
+
+def parse_vcd(text: str):
+    """A Value Change Dump's signals as `scope.name` → [(time, value)] (what cwisim vcd
+    writes: real, wire and bit values; `z` as NaN)."""
+    ids, scopes, out, now = {}, [], {}, None
+    body = False
+    for tok in text.split("\n"):
+        tok = tok.strip()
+        if tok.startswith("$scope module"):
+            scopes.append(tok.split()[2])
+        elif tok.startswith("$upscope"):
+            scopes.pop()
+        elif tok.startswith("$var"):
+            _, _, _, code, name, _ = tok.split()
+            ids[code] = f"{scopes[-1]}.{name}"
+            out[ids[code]] = []
+        elif tok.startswith("$enddefinitions"):
+            body = True
+        elif body and tok.startswith("#"):
+            now = int(tok[1:])
+        elif body and tok and not tok.startswith("$"):
+            if tok[0] in "rb":
+                value, code = tok[1:].split()
+                v = float("nan") if value == "z" else (float(value) if tok[0] == "r" else int(value, 2))
+            else:
+                value, code = tok[0], tok[1:]
+                v = float("nan") if value == "z" else int(value)
+            out[ids[code]].append((now, v))
+    return out
+
+
+def test_a_waveform_is_the_command_line_s_vcd(tmp_path):
+    trace = ROOT / "traces" / "gouraud.cwt"
+    out = cli("vcd", str(trace), "--line", "1", "--x", "2..=8", "-o", "l.vcd", cwd=tmp_path)
+    assert out.returncode == 0, out.stderr
+    dumped = parse_vcd((tmp_path / "l.vcd").read_text())
+    wave = cwisim.waveform(trace, 1, (2, 8))
+    assert set(wave.signals) == set(dumped)
+    for name, changes in dumped.items():
+        cycles, values = wave.signals[name]
+        assert cycles.tolist() == [t for t, _ in changes], name
+        assert np.array_equal(values, np.array([v for _, v in changes], dtype=float), equal_nan=True), name
+    assert wave.start == dumped["bus.opcode"][0][0]
+    every, acc = wave.sampled("p5.acc")
+    assert len(every) == wave.end - wave.start + 1 and acc[-1] == wave.signals["p5.acc"][1][-1]
+    # the whole array by default (16 processors), one processor, a range
+    assert "p15.acc" in cwisim.waveform(trace, 1).signals
+    assert {n.split(".")[0] for n in cwisim.waveform(trace, 1, 4).signals} == {"bus", "p4"}
+    assert "p7.out" in cwisim.waveform(trace, 1, range(6, 8)).signals
+    with pytest.raises(cwisim.UsageError, match="processors 2..=99"):
+        cwisim.waveform(trace, 1, (2, 99))

@@ -417,6 +417,98 @@ pub struct Wave {
     log: Vec<(u64, usize, Val)>,
 }
 
+/// A cycle of a [`Wave`] and the signals that change in it, with their new values.
+type Step = (u64, Vec<(usize, Val)>);
+
+impl Wave {
+    /// Every signal's value at the window's first cycle (the state then, with that
+    /// cycle's changes), then, cycle by cycle, the signals whose value at the end of the
+    /// cycle differs from before, with their new values: what the dump writes.
+    fn steps(&self) -> (Vec<Val>, Vec<Step>) {
+        let mut vals = self.initial.clone();
+        let mut log = self.log.iter().peekable();
+        while let Some(&&(t, sig, val)) = log.peek() {
+            if t != self.start {
+                break;
+            }
+            vals[sig] = val;
+            log.next();
+        }
+        let start = vals.clone();
+        let rest: Vec<_> = log.copied().collect();
+        let mut steps = Vec::new();
+        let mut i = 0;
+        let mut next = vals.clone();
+        let mut touched = Vec::new();
+        while i < rest.len() {
+            let t = rest[i].0;
+            touched.clear();
+            while i < rest.len() && rest[i].0 == t {
+                let (_, sig, val) = rest[i];
+                next[sig] = val;
+                touched.push(sig);
+                i += 1;
+            }
+            touched.sort_unstable();
+            touched.dedup();
+            let changed: Vec<(usize, Val)> = touched
+                .iter()
+                .copied()
+                .filter(|&s| !next[s].same(vals[s]))
+                .map(|s| (s, next[s]))
+                .collect();
+            if changed.is_empty() {
+                continue;
+            }
+            for &(s, v) in &changed {
+                vals[s] = v;
+            }
+            steps.push((t, changed));
+        }
+        (start, steps)
+    }
+
+    /// The window: the cycle the bus starts issuing the scanline, and the cycle it
+    /// leaves the array.
+    pub fn window(&self) -> (u64, u64) {
+        (self.start, self.end)
+    }
+
+    /// Every signal as `scope.name` (`bus.opcode`, `p3.acc`, `p3.I_c1`) with its values
+    /// as numbers — a bit 0 or 1, a word its value (NaN when nothing drives it), a real
+    /// itself — at the window's first cycle and at each cycle it changes after: the
+    /// dump's contents, for callers that want arrays (the Python package).
+    pub fn signals(&self) -> Vec<(String, Vec<u64>, Vec<f64>)> {
+        let number = |v: Val| match v {
+            Val::Bit(b) => f64::from(u8::from(b)),
+            Val::Word(Some(w)) => w as f64,
+            Val::Word(None) => f64::NAN,
+            Val::Real(r) => r,
+        };
+        let (start, steps) = self.steps();
+        let mut out: Vec<(String, Vec<u64>, Vec<f64>)> = self
+            .layout
+            .defs
+            .iter()
+            .zip(&start)
+            .map(|(d, &v)| {
+                (
+                    format!("{}.{}", self.layout.scopes[d.scope], d.name),
+                    vec![self.start],
+                    vec![number(v)],
+                )
+            })
+            .collect();
+        for (t, changed) in steps {
+            for (s, v) in changed {
+                out[s].1.push(t);
+                out[s].2.push(number(v));
+            }
+        }
+        out
+    }
+}
+
 impl Recorder {
     fn new(
         header: &TraceHeader,
@@ -781,16 +873,7 @@ the array. Tokens stay {} cycle(s) in each processor.",
     w.upscope()?;
     w.enddefinitions()?;
 
-    // The values at the window's first cycle: the state then, with that cycle's changes.
-    let mut vals = wave.initial.clone();
-    let mut log = wave.log.iter().peekable();
-    while let Some(&&(t, sig, val)) = log.peek() {
-        if t != wave.start {
-            break;
-        }
-        vals[sig] = val;
-        log.next();
-    }
+    let (vals, steps) = wave.steps();
     let mut clock = Clock { last: None };
     clock.at(wave.start)?;
     w.timestamp(wave.start)?;
@@ -799,36 +882,11 @@ the array. Tokens stay {} cycle(s) in each processor.",
         change(&mut w, ids[i], def.kind, vals[i])?;
     }
     w.end()?;
-
-    // Then, cycle by cycle, each signal whose value at the end of the cycle differs.
-    let rest: Vec<_> = log.copied().collect();
-    let mut i = 0;
-    let mut next = vals.clone();
-    let mut touched = Vec::new();
-    while i < rest.len() {
-        let t = rest[i].0;
-        touched.clear();
-        while i < rest.len() && rest[i].0 == t {
-            let (_, sig, val) = rest[i];
-            next[sig] = val;
-            touched.push(sig);
-            i += 1;
-        }
-        touched.sort_unstable();
-        touched.dedup();
-        let changed: Vec<usize> = touched
-            .iter()
-            .copied()
-            .filter(|&s| !next[s].same(vals[s]))
-            .collect();
-        if changed.is_empty() {
-            continue;
-        }
+    for (t, changed) in steps {
         clock.at(t)?;
         w.timestamp(t)?;
-        for s in changed {
-            change(&mut w, ids[s], l.defs[s].kind, next[s])?;
-            vals[s] = next[s];
+        for (s, v) in changed {
+            change(&mut w, ids[s], l.defs[s].kind, v)?;
         }
     }
     // Mark the end of the window even when nothing changes then.

@@ -48,6 +48,8 @@ __all__ = [
     "fit",
     "refine",
     "history",
+    "Waveform",
+    "waveform",
 ]
 
 #: A scene: an embedded scene's name or a scene file's path (``None``: the default,
@@ -566,3 +568,57 @@ def history(
             machine=_path(machine),
         )
     )
+
+
+@dataclass
+class Waveform:
+    """A scanline's per-cycle waveform (``cwisim vcd``'s contents): from ``start``, the
+    cycle the bus starts issuing the scanline, to ``end``, the cycle it leaves the array.
+    ``signals``: ``"scope.name"`` (``"bus.opcode"``, ``"p5.acc"``, ``"p5.I_c1"`` for a
+    channel of several) → ``(cycles, values)``, the value at ``start`` and at each cycle
+    it changes (bits 0 or 1, words their value or NaN when nothing drives them)."""
+
+    start: int
+    end: int
+    signals: Dict[str, Tuple[np.ndarray, np.ndarray]]
+
+    def sampled(self, name: str) -> Tuple[np.ndarray, np.ndarray]:
+        """Signal ``name`` at every cycle from ``start`` to ``end``: ``(cycles, values)``,
+        for plotting as a step function."""
+        cycles, values = self.signals[name]
+        every = np.arange(self.start, self.end + 1, dtype=np.uint64)
+        return every, values[np.searchsorted(cycles, every, side="right") - 1]
+
+
+def waveform(
+    trace: Union[str, "os.PathLike[str]", Stream],
+    line: int,
+    x: Union[int, Tuple[int, int], range, None] = None,
+    *,
+    numeric: str = "f64",
+    machine: Optional[Union[str, "os.PathLike[str]"]] = None,
+) -> Waveform:
+    """``cwisim vcd``: scanline ``line`` of a trace (a file or a :class:`Stream`) cycle by
+    cycle on the stepped engine — the bus and the processors ``x``: one (``5``), a pair
+    ``(first, last)`` (both included), a ``range``, or ``None``: the whole array (at most
+    512 processors, as the command line allows)."""
+    if isinstance(trace, Stream):
+        with _written(trace) as path:
+            return waveform(path, line, x, numeric=numeric, machine=machine)
+    if x is None:
+        width = _native.trace_header(os.fspath(trace))[0]
+        if width > 512:
+            raise UsageError(f"the array is {width} processors wide: choose a window of at most 512 (x=…)")
+        first, last = 0, width - 1
+    elif isinstance(x, range):
+        if x.step != 1 or len(x) == 0:
+            raise UsageError("x: a range of consecutive processors, not empty")
+        first, last = x.start, x.stop - 1
+    elif isinstance(x, tuple):
+        first, last = x
+    else:
+        first = last = int(x)
+    out = _native.waveform(
+        os.fspath(trace), line, first, last, numeric=numeric, machine=_path(machine)
+    )
+    return Waveform(out["start"], out["end"], dict(out["signals"]))

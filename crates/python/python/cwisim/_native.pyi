@@ -88,3 +88,12 @@ def refine(
 def history(
     path: str, x: int, line: int, numeric: str = "f64", machine: Optional[str] = None
 ) -> List[Dict[str, Any]]: ...
+def trace_header(path: str) -> Tuple[int, int, int]: ...
+def waveform(
+    path: str,
+    line: int,
+    first: int,
+    last: int,
+    numeric: str = "f64",
+    machine: Optional[str] = None,
+) -> Dict[str, Any]: ...
