@@ -16,7 +16,10 @@
 //! render runs without the GIL, and stops after the scanline during which Ctrl-C came
 //! (`KeyboardInterrupt`).
 
-use cwisim_isa::{Encoding, FileReader, Instruction, Opcode, TraceError, TraceHeader, TraceRead};
+use cwisim_isa::note::NoteTaker;
+use cwisim_isa::{
+    Encoding, FileReader, Instruction, NoteTable, Opcode, TraceError, TraceHeader, TraceRead,
+};
 use cwisim_render::draw::{draw, SceneInput};
 use cwisim_render::refine::parse_phases;
 use cwisim_render::settings::Setting;
@@ -231,11 +234,14 @@ fn array_config(numeric: &str, timing: &str, machine: Option<&str>) -> PyResult<
 
 /// A stream as columns: `width`, `lines`, `channels` (the header), `code` (each
 /// instruction's opcode, its binary code), `x`, `dx`, and `values` (instructions × 3 ×
-/// channels: `I`, `dI`, `ddI`, NaN in a slot the opcode does not carry).
+/// channels: `I`, `dI`, `ddI`, NaN in a slot the opcode does not carry), and its notes
+/// (the provenance a renderer or a `.cwt` gives): `notes` each text once, `note` each
+/// instruction's place in it (-1: none).
 fn stream_dict<'py>(
     py: Python<'py>,
     header: &TraceHeader,
     stream: &[Instruction],
+    notes: &NoteTable,
 ) -> PyResult<Bound<'py, PyDict>> {
     let ch = usize::from(header.channels);
     let out = PyDict::new(py);
@@ -254,6 +260,25 @@ fn stream_dict<'py>(
             }
         }
     }
+    // each note once, in the order first met; each instruction its note's place (-1: none)
+    let mut texts: Vec<String> = Vec::new();
+    let mut note = vec![-1i32; stream.len()];
+    for (range, n) in notes.runs() {
+        let at = match texts.iter().position(|t| t == n.text) {
+            Some(k) => k,
+            None => {
+                texts.push(n.text.to_string());
+                texts.len() - 1
+            }
+        };
+        for k in range {
+            if let Some(slot) = usize::try_from(k).ok().and_then(|k| note.get_mut(k)) {
+                *slot = i32::try_from(at).unwrap_or(i32::MAX);
+            }
+        }
+    }
+    out.set_item("note", PyArray1::from_vec(py, note))?;
+    out.set_item("notes", texts)?;
     out.set_item("code", PyArray1::from_vec(py, code))?;
     out.set_item("x", PyArray1::from_vec(py, x))?;
     out.set_item("dx", PyArray1::from_vec(py, dx))?;
@@ -290,29 +315,37 @@ fn emit_stream<'py>(
         (_, Some(text)) => SceneInput::Text { name, text },
         (path, None) => SceneInput::Named(path.map(Path::new)),
     };
-    let (header, stream) = py
+    let (header, stream, notes) = py
         .detach(|| {
             let drawn = draw(renderer, input, &given, &settings)?;
-            let mut stream: Vec<Instruction> = Vec::new();
-            cwisim_render::emit(&*drawn.renderer, &mut stream)?;
-            Ok::<_, RenderError>((drawn.renderer.header(), stream))
+            let mut taker = NoteTaker::new(Vec::<Instruction>::new());
+            cwisim_render::emit(&*drawn.renderer, &mut taker)?;
+            let (stream, notes) = taker.into_parts();
+            Ok::<_, RenderError>((drawn.renderer.header(), stream, notes))
         })
         .map_err(to_py)?;
-    stream_dict(py, &header, &stream)
+    stream_dict(py, &header, &stream, &notes)
 }
 
 /// The trace file `path` (`.cwt`, `.jsonl` or `.cwb`), read and checked, as columns
 /// ([`stream_dict`]); a trace that cannot be read raises `SceneError` with its location.
 #[pyfunction]
 fn read_trace<'py>(py: Python<'py>, path: &str) -> PyResult<Bound<'py, PyDict>> {
-    let (header, stream) = py
+    let (header, stream, notes) = py
         .detach(|| {
             let mut reader = FileReader::open(Path::new(path))?;
-            let stream = cwisim_isa::io::read_all(&mut reader)?;
-            Ok::<_, TraceError>((*reader.header(), stream))
+            let mut stream = Vec::new();
+            let mut notes = NoteTable::new();
+            while let Some(i) = reader.next_instruction()? {
+                if let Some(n) = reader.note() {
+                    notes.record(stream.len() as u64, n);
+                }
+                stream.push(i);
+            }
+            Ok::<_, TraceError>((*reader.header(), stream, notes))
         })
         .map_err(|e| SceneError::new_err(e.to_string()))?;
-    stream_dict(py, &header, &stream)
+    stream_dict(py, &header, &stream, &notes)
 }
 
 /// The header of the trace file `path`: `(width, lines, channels)`, read without the
@@ -339,6 +372,8 @@ fn encode_trace<'py>(
     x: PyReadonlyArray1<'py, u32>,
     dx: PyReadonlyArray1<'py, u32>,
     values: PyReadonlyArray3<'py, f64>,
+    note: PyReadonlyArray1<'py, i32>,
+    notes: Vec<String>,
     encoding: &str,
 ) -> PyResult<Bound<'py, PyBytes>> {
     let header = TraceHeader::new(width, lines, channels)
@@ -352,15 +387,16 @@ fn encode_trace<'py>(
                 "unknown trace encoding `{encoding}`; expected cwt, jsonl or cwb"
             ))
         })?;
-    let (code, x, dx, values) = (
+    let (code, x, dx, values, note) = (
         code.as_slice()?,
         x.as_slice()?,
         dx.as_slice()?,
         values.as_slice()?,
+        note.as_slice()?,
     );
     let ch = usize::from(channels);
     let n = code.len();
-    if x.len() != n || dx.len() != n || values.len() != n * 3 * ch {
+    if x.len() != n || dx.len() != n || note.len() != n || values.len() != n * 3 * ch {
         return Err(UsageError::new_err(format!(
             "the columns disagree: {n} opcodes, {} x, {} dx, {} values (expected {} = {n} × 3 × {ch})",
             x.len(),
@@ -389,9 +425,16 @@ fn encode_trace<'py>(
         let mut w = encoding
             .writer(&mut bytes, &header)
             .map_err(|e| CwisimError::new_err(e.to_string()))?;
-        for i in &stream {
-            w.write(i)
-                .map_err(|e| CwisimError::new_err(e.to_string()))?;
+        let fault = |e: std::io::Error| CwisimError::new_err(e.to_string());
+        for (k, i) in stream.iter().enumerate() {
+            // a note is attached to the first instruction it covers: where it changes,
+            // or after a Refresh (notes never cover two scanlines)
+            let fresh = k == 0 || note[k] != note[k - 1] || stream[k - 1].op == Opcode::Refresh;
+            let text = usize::try_from(note[k]).ok().and_then(|n| notes.get(n));
+            if let (true, Some(text)) = (fresh, text) {
+                w.comment(text).map_err(fault)?;
+            }
+            w.write(i).map_err(fault)?;
         }
         w.finish()
             .map_err(|e| CwisimError::new_err(e.to_string()))?;

@@ -184,10 +184,11 @@ def _named(scene: SceneLike, what: str) -> Optional[str]:
 
 
 @contextlib.contextmanager
-def _written(stream: "Stream"):
-    """``stream`` as a temporary ``.cwb`` file, for the calls that read a trace file."""
+def _written(stream: "Stream", encoding: str = "cwb"):
+    """``stream`` as a temporary trace file, for the calls that read one (``.cwb``, or
+    ``.jsonl`` to keep the notes)."""
     with tempfile.TemporaryDirectory() as d:
-        path = Path(d) / "stream.cwb"
+        path = Path(d) / f"stream.{encoding}"
         stream.write(path)
         yield path
 
@@ -371,13 +372,21 @@ class Stream:
     """An instruction stream: the trace header (``width`` processors, ``lines`` per
     frame, ``channels``) and the instructions as a NumPy structured array with fields
     ``op`` (the opcode's name: ``"Eval2"``), ``x`` (first processor), ``dx`` (count or
-    period), and ``I``, ``dI``, ``ddI`` (one value per channel; NaN in a slot the opcode
-    does not carry)."""
+    period), ``I``, ``dI``, ``ddI`` (one value per channel; NaN in a slot the opcode
+    does not carry) and ``note``: the instruction's provenance, an index into ``notes``
+    (``-1``: none) — the renderer's note on where it came from (``row 3 trapezium 4
+    (polygon 2): case 8: …``), kept by ``.cwt`` and ``.jsonl``, not by ``.cwb``."""
 
     width: int
     lines: int
     channels: int
     instructions: np.ndarray
+    notes: List[str] = field(default_factory=list)
+
+    def note(self, k: int) -> Optional[str]:
+        """Instruction ``k``'s note, if it has one."""
+        n = int(self.instructions["note"][k])
+        return self.notes[n] if n >= 0 else None
 
     def write(self, path: Union[str, "os.PathLike[str]"]) -> None:
         """Writes the stream as a trace file, its encoding by the extension (``.cwt``
@@ -403,6 +412,8 @@ class Stream:
             np.ascontiguousarray(ins["x"], dtype=np.uint32),
             np.ascontiguousarray(ins["dx"], dtype=np.uint32),
             np.ascontiguousarray(values, dtype=np.float64),
+            np.ascontiguousarray(ins["note"], dtype=np.int32),
+            list(self.notes),
             path.suffix.lstrip("."),
         )
         _write_whole(path, data)
@@ -417,14 +428,23 @@ def _stream_of(out: Mapping[str, Any]) -> Stream:
     names = np.array([OPCODES.get(c, "?") for c in range(256)], dtype="U8")
     ins = np.empty(
         n,
-        dtype=[("op", "U8"), ("x", "u4"), ("dx", "u4"), ("I", "f8", (ch,)), ("dI", "f8", (ch,)), ("ddI", "f8", (ch,))],
+        dtype=[
+            ("op", "U8"),
+            ("x", "u4"),
+            ("dx", "u4"),
+            ("I", "f8", (ch,)),
+            ("dI", "f8", (ch,)),
+            ("ddI", "f8", (ch,)),
+            ("note", "i4"),
+        ],
     )
     ins["op"] = names[out["code"]]
     ins["x"] = out["x"]
     ins["dx"] = out["dx"]
     values = out["values"]
     ins["I"], ins["dI"], ins["ddI"] = values[:, 0, :], values[:, 1, :], values[:, 2, :]
-    return Stream(out["width"], out["lines"], ch, ins)
+    ins["note"] = out["note"]
+    return Stream(out["width"], out["lines"], ch, ins, list(out["notes"]))
 
 
 def _write_whole(path: Path, data: bytes) -> None:
@@ -557,7 +577,7 @@ def history(
     through"``, ``"suppressed: …"`` or ``None``) and ``provenance`` (the trace's note on
     the instruction, when it has one)."""
     if isinstance(trace, Stream):
-        with _written(trace) as path:
+        with _written(trace, "jsonl") as path:
             return history(path, x, line, numeric=numeric, machine=machine)
     return list(
         _native.history(

@@ -45,6 +45,8 @@ def encode_trace(
     x: Any,
     dx: Any,
     values: Any,
+    note: Any,
+    notes: Sequence[str],
     encoding: str,
 ) -> bytes: ...
 def replay(
