@@ -7,6 +7,10 @@
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 python="${PYTHON:-python3}"
+# maturin's build backend runs the `maturin` program: that of this Python's environment,
+# active or not
+PATH="$("$python" -c 'import sysconfig; print(sysconfig.get_path("scripts"))'):$PATH"
+export PATH
 "$python" -m pip install --quiet --disable-pip-version-check -r "$here/requirements-test.txt"
 # no build isolation: the maturin just installed builds it (no second download)
 "$python" -m pip install --quiet --disable-pip-version-check --no-build-isolation "$here"

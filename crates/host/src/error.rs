@@ -72,7 +72,8 @@ impl From<StudyError> for CliError {
             StudyError::Trace(e) => CliError::Trace(e),
             StudyError::Machine(e) => CliError::Machine(e),
             StudyError::ImageLimit(e) => CliError::ImageLimit(e),
-            e @ StudyError::Array(_) => CliError::Internal(e.to_string()),
+            // (the command line never asks to cancel: its Ctrl-C ends the process)
+            e @ (StudyError::Array(_) | StudyError::Cancelled) => CliError::Internal(e.to_string()),
             e @ (StudyError::Usage(_) | StudyError::Plot(_)) => CliError::Usage(e.to_string()),
         }
     }

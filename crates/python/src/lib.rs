@@ -42,6 +42,7 @@ use pyo3::exceptions::{PyException, PyKeyboardInterrupt};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyList};
 use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 create_exception!(
     _native,
@@ -75,6 +76,34 @@ fn to_py(e: RenderError) -> PyErr {
         RenderError::Cancelled { .. } => PyKeyboardInterrupt::new_err(message),
         RenderError::Renderer { .. } | RenderError::Array(_) => CwisimError::new_err(message),
     }
+}
+
+/// Runs `work` without the GIL on a thread of its own while this thread asks Python for
+/// signals every 20 ms: on Ctrl-C, `work`'s cancel flag is set (it stops at its next
+/// check) and `KeyboardInterrupt` is raised once it has returned, whatever it returned.
+fn interruptible<T: Send>(
+    py: Python<'_>,
+    work: impl FnOnce(&AtomicBool) -> T + Send,
+) -> PyResult<T> {
+    let cancel = AtomicBool::new(false);
+    let (out, interrupted) = py.detach(|| {
+        std::thread::scope(|scope| {
+            let handle = scope.spawn(|| work(&cancel));
+            let mut interrupted = false;
+            while !handle.is_finished() {
+                std::thread::sleep(std::time::Duration::from_millis(20));
+                if !interrupted && Python::attach(|py| py.check_signals().is_err()) {
+                    interrupted = true;
+                    cancel.store(true, Ordering::Relaxed);
+                }
+            }
+            (handle.join(), interrupted)
+        })
+    });
+    if interrupted {
+        return Err(PyKeyboardInterrupt::new_err("interrupted"));
+    }
+    out.map_err(|_| CwisimError::new_err("cwisim failed: its worker thread panicked"))
 }
 
 /// The embedded scenes: `(name, one line about it)`, in `cwisim scenes`' order.
@@ -617,6 +646,7 @@ fn study_to_py(e: StudyError) -> PyErr {
             UsageError::new_err(e.to_string())
         }
         StudyError::Array(_) | StudyError::Plot(_) => CwisimError::new_err(e.to_string()),
+        StudyError::Cancelled => PyKeyboardInterrupt::new_err("interrupted"),
     }
 }
 
@@ -711,9 +741,11 @@ impl TradeoffPlan {
                 self.plan.groups.len()
             )));
         }
-        let rows = py
-            .detach(|| self.plan.measure_group(g, &self.machine, repeat))
-            .map_err(study_to_py)?;
+        let rows = interruptible(py, |cancel| {
+            self.plan
+                .measure_group_until(g, &self.machine, repeat, Some(cancel))
+        })?
+        .map_err(study_to_py)?;
         serde_json::to_string(&rows).map_err(|e| CwisimError::new_err(e.to_string()))
     }
 }
@@ -760,25 +792,25 @@ fn fit<'py>(
     };
     let (settings, given) = settings_of(&settings, threads)?;
     let array = array_config("f64", "fast", machine)?;
-    let found = py
-        .detach(|| {
-            let drawn = draw(
-                renderer,
-                SceneInput::Named(scene.map(Path::new)),
-                &given,
-                &settings,
-            )?;
-            fit_scene(
-                &*drawn.renderer,
-                scene.map(Path::new),
-                settings.size,
-                &array.machine,
-                max_error,
-                overflow,
-                threads,
-            )
-        })
-        .map_err(study_to_py)?;
+    let found = interruptible(py, |cancel| {
+        let drawn = draw(
+            renderer,
+            SceneInput::Named(scene.map(Path::new)),
+            &given,
+            &settings,
+        )?;
+        fit_scene(
+            &*drawn.renderer,
+            scene.map(Path::new),
+            settings.size,
+            &array.machine,
+            max_error,
+            overflow,
+            threads,
+            Some(cancel),
+        )
+    })?
+    .map_err(study_to_py)?;
     let f = &found.fit;
     let out = PyDict::new(py);
     out.set_item("numeric", Numeric::Fixed(f.format).to_string())?;
@@ -843,19 +875,21 @@ fn refine<'py>(
         .map_err(UsageError::new_err)?;
     settings.check().map_err(UsageError::new_err)?;
     let array = array_config("f64", "fast", machine)?;
-    let setup = RefineSetup {
-        scene: scene.map(Path::new),
-        settings,
-        phases,
-        machine: array.machine,
-        naive: true,
-        cost_maps: false,
-        ids: false,
-        threads,
-    };
-    let mut run = py
-        .detach(|| run_refine(&setup, None, None))
-        .map_err(study_to_py)?;
+    let mut run = interruptible(py, |cancel| {
+        let setup = RefineSetup {
+            scene: scene.map(Path::new),
+            settings,
+            phases,
+            machine: array.machine,
+            naive: true,
+            cost_maps: false,
+            ids: false,
+            threads,
+            cancel: Some(cancel),
+        };
+        run_refine(&setup, None, None)
+    })?
+    .map_err(study_to_py)?;
     let out = PyDict::new(py);
     let rows = PyList::empty(py);
     for r in &run.rows {

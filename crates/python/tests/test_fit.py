@@ -68,3 +68,28 @@ def test_refine_measures_the_command_line_s_phases(tmp_path):
         cwisim.refine("pot", samples=3)
     with pytest.raises(cwisim.UsageError, match="unknown phase"):
         cwisim.refine("pot", phases="flat,glow")
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda: cwisim.fit("pot", size=(1600, 1600), max_error=1 / 4096, threads=1),
+        lambda: cwisim.refine("teapot", size=(1000, 1000)),
+    ],
+    ids=["fit", "refine"],
+)
+def test_ctrl_c_stops_a_long_call(call):
+    """SIGINT during fit or refine: KeyboardInterrupt soon, the work stopped."""
+    import signal
+    import threading
+    import time
+
+    timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
+    start = time.perf_counter()
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            call()
+    finally:
+        timer.cancel()
+    assert time.perf_counter() - start < 6.0

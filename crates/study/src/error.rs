@@ -31,6 +31,9 @@ pub enum StudyError {
     /// A plot could not be drawn (the message says so).
     #[error("{0}")]
     Plot(String),
+    /// The caller asked the work to stop (a Python caller's Ctrl-C), and it stopped.
+    #[error("interrupted")]
+    Cancelled,
 }
 
 impl From<ReplayError> for StudyError {

@@ -23,6 +23,7 @@ use crate::tradeoff::errors;
 use cwisim_isa::{Instruction, TraceWrite};
 use cwisim_xproc::numeric::{FixedFormat, Numeric, Overflow, Q};
 use cwisim_xproc::{ImageSink, Machine, RunStats, Timing};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// The four registers.
 pub const REGISTERS: [&str; 4] = ["I", "dI", "ddI", "acc"];
@@ -62,6 +63,7 @@ pub struct Bench<'a> {
     exact: &'a [f64],
     runs: u64,
     threads: usize,
+    cancel: Option<&'a AtomicBool>,
 }
 
 impl<'a> Bench<'a> {
@@ -81,6 +83,7 @@ impl<'a> Bench<'a> {
             exact,
             runs: 0,
             threads: 1,
+            cancel: None,
         };
         bench.reference = bench.run(&Numeric::F64)?.0;
         Ok(bench)
@@ -92,6 +95,13 @@ impl<'a> Bench<'a> {
     /// replayed a batch at a time, and those after the first that holds are not counted.
     pub fn threads(mut self, threads: usize) -> Self {
         self.threads = cwisim_scene::budget::resolve_threads(threads);
+        self
+    }
+
+    /// The bench stopping, with [`StudyError::Cancelled`], at the first replay after
+    /// `flag` is set (a Python caller's Ctrl-C).
+    pub fn cancel(mut self, flag: Option<&'a AtomicBool>) -> Self {
+        self.cancel = flag;
         self
     }
 
@@ -159,6 +169,9 @@ impl<'a> Bench<'a> {
     }
 
     fn run(&self, numeric: &Numeric) -> Result<(Vec<f64>, RunStats), StudyError> {
+        if self.cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
+            return Err(StudyError::Cancelled);
+        }
         let mut sink = ImageSink::new(
             self.header.width as usize,
             self.header.channel_count(),
@@ -545,7 +558,9 @@ pub struct SceneFit {
 /// What `cwisim fit` does: the stream `renderer` draws for the scene SCENE names (a file
 /// or an embedded name, at `size`), its exact image, and the narrowest format found for
 /// it within `max_error` of the f64 array ([`fit_format`]), candidates replayed on
-/// `threads` threads (the result the same at any count).
+/// `threads` threads (the result the same at any count); stopped at the next replay once
+/// `cancel` is set.
+#[allow(clippy::too_many_arguments)]
 pub fn fit_scene(
     renderer: &dyn cwisim_render::Renderer,
     scene: Option<&std::path::Path>,
@@ -554,12 +569,15 @@ pub fn fit_scene(
     max_error: f64,
     overflow: Overflow,
     threads: usize,
+    cancel: Option<&AtomicBool>,
 ) -> Result<SceneFit, StudyError> {
     let exact = crate::tradeoff::exact_image(scene, size)?;
     let header = renderer.header();
     let mut instructions: Vec<Instruction> = Vec::new();
     cwisim_render::emit(renderer, &mut instructions)?;
-    let mut bench = Bench::new(header, &instructions, machine, &exact)?.threads(threads);
+    let mut bench = Bench::new(header, &instructions, machine, &exact)?
+        .threads(threads)
+        .cancel(cancel);
     let fit = fit_format(&mut bench, max_error, overflow)?;
     Ok(SceneFit {
         fit,

@@ -114,6 +114,9 @@ pub struct RefineSetup<'a> {
     /// at any count): [`run_refines`] gives a single run all of its threads, a sweep's
     /// runs one each.
     pub threads: usize,
+    /// Set: the run stops after the scanline being drawn, with
+    /// [`cwisim_render::RenderError::Cancelled`] (a Python caller's Ctrl-C).
+    pub cancel: Option<&'a std::sync::atomic::AtomicBool>,
 }
 
 /// A tap on the stream: each frame's cost map and display-list bytes, and the stream
@@ -225,6 +228,11 @@ fn pass(
         numeric: cwisim_xproc::Numeric::F64,
         timing: Timing::Fast,
     };
+    let stop = || {
+        setup
+            .cancel
+            .is_some_and(|c| c.load(std::sync::atomic::Ordering::Relaxed))
+    };
     let done = render(
         &refine,
         &array,
@@ -233,7 +241,7 @@ fn pass(
         Taps {
             also: Some(&mut tap),
             progress: Some(&mut report),
-            cancel: None,
+            cancel: Some(&stop),
         },
     )?;
     let image = sink.finish()?;

@@ -644,9 +644,21 @@ impl Plan {
         machine: &Machine,
         repeat: u32,
     ) -> Result<Vec<Row>, StudyError> {
+        self.measure_group_until(g, machine, repeat, None)
+    }
+
+    /// [`Plan::measure_group`], stopped with [`StudyError::Cancelled`] at the next
+    /// drawing or replay once `cancel` is set (a Python caller's Ctrl-C).
+    pub fn measure_group_until(
+        &self,
+        g: usize,
+        machine: &Machine,
+        repeat: u32,
+        cancel: Option<&std::sync::atomic::AtomicBool>,
+    ) -> Result<Vec<Row>, StudyError> {
         let scene = self.scene.as_deref();
         let group = &self.settings[self.groups[g].clone()];
-        let measured = measure_stream(scene, group, machine, repeat)?;
+        let measured = measure_stream_until(scene, group, machine, repeat, cancel)?;
         group
             .iter()
             .zip(measured)
@@ -876,11 +888,30 @@ pub fn measure_stream(
     machine: &Machine,
     repeat: u32,
 ) -> Result<Vec<(Measured, Vec<Duration>)>, StudyError> {
+    measure_stream_until(scene, group, machine, repeat, None)
+}
+
+/// [`measure_stream`], stopped at the next drawing or replay once `cancel` is set.
+fn measure_stream_until(
+    scene: Option<&Path>,
+    group: &[Setting],
+    machine: &Machine,
+    repeat: u32,
+    cancel: Option<&std::sync::atomic::AtomicBool>,
+) -> Result<Vec<(Measured, Vec<Duration>)>, StudyError> {
     let Some(first) = group.first() else {
         return Ok(Vec::new());
     };
+    let stop = || {
+        if cancel.is_some_and(|c| c.load(std::sync::atomic::Ordering::Relaxed)) {
+            Err(StudyError::Cancelled)
+        } else {
+            Ok(())
+        }
+    };
     let mut out: Vec<(Measured, Vec<Duration>)> = Vec::with_capacity(group.len());
     for time in 0..repeat.max(1) {
+        stop()?;
         let start = Instant::now();
         let loaded = Source::resolve(scene)?.load_for(&first.settings)?;
         let renderer = (first.renderer.build)(loaded, &first.settings)?;
@@ -891,6 +922,7 @@ pub fn measure_stream(
             .map_err(|unfit| StudyError::Array(unfit.refusal()))?;
         let drawing = start.elapsed();
         for (k, setting) in group.iter().enumerate() {
+            stop()?;
             renderer
                 .check_numeric(&setting.numeric)
                 .map_err(cwisim_render::RenderError::Usage)?;

@@ -97,6 +97,7 @@ pub fn run(args: &FitArgs, stdout: &mut dyn Write, progress: bool) -> Result<(),
         args.max_error,
         overflow,
         args.threads,
+        None,
     )?;
     drop(stage);
     let out = stdout;

@@ -210,6 +210,7 @@ pub fn run(args: &RefineArgs, stdout: &mut dyn Write, progress: bool) -> Result<
             cost_maps: args.cost_image_dir.is_some(),
             ids: args.ids.is_some(),
             threads: 1,
+            cancel: None,
         })
         .collect();
     let bar = std::sync::Mutex::new(Progress::scanlines(0, progress));
