@@ -549,6 +549,7 @@ fn drawn_and_rendered(
     given: &[Setting],
     settings: &Settings,
     array: &ArrayConfig,
+    progress: Option<&Py<PyAny>>,
 ) -> Result<Done, RenderError> {
     let drawn = draw(renderer, input, given, settings)?;
     let r = &*drawn.renderer;
@@ -569,10 +570,23 @@ fn drawn_and_rendered(
         )
         .map_err(|e| RenderError::Usage(e.to_string()))?;
     let mut sink = ImageSink::new(h.width as usize, h.channel_count(), bytes.max(1));
-    // Ctrl-C: Python's signal handler runs when asked, after each scanline
-    let interrupted = || Python::attach(|py| py.check_signals().is_err());
+    // after each scanline: the progress callback told (scanlines done, of all), and
+    // Python's signal handlers run (Ctrl-C); a callback that raises stops the render too
+    let failed = std::cell::Cell::new(false);
+    let mut told = |lines: u64| {
+        if let Some(callback) = progress {
+            Python::attach(|py| {
+                if let Err(e) = callback.call1(py, (lines, frames_lines)) {
+                    e.restore(py);
+                    failed.set(true);
+                }
+            });
+        }
+    };
+    let interrupted = || failed.get() || Python::attach(|py| py.check_signals().is_err());
     let taps = Taps {
         cancel: Some(&interrupted),
+        progress: Some(&mut told),
         ..Taps::default()
     };
     let rendered = render_frames(r, array, settings.threads, &mut sink, taps)?;
@@ -597,7 +611,7 @@ fn drawn_and_rendered(
 /// renderer's summary rows), `renderer`, `phrase` (the settings in words), `scene`,
 /// `kind`, `width`, `height`, `channels`, `frames`, `line_period`.
 #[pyfunction]
-#[pyo3(signature = (scene=None, scene_json=None, name="scene", renderer="vanrij", settings=Vec::new(), numeric="f64", timing="fast", machine=None, threads=1))]
+#[pyo3(signature = (scene=None, scene_json=None, name="scene", renderer="vanrij", settings=Vec::new(), numeric="f64", timing="fast", machine=None, threads=1, progress=None))]
 #[allow(clippy::too_many_arguments)]
 fn render<'py>(
     py: Python<'py>,
@@ -610,6 +624,7 @@ fn render<'py>(
     timing: &str,
     machine: Option<&str>,
     threads: usize,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     cwisim_scene::budget::check_threads(threads).map_err(UsageError::new_err)?;
     let (settings, given) = settings_of(&settings, threads)?;
@@ -619,8 +634,21 @@ fn render<'py>(
         (path, None) => SceneInput::Named(path.map(Path::new)),
     };
     let done = py
-        .detach(|| drawn_and_rendered(renderer, input, &given, &settings, &array))
-        .map_err(to_py)?;
+        .detach(|| {
+            drawn_and_rendered(
+                renderer,
+                input,
+                &given,
+                &settings,
+                &array,
+                progress.as_ref(),
+            )
+        })
+        .map_err(|e| match (&e, PyErr::take(py)) {
+            // stopped by the progress callback's own exception: that one
+            (RenderError::Cancelled { .. }, Some(raised)) => raised,
+            _ => to_py(e),
+        })?;
     let out = run_dict(py, done.image, &done.rendered.stats, &array, &array.numeric)?;
     let counters = PyDict::new(py);
     for (k, v) in done.rendered.counters.iter() {

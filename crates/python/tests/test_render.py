@@ -181,3 +181,23 @@ def test_ctrl_c_stops_a_render_after_a_scanline():
     finally:
         timer.cancel()
     assert time.perf_counter() - start < 5.0
+
+
+def test_progress_is_told_of_every_scanline_and_may_stop_the_render():
+    told = []
+    r = cwisim.render("pot", size=(64, 48), progress=lambda done, total: told.append((done, total)))
+    assert told == [(k, 48) for k in range(1, 49)]
+    assert r.image.shape == (48, 64, 1)
+    frames = []
+    cwisim.render("pot", "refine", size=(32, 24), progress=lambda d, t: frames.append(t))
+    assert set(frames) == {4 * 24}
+
+    class Enough(Exception):
+        pass
+
+    def stop(done, total):
+        if done == 10:
+            raise Enough(done)
+
+    with pytest.raises(Enough):
+        cwisim.render("pot", size=(64, 48), progress=stop)

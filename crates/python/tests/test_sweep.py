@@ -85,3 +85,21 @@ def test_a_bad_sweep_is_refused_before_any_task():
         cwisim.tradeoff("pot", numeric="f16")
     with pytest.raises(cwisim.UsageError, match="tradeoff takes a scene file"):
         cwisim.tradeoff(cwisim.scene("pot"))
+
+
+def test_settings_times_scenes_here_and_on_dask():
+    grid = dict(size=(48, 48), renderers=["vanrij"], numeric=["f64"], repeat=1)
+    scenes = ["pot", "bowl"]
+    rows = cwisim.tradeoff(scenes, **grid)
+    alone = {name: cwisim.tradeoff(name, **grid) for name in scenes}
+    # each scene's rows in turn, each as the scene's own sweep, its front its own
+    assert [r["scene"] for r in rows] == [n for n in scenes for _ in alone[n]]
+    for name in scenes:
+        mine = [{k: v for k, v in r.items() if k != "scene"} for r in rows if r["scene"] == name]
+        assert sweep.compare(alone[name], mine) == [], name
+    distributed = pytest.importorskip("dask.distributed")
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+    ) as cluster, distributed.Client(cluster) as client:
+        there = cwisim.tradeoff(scenes, client=client, **grid)
+    assert sweep.compare(rows, there) == []

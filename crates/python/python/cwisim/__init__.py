@@ -20,7 +20,7 @@ import os
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Dict, List, Mapping, Optional, Tuple, Union
+from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -201,6 +201,7 @@ def render(
     timing: str = "fast",
     machine: Optional[Union[str, "os.PathLike[str]"]] = None,
     threads: int = 1,
+    progress: Optional[Callable[[int, int], Any]] = None,
     **settings: Any,
 ) -> Render:
     """Draws ``scene`` with ``renderer`` and runs the instructions through the simulated
@@ -217,6 +218,8 @@ def render(
     ``None`` leaves a setting at its default. A setting the renderer does not read, or
     that the others leave idle, raises :class:`UsageError` naming what would use it.
 
+    ``progress``: called after each scanline with (scanlines done, scanlines in all) —
+    a progress bar's ``update`` (an exception it raises stops the render, and is raised).
     Runs without the GIL. Raises :class:`SceneError` for a scene that cannot be read (the
     message locates it) and :class:`UsageError` for names, settings or sizes refused.
     """
@@ -229,6 +232,7 @@ def render(
         timing=timing,
         machine=_path(machine),
         threads=threads,
+        progress=progress,
     )
     return _render_of(out, settings=dict(given))
 
@@ -289,7 +293,7 @@ def _plan_args(scene, size, tessellate, shadows, renderers, numeric, machine) ->
 
 
 def tradeoff(
-    scene: SceneLike = None,
+    scene: Union[SceneLike, Sequence[Union[str, "os.PathLike[str]"]]] = None,
     *,
     size: Optional[Union[str, Tuple[int, int]]] = None,
     tessellate: Optional[List[int]] = None,
@@ -301,37 +305,58 @@ def tradeoff(
     threads: int = 1,
     client: Any = None,
 ) -> List[Dict[str, Any]]:
-    """``cwisim tradeoff``: one scene drawn over a grid of settings, each measured (what
-    it costs the array and the host against its error from the exact image), the Pareto
+    """``cwisim tradeoff``: a scene drawn over a grid of settings, each measured (what it
+    costs the array and the host against its error from the exact image), the Pareto
     front of bus cycles, register bits and RMS error marked. Returns the rows, in the
     grid's order, as dicts with the CSV's fields (and the renderer's ``counters``);
     :func:`frame` makes a pandas DataFrame of them.
 
-    The axes default to the command line's: every one-frame renderer, ``tessellate``
-    (4, 8, 16) on a scene with patches, the scene's own shadows, the five default
-    ``numeric`` formats. ``threads``: measured on that many threads in this process.
-    ``client``: a ``dask.distributed.Client``: each group of settings that shares a
-    stream becomes a Dask task, run on the cluster's workers, and the rows gathered in
-    the same order — equal to the local sweep's, row for row, but for the host times.
+    ``scene``: a file or an embedded name, or a list of them — settings × scenes: each
+    scene's grid in turn, each row with its ``scene``, each scene's front marked among
+    its own rows. The axes default to the command line's: every one-frame renderer,
+    ``tessellate`` (4, 8, 16) on a scene with patches, the scene's own shadows, the five
+    default ``numeric`` formats. ``threads``: measured on that many threads in this
+    process. ``client``: a ``dask.distributed.Client``: each group of settings that
+    shares a stream (of every scene) becomes a Dask task, run on the cluster's workers,
+    and the rows gathered in the same order — equal to the local sweep's, row for row,
+    but for the host times.
     """
-    args = _plan_args(scene, size, tessellate, shadows, renderers, numeric, machine)
+    many = isinstance(scene, (list, tuple))
+    plans = [
+        _plan_args(one, size, tessellate, shadows, renderers, numeric, machine)
+        for one in (scene if many else [scene])
+    ]
     if client is not None:
         from . import sweep  # noqa: PLC0415 (Dask is optional)
 
-        return sweep.tradeoff_on(client, args, repeat)
+        per_scene = sweep.tradeoff_on(client, plans, repeat)
+    else:
+        per_scene = [_measured_here(args, repeat, threads) for args in plans]
+    rows: List[Dict[str, Any]] = []
+    for args, scene_rows in zip(plans, per_scene):
+        mark_pareto(scene_rows)
+        if many:
+            for r in scene_rows:
+                r["scene"] = args["scene"]
+        rows.extend(scene_rows)
+    return rows
+
+
+def _measured_here(args: Dict[str, Any], repeat: int, threads: int) -> List[Dict[str, Any]]:
+    """The rows of one plan, measured in this process on ``threads`` threads, unmarked."""
     plan = _native.TradeoffPlan(**args)
     rows: List[Dict[str, Any]] = []
     if threads == 1:
         for g in range(plan.groups()):
             rows.extend(rows_of(plan.measure(g, repeat)))
-    else:
-        from concurrent.futures import ThreadPoolExecutor  # noqa: PLC0415
+        return rows
+    from concurrent.futures import ThreadPoolExecutor  # noqa: PLC0415
 
-        workers = threads if threads > 0 else (os.cpu_count() or 1)
-        with ThreadPoolExecutor(workers) as pool:
-            for group in pool.map(lambda g: plan.measure(g, repeat), range(plan.groups())):
-                rows.extend(rows_of(group))
-    return mark_pareto(rows)
+    workers = threads if threads > 0 else (os.cpu_count() or 1)
+    with ThreadPoolExecutor(workers) as pool:
+        for group in pool.map(lambda g: plan.measure(g, repeat), range(plan.groups())):
+            rows.extend(rows_of(group))
+    return rows
 
 
 def rows_of(text: str) -> List[Dict[str, Any]]:

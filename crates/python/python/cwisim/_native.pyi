@@ -26,6 +26,7 @@ def render(
     timing: str = "fast",
     machine: Optional[str] = None,
     threads: int = 1,
+    progress: Optional[Any] = None,
 ) -> Dict[str, Any]: ...
 def opcodes() -> List[Tuple[int, str]]: ...
 def emit_stream(

@@ -33,23 +33,27 @@ def measure_group(args: Dict[str, Any], g: int, repeat: int) -> List[Dict[str, A
     return rows_of(_plan(args).measure(g, repeat))
 
 
-def tradeoff_on(client: Any, args: Dict[str, Any], repeat: int) -> List[Dict[str, Any]]:
-    """The sweep of ``args`` on ``client``'s cluster: one task per group, gathered in
-    order, Pareto-marked over all the rows."""
-    from . import mark_pareto  # noqa: PLC0415
-
-    groups = _native.TradeoffPlan(**args).groups()
+def tradeoff_on(
+    client: Any, plans: List[Dict[str, Any]], repeat: int
+) -> List[List[Dict[str, Any]]]:
+    """The sweeps of ``plans`` (one per scene) on ``client``'s cluster: one task per group
+    of every plan, all submitted at once, gathered in order; each plan's rows, unmarked."""
+    tasks = [
+        (k, g)
+        for k, args in enumerate(plans)
+        for g in range(_native.TradeoffPlan(**args).groups())
+    ]
     futures = client.map(
         measure_group,
-        [args] * groups,
-        range(groups),
-        [repeat] * groups,
+        [plans[k] for k, _ in tasks],
+        [g for _, g in tasks],
+        [repeat] * len(tasks),
         pure=False,
     )
-    rows: List[Dict[str, Any]] = []
-    for group in client.gather(futures):
-        rows.extend(group)
-    return mark_pareto(rows)
+    out: List[List[Dict[str, Any]]] = [[] for _ in plans]
+    for (k, _), group in zip(tasks, client.gather(futures)):
+        out[k].extend(group)
+    return out
 
 
 def compare(local: List[Dict[str, Any]], distributed: List[Dict[str, Any]]) -> List[Tuple[int, str]]:
