@@ -142,6 +142,8 @@ const LONG: &[&str] = &[
     "docs/REPRODUCTION.md: render many500.json",
     // three nishita teapots: 3 × 10 s debug, 4 s release
     "docs/REPRODUCTION.md: --renderer nishita --root-tolerance $t",
+    // seven nishita teapots, flatness 16 to 0.25 px: 10–90 s debug each, 1–5 s release
+    "docs/REPRODUCTION.md: --root-tolerance 1e-3 --flatness $f",
     // eight refinements of the pot: 15 s debug, 2 s release
     "docs/REPRODUCTION.md: refine pot --sweep",
     // 50–200 s debug, 9–14 s release

@@ -392,6 +392,68 @@ mod tests {
         }
     }
 
+    /// Van Rij's figures 26 and 27 (docs/REPRODUCTION.md): the report's figure-25 points
+    /// read as P = ADE, Q = ABC, R = DEF and transferred to cwisim's frame
+    /// (`tests/fixtures/fig25-report.json`: the report's scanline 6 is row 7). Sorted on
+    /// Xmax alone, row 7's nodes pair P–R, Q–P, R–Q (figure 26, the report's "between an
+    /// edge of triangle P and one of R, then … P and … Q and last … R and … Q"); sorted on
+    /// Identifier then Xmax, each triangle's own two edges (figure 27).
+    #[test]
+    fn figure_26_pairs_across_triangles_on_xmax_alone() {
+        let tri = |v: [[f64; 2]; 3]| Polygon {
+            vertices: v.to_vec(),
+            intensity: vec![vec![1.0]; 3],
+            depth: None,
+        };
+        let polygons = [
+            tri([[2.5, 1.5], [2.5, 7.5], [9.05, 7.5]]),
+            tri([[2.5, 1.5], [10.5, 1.5], [10.5, 8.83]]),
+            tri([[2.5, 7.5], [9.05, 7.5], [14.5, 12.5]]),
+        ];
+        let mut ts = Vec::new();
+        for (k, p) in polygons.iter().enumerate() {
+            let id = ts.len() as u32 + 1;
+            ts.extend(trapezia(p, k as u32, 1, id));
+        }
+        assert_eq!(
+            ts.len(),
+            3,
+            "each triangle one trapezium, as the report numbers them"
+        );
+        let row = 7;
+        let mut nodes: Vec<EdgeNode> = ts
+            .iter()
+            .enumerate()
+            .filter(|(_, t)| t.y_top < row as f64 + 1.0 && t.y_bot > row as f64)
+            .flat_map(|(k, t)| {
+                [
+                    EdgeNode::new(t, k, Side::Left),
+                    EdgeNode::new(t, k, Side::Right),
+                ]
+            })
+            .collect();
+        for n in &mut nodes {
+            n.update_to(row);
+        }
+        assert_eq!(nodes.len(), 6, "all three triangles meet the row");
+        let pairs = |nodes: &[EdgeNode]| -> Vec<(u32, u32)> {
+            nodes
+                .chunks_exact(2)
+                .map(|p| (p[0].identifier, p[1].identifier))
+                .collect()
+        };
+        let (p, q, r) = (1, 2, 3);
+        // a stable sort: ties in table order, as the report's insertion keeps them
+        nodes.sort_by(|a, b| a.x_max.total_cmp(&b.x_max));
+        assert_eq!(pairs(&nodes), [(p, r), (q, p), (r, q)], "figure 26");
+        nodes.sort_by(|a, b| {
+            (a.identifier, a.x_max)
+                .partial_cmp(&(b.identifier, b.x_max))
+                .expect("finite")
+        });
+        assert_eq!(pairs(&nodes), [(p, p), (q, q), (r, r)], "figure 27");
+    }
+
     /// The scan's slices are [`Slice::of`]'s bit for bit, for every trapezium it visits
     /// in every row, and it visits exactly those [`scan_rows_of`] does whose band meets
     /// the row: random polygons, slivers, rows starting mid-trapezium, huge coordinates.

@@ -46,35 +46,59 @@ fn e1_sequence_increment_is_one_over_inverse_slope() {
     }
 }
 
-/// E2: the share-sequence increment is 1/|1/slope_left| − 1/|1/slope_right| whichever
-/// way the edges lean (the report's signed S1 − S2 is right only when they lean apart).
+/// E2 (a clarification): in a run of pixels cut by both edges, coverage changes by
+/// 1/|1/slope_left| − 1/|1/slope_right| (E1's factor fixed). Only edges that lean the
+/// same way share pixels (on a simple polygon, edges leaning apart overlap in x in at most
+/// a point), and for them the report's signed `S1 − S2` of its 1/slope fields (y up:
+/// `(bottom_x − top_x)/(bottom_y − top_y)`) is right when both fields are positive and
+/// of the wrong sign when both are negative — which its "case B … divide −1" corrects.
+/// So cwisim's absolute form equals the report with case B read as "both fields
+/// negative", and differs from the procedure as defined without it. Simple polygons only.
 #[test]
-fn e2_share_sequence_increment_uses_absolute_slopes() {
-    for (l, r) in [(6.0f64, 8.0f64), (6.0, -8.0), (-6.0, -8.0)] {
-        // left edge 1/slope l, right edge 1/slope r, sharing pixels 5..=7
-        let (lt, lb) = if l > 0.0 {
-            (3.0, 3.0 + l)
+fn e2_share_sequence_increment_is_the_report_s_with_case_b() {
+    // (polygon, its left and right edges' report fields, the pixels both edges cut)
+    type Case = (Vec<[f64; 2]>, f64, f64, std::ops::Range<usize>);
+    let cases: [Case; 3] = [
+        // edges running down to the right (y down): both fields negative
+        (
+            vec![[3.0, 0.0], [4.0, 0.0], [12.0, 1.0], [9.0, 1.0]],
+            -6.0,
+            -8.0,
+            5..8,
+        ),
+        // the control: both running down to the left, both fields positive
+        (
+            vec![[9.0, 0.0], [12.0, 0.0], [4.0, 1.0], [3.0, 1.0]],
+            6.0,
+            8.0,
+            5..8,
+        ),
+        // a triangle with a shared apex row
+        (vec![[0.0, 0.0], [1.0, 0.0], [5.0, 1.0]], -5.0, -4.0, 2..4),
+    ];
+    for (vertices, left, right, run) in cases {
+        let p = grey(vertices.clone());
+        let c = coverage(&p, 16, 1);
+        let absolute = 1.0 / left.abs() - 1.0 / right.abs();
+        let signed = 1.0 / left - 1.0 / right;
+        let case_b = if left < 0.0 && right < 0.0 {
+            -signed
         } else {
-            (3.0 - l, 3.0)
+            signed
         };
-        let (rt, rb) = if r > 0.0 {
-            (4.0, 4.0 + r)
-        } else {
-            (4.0 - r, 4.0)
-        };
-        let p = grey(vec![[lt, 0.0], [rt, 0.0], [rb, 1.0], [lb, 1.0]]);
-        let c = coverage(&p, 24, 1);
-        let increment = c[6] - c[5];
-        let corrected = 1.0 / l.abs() - 1.0 / r.abs();
-        assert!(
-            (increment - corrected).abs() < 1e-12,
-            "l {l} r {r}: {increment} vs {corrected}"
-        );
-        if l.signum() != r.signum() {
-            let signed = 1.0 / l - 1.0 / r;
+        for k in run.start..run.end - 1 {
+            let increment = c[k + 1] - c[k];
             assert!(
+                (increment - absolute).abs() < 1e-12,
+                "{vertices:?} pixel {k}: {increment} vs {absolute}"
+            );
+            assert!((case_b - absolute).abs() < 1e-15);
+            // the procedure as defined, without case B, is wrong exactly when both
+            // fields are negative
+            assert_eq!(
                 (increment - signed).abs() > 0.05,
-                "signed slopes would match for l {l} r {r}"
+                left < 0.0 && right < 0.0,
+                "{vertices:?}: signed {signed} against {increment}"
             );
         }
     }

@@ -44,7 +44,8 @@ fn figure_25_pairs_edges_by_identifier() {
     insta::assert_snapshot!("fig25_centre", text(&scene, &centre()));
     // With the AET grouped by Identifier every trapezium is filled between its own two
     // edges, so with intensity 1 the image is exactly the triangles' coverage. (Sorted on
-    // Xmax alone, row 6 would pair edges of different triangles, as the report shows.)
+    // Xmax alone, the report's figure 26 pairs edges of different triangles:
+    // `scan.rs::tests::figure_26_pairs_across_triangles_on_xmax_alone`, in its frame.)
     let mut ones = scene.clone();
     for p in &mut ones.polygons {
         for i in &mut p.intensity {
