@@ -9,10 +9,12 @@
 //! the Y-processor as ratios.
 //!
 //! ```sh
-//! cargo run --release -p cwisim-render --example cp_tables [-- POLYGONS [STEP]]
+//! cargo run --release -p cwisim-render --example cp_tables [-- POLYGONS [STEP [REPEAT [FAMILY N,…]]]]
 //! ```
 //!
-//! Counts are deterministic; times are one run's, on whatever machine runs it.
+//! Counts are deterministic. Host times are the median of REPEAT runs (default 1), with
+//! the spread (min–max) when REPEAT > 1, on whatever machine runs it; FAMILY and a list
+//! of `n` restrict the table to those rows (`convex 100,1000`).
 
 use cwisim_render::cpbench::{generate, BenchSpec, Family};
 use cwisim_render::{registry, render, ArrayConfig, LoadedScene, Rendered, Settings};
@@ -34,6 +36,16 @@ fn run(name: &str, scene: &ScreenScene, settings: &Settings) -> Rendered {
     .expect("the benchmark draws")
 }
 
+/// Host times in ms: the median, and the spread (min–max) of several.
+fn times(ms: &mut [f64]) -> String {
+    ms.sort_by(f64::total_cmp);
+    let median = ms[ms.len() / 2];
+    match ms {
+        [_] => format!("{median:.1}"),
+        _ => format!("{median:.1} ({:.1}–{:.1})", ms[0], ms[ms.len() - 1]),
+    }
+}
+
 /// Edges a plain edge table holds: every edge that is not horizontal.
 fn plain_edges(scene: &ScreenScene) -> u64 {
     scene
@@ -52,6 +64,11 @@ fn main() {
     let mut args = std::env::args().skip(1);
     let polygons: u32 = args.next().map_or(1000, |a| a.parse().expect("POLYGONS"));
     let step: u32 = args.next().map_or(100, |a| a.parse().expect("STEP"));
+    let repeat: usize = args.next().map_or(1, |a| a.parse().expect("REPEAT"));
+    let only: Option<Family> = args.next().map(|a| a.parse().expect("FAMILY"));
+    let ns: Option<Vec<u32>> = args
+        .next()
+        .map(|a| a.split(',').map(|n| n.parse().expect("N,…")).collect());
     let sbuffer = Settings {
         samples: 1,
         ..Settings::default()
@@ -65,8 +82,15 @@ fn main() {
     );
     println!("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
     for family in Family::ALL {
+        if only.is_some_and(|f| f != family) {
+            continue;
+        }
         let mut n = step;
         while n <= 10 * step {
+            if ns.as_ref().is_some_and(|ns| !ns.contains(&n)) {
+                n += step;
+                continue;
+            }
             let (scene, counts) = generate(&BenchSpec {
                 family,
                 polygons,
@@ -78,10 +102,16 @@ fn main() {
             .expect("a benchmark scene");
             let s = run("sbuffer", &scene, &sbuffer);
             let v = run("vanrij", &scene, &vanrij);
+            let mut s_ms = vec![s.renderer_time.as_secs_f64() * 1e3];
+            let mut v_ms = vec![v.renderer_time.as_secs_f64() * 1e3];
+            for _ in 1..repeat {
+                s_ms.push(run("sbuffer", &scene, &sbuffer).renderer_time.as_secs_f64() * 1e3);
+                v_ms.push(run("vanrij", &scene, &vanrij).renderer_time.as_secs_f64() * 1e3);
+            }
             let get = |r: &Rendered, k: &str| r.counters.get(k).unwrap_or(0);
             let busy = |r: &Rendered| r.stats.lines.iter().map(|l| l.busy_cycles).sum::<u64>();
             println!(
-                "| {family} | {n} | {:.2} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.1} | {:.1} |",
+                "| {family} | {n} | {:.2} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
                 counts.critical_points as f64 / f64::from(polygons),
                 get(&s, "moveup_steps"),
                 get(&s, "aet_inserts"),
@@ -93,8 +123,8 @@ fn main() {
                 busy(&s),
                 v.stats.totals.instructions,
                 busy(&v),
-                s.renderer_time.as_secs_f64() * 1e3,
-                v.renderer_time.as_secs_f64() * 1e3,
+                times(&mut s_ms),
+                times(&mut v_ms),
             );
             n += step;
         }
