@@ -23,6 +23,7 @@ use cwisim_render::settings::{
 use cwisim_render::subsample::Grid;
 use cwisim_render::{registry, Settings, Size};
 use cwisim_scene::{Antialias, Shading};
+use cwisim_world::texture::TextureFilter;
 use cwisim_world::Visibility;
 use std::path::Path;
 
@@ -77,6 +78,26 @@ pub enum ShadowsArg {
     On,
     /// No light casts shadows.
     Off,
+}
+
+/// `--texture-filter`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum TextureFilterArg {
+    /// The texture's mean over the pixel's footprint (its preimage's bounding box in
+    /// texture space, from a summed-area table).
+    #[default]
+    Box,
+    /// The texel under the pixel centre.
+    Point,
+}
+
+impl From<TextureFilterArg> for TextureFilter {
+    fn from(f: TextureFilterArg) -> TextureFilter {
+        match f {
+            TextureFilterArg::Box => TextureFilter::Box,
+            TextureFilterArg::Point => TextureFilter::Point,
+        }
+    }
 }
 
 /// `--grid`.
@@ -368,6 +389,17 @@ pub struct DrawArgs {
     /// or the same lit parts tested at each sample (woo-chall, sbuffer, bsp).
     #[arg(long, value_enum, value_name = "on|off")]
     pub shadows: Option<ShadowsArg>,
+    /// How a pixel reads a textured mesh's texture: its mean over the pixel's footprint
+    /// (box), or the texel under the pixel's centre (point). The result goes through the
+    /// span fitter, within --shade-tolerance, under any --shading.
+    #[arg(
+        long,
+        value_enum,
+        value_name = "box|point",
+        default_value = "box",
+        help_heading = "Textures (vanrij, nishita)"
+    )]
+    pub texture_filter: TextureFilterArg,
 }
 
 /// The help heading of van Rij's trapezia's flags: the pixel filter and the visibility.
@@ -411,6 +443,7 @@ impl Default for DrawArgs {
             aa_threshold: Threshold::Above(DEFAULT_AA_THRESHOLD),
             phong_angle: Threshold::Above(DEFAULT_PHONG_ANGLE),
             shadows: None,
+            texture_filter: TextureFilterArg::Box,
         }
     }
 }
@@ -475,6 +508,7 @@ impl DrawArgs {
             aa_threshold: self.aa_threshold,
             phong_angle: self.phong_angle,
             shadows: self.shadows.map(|s| s == ShadowsArg::On),
+            texture_filter: self.texture_filter.into(),
             threads: 1,
         }
     }
@@ -563,6 +597,7 @@ mod tests {
             Setting::GouraudThreshold | Setting::AaThreshold => "all",
             Setting::PhongAngle => "45",
             Setting::Shadows => "off",
+            Setting::TextureFilter => "point",
             _ => "0.25",
         };
         for s in Setting::ALL {

@@ -144,6 +144,8 @@ const LONG: &[&str] = &[
     "docs/REPRODUCTION.md: --renderer nishita --root-tolerance $t",
     // seven nishita teapots, flatness 16 to 0.25 px: 10–90 s debug each, 1–5 s release
     "docs/REPRODUCTION.md: --root-tolerance 1e-3 --flatness $f",
+    // the plain and the textured teapot by nishita: 2 × 40 s debug, 2 s release
+    "docs/REPRODUCTION.md: --renderer nishita --threads 1",
     // eight refinements of the pot: 15 s debug, 2 s release
     "docs/REPRODUCTION.md: refine pot --sweep",
     // 50–200 s debug, 9–14 s release
@@ -196,6 +198,7 @@ const DOCUMENTS: &[&str] = &[
     "docs/REPRODUCTION.md",
     "docs/SHADOWS.md",
     "docs/STUDYING.md",
+    "docs/TEXTURES.md",
     "docs/TIMING.md",
     "docs/TRADEOFF.md",
 ];
@@ -248,6 +251,11 @@ fn shadows() {
 #[test]
 fn studying() {
     run_document("docs/STUDYING.md");
+}
+
+#[test]
+fn textures() {
+    run_document("docs/TEXTURES.md");
 }
 
 #[test]

@@ -164,7 +164,7 @@ fn a_flag_the_other_flags_or_the_scene_leave_idle_is_refused() {
     for (args, message) in [
         (
             &["--shade-tolerance", "0"][..],
-            "--shade-tolerance is the span fitter's, used with --shading phong only (and by nishita under the box filter)",
+            "--shade-tolerance is the span fitter's, used with --shading phong, on textured meshes, and by nishita under the box filter; pot has no texture",
         ),
 
         (
@@ -226,7 +226,7 @@ fn a_flag_the_other_flags_or_the_scene_leave_idle_is_refused() {
     refused(
         &dir,
         &[&nishita[..], &["--aa", "none", "--shade-tolerance", "0"]].concat(),
-        "--shade-tolerance is the span fitter's, used with --shading phong only (and by nishita under the box filter)",
+        "--shade-tolerance is the span fitter's, used with --shading phong, on textured meshes, and by nishita under the box filter; teapot has no texture",
     );
     assert!(!dir.join("x.png").exists());
     let coarse = cwisim_ok(
@@ -351,6 +351,7 @@ fn example(s: Setting, shading: bool) -> Vec<&'static str> {
         Setting::AaThreshold => vec!["--aa-threshold", "all"],
         Setting::PhongAngle => vec!["--phong-angle", "all"],
         Setting::Shadows => vec!["--shadows", "on"],
+        Setting::TextureFilter => vec!["--texture-filter", "point"],
     }
 }
 
@@ -397,14 +398,25 @@ fn alone(s: Setting) -> Vec<&'static str> {
 fn every_renderer_takes_and_uses_every_flag_it_declares_and_refuses_the_others() {
     let dir = scratch("flags-used-declared");
     std::fs::write(dir.join("patches.json"), patch_scene()).unwrap();
+    // the same patches with a checkerboard, for the flags of textured scenes
+    let textured = patch_scene().replace(
+        r#""n": 20}"#,
+        r#""n": 20, "texture": {"checker": {"squares": [3, 3]}}}"#,
+    );
+    assert_ne!(textured, patch_scene());
+    std::fs::write(dir.join("textured.json"), textured).unwrap();
+    let scene_of = |s: Setting| match s {
+        Setting::TextureFilter => "textured.json",
+        _ => "patches.json",
+    };
     for entry in REGISTRY {
         // what a flag may change: the image, the instructions per pixel, and the host's
         // work the summary counts (not its first line, which repeats the settings, nor
         // the wall times)
-        let render = |extra: &[&str]| {
+        let render = |scene: &str, extra: &[&str]| {
             let mut args = vec![
                 "render",
-                "patches.json",
+                scene,
                 "--renderer",
                 entry.name,
                 "--npy",
@@ -428,8 +440,13 @@ fn every_renderer_takes_and_uses_every_flag_it_declares_and_refuses_the_others()
             ]
             .concat()
         };
-        let default = render(&[]);
+        let mut defaults = std::collections::HashMap::new();
         for &s in entry.uses {
+            let scene = scene_of(s);
+            let default = defaults
+                .entry(scene)
+                .or_insert_with(|| render(scene, &[]))
+                .clone();
             let extra = example(s, entry.uses.contains(&Setting::Shading));
             // the flag against what it needs of the others without it
             let flag = alone(s);
@@ -438,10 +455,10 @@ fn every_renderer_takes_and_uses_every_flag_it_declares_and_refuses_the_others()
             let reference = if needs.is_empty() {
                 default.clone()
             } else {
-                render(&needs)
+                render(scene, &needs)
             };
             assert_ne!(
-                render(&extra),
+                render(scene, &extra),
                 reference,
                 "{} {} changes nothing: {extra:?}",
                 entry.name,

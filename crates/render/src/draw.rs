@@ -69,7 +69,7 @@ pub fn draw(
         }
     };
     entry
-        .check_scene(given, &loaded.scene, &name)
+        .check_scene(given, &loaded.scene, &name, settings)
         .map_err(RenderError::Usage)?;
     build(entry, loaded, settings)
 }

@@ -171,7 +171,7 @@ impl FramePlan for PhongFrame<'_> {
                         let p = nearest_in(triangle, centre);
                         let shade = self
                             .surfaces
-                            .shade(t.polygon as usize, p)
+                            .shade_pixel(t.polygon as usize, p, centre)
                             .unwrap_or_default();
                         targets.extend(shade[..channels].iter().map(|v| c * v.max(0.0)));
                     }

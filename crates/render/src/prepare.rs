@@ -10,6 +10,7 @@ use cwisim_scene::{ScreenScene, Shading, Vector};
 use cwisim_world::face::ScreenTriangle;
 use cwisim_world::shade::PhongShader;
 use cwisim_world::shadow::{self, Casters, LightSet, ShadowStats, ShadowTest};
+use cwisim_world::texture::TextureFilter;
 use cwisim_world::{AnyScene, ProjectStats, Visibility, VisibilityStats};
 use std::time::{Duration, Instant};
 
@@ -38,7 +39,8 @@ pub struct PolygonScene {
     pub shadows: Option<ShadowStats>,
     /// Wall time of the shadow pass.
     pub shadow_time: Duration,
-    /// With Phong shading: what per-pixel shading needs of the world.
+    /// With Phong shading, or a textured scene under any shading: what per-pixel
+    /// shading needs of the world.
     pub phong: Option<PhongSurfaces>,
     /// Meshes whose material lets light through (`transmittance` > 0), drawn opaque
     /// here: polygon renderers keep the nearest surface only.
@@ -58,6 +60,8 @@ pub struct PhongSurfaces {
     pub shader: PhongShader,
     /// With shadows: which lights reach each polygon.
     pub shadows: Option<PolygonLights>,
+    /// How a pixel reads a texture.
+    pub filter: TextureFilter,
 }
 
 /// Which lights reach each polygon of a scene drawn with shadows.
@@ -77,6 +81,29 @@ impl PhongSurfaces {
             sources,
             shader,
             shadows: None,
+            filter: TextureFilter::Box,
+        }
+    }
+
+    /// The same, reading textures through `filter`.
+    pub fn filtered(self, filter: TextureFilter) -> Self {
+        PhongSurfaces { filter, ..self }
+    }
+
+    /// The intensity of polygon `polygon` at screen point `p` (on its triangle) of the
+    /// pixel whose centre is `centre`, by the lights that reach it, its texture read
+    /// through [`Self::filter`] (`cwisim_world::shade::PhongShader::at_pixel_lit`).
+    pub fn shade_pixel(&self, polygon: usize, p: [f64; 2], centre: [f64; 2]) -> Option<Vector> {
+        let triangle = &self.triangles[self.sources[polygon]];
+        match &self.shadows {
+            None => self
+                .shader
+                .at_pixel_lit(triangle, p, centre, self.filter, |_| true),
+            Some(s) => self
+                .shader
+                .at_pixel_lit(triangle, p, centre, self.filter, |k| {
+                    s.casters.reaches(s.lit[polygon], k)
+                }),
         }
     }
 
@@ -232,7 +259,11 @@ impl PolygonScene {
                 "--shading hidden (edges of the visible triangles, no shading calls) is drawn by renderers that resolve visibility per sample: use --renderer woo-chall".into(),
             ));
         }
+        let textured = loaded.scene.is_textured();
         let phong = settings.shading == Shading::Phong;
+        // a texture changes the intensity within a triangle under any shading: it is
+        // drawn per pixel, as Phong is
+        let per_pixel = phong || textured;
         match loaded.scene {
             AnyScene::Screen(_) if phong => return Err(phong_needs_world()),
             AnyScene::Screen(s) => {
@@ -242,6 +273,11 @@ impl PolygonScene {
             AnyScene::World(_) if phong && settings.visibility != Visibility::Exact => {
                 return Err(RenderError::Usage(
                     "Phong shading is drawn on exact visible surfaces only: use --visibility exact (eval0 claims hold one value per pixel run, not a per-pixel shade)".into(),
+                ))
+            }
+            AnyScene::World(_) if textured && settings.visibility != Visibility::Exact => {
+                return Err(RenderError::Usage(
+                    "textures are drawn on exact visible surfaces only: use --visibility exact (eval0 claims hold one value per pixel run, not a texture)".into(),
                 ))
             }
             AnyScene::World(w) => {
@@ -256,7 +292,7 @@ impl PolygonScene {
                 prepared.transform_time = start.elapsed();
                 let casters = world_casters(&w, settings)?;
                 let start = Instant::now();
-                let (polygons, vis) = if phong || !casters.is_empty() {
+                let (polygons, vis) = if per_pixel || !casters.is_empty() {
                     // the fragments with their source triangles: per-pixel shading and
                     // shadows need them
                     let (fragments, stats) = match settings.visibility {
@@ -288,9 +324,13 @@ impl PolygonScene {
                         prepared.shadow_time = start.elapsed();
                     }
                     let sources = shadowed.fragments.iter().map(|f| f.source).collect();
-                    if phong {
-                        let mut surfaces =
-                            PhongSurfaces::new(tris, sources, PhongShader::new(&w));
+                    if per_pixel {
+                        let mut surfaces = PhongSurfaces::new(
+                            tris,
+                            sources,
+                            PhongShader::for_shading(&w, settings.shading),
+                        )
+                        .filtered(settings.texture_filter);
                         if !casters.is_empty() {
                             surfaces.shadows = Some(PolygonLights {
                                 casters,
@@ -347,6 +387,9 @@ impl PolygonScene {
                 ),
             ));
         }
+        if let Some(t) = self.textures_phrase() {
+            rows.push(("textures", t));
+        }
         if self.transparent_meshes > 0 {
             rows.push((
                 "note",
@@ -357,6 +400,40 @@ impl PolygonScene {
             ));
         }
         rows
+    }
+
+    /// The textures of a textured scene, and how pixels read them.
+    fn textures_phrase(&self) -> Option<String> {
+        let s = self.phong.as_ref().filter(|s| s.shader.textured())?;
+        let labels = self.texture_labels();
+        let how = match s.filter {
+            TextureFilter::Box => {
+                "box filter: each pixel the texture's mean over its footprint (summed-area table)"
+            }
+            TextureFilter::Point => "point sampling: each pixel the texel under its centre",
+        };
+        Some(format!(
+            "{} texture(s) ({}), {how}; every shade through the span fitter",
+            labels.len(),
+            labels.join(", ")
+        ))
+    }
+
+    /// Per textured mesh, `mesh K: LABEL W×H`.
+    fn texture_labels(&self) -> Vec<String> {
+        let Some(s) = &self.phong else {
+            return Vec::new();
+        };
+        (0..)
+            .map_while(|k| s.shader.mesh_texture(k))
+            .enumerate()
+            .filter_map(|(k, t)| {
+                t.map(|t| {
+                    let (w, h) = t.size();
+                    format!("mesh {k}: {} {w}×{h}", t.label())
+                })
+            })
+            .collect()
     }
 
     /// The host-side stage times: transform & lighting, visibility, shadows (when cast).
@@ -373,7 +450,7 @@ impl PolygonScene {
 
     /// The scene part of `--stats-json`: deterministic (no times, no paths).
     pub fn scene_json(&self) -> serde_json::Value {
-        serde_json::json!({
+        let mut json = serde_json::json!({
             "name": self.source.name(),
             "kind": self.kind,
             "polygons": self.screen.polygons.len(),
@@ -381,6 +458,11 @@ impl PolygonScene {
             "project": self.project,
             "exact_visibility": self.visibility,
             "shadows": self.shadows,
-        })
+        });
+        let textures = self.texture_labels();
+        if !textures.is_empty() {
+            json["textures"] = textures.into();
+        }
+        json
     }
 }

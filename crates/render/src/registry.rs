@@ -32,6 +32,9 @@ pub struct Entry {
     /// shading (`nishita`: a patch's row as one span), so `--shade-tolerance` applies to
     /// Gouraud and flat shading too, not to Phong alone.
     pub fits_rows: bool,
+    /// It draws textured meshes (a renderer that does not refuses a textured scene,
+    /// naming those that do).
+    pub textures: bool,
     /// The settings it reads (its module reads them in `build`); the command line
     /// refuses a flag given for any other.
     pub uses: &'static [Setting],
@@ -61,25 +64,52 @@ impl Entry {
                     flag = s.flag()
                 ));
             }
-            let fitted = s == Setting::ShadeTolerance && self.fits_rows && settings.aa.is_box();
+            // the span fitter's tolerance may serve a textured scene: decided with the scene
+            if s == Setting::ShadeTolerance {
+                continue;
+            }
             match s.idle_under(settings) {
-                Some((by, why)) if self.uses.contains(&by) && !fitted => return Err(why),
+                Some((by, why)) if self.uses.contains(&by) => return Err(why),
                 _ => {}
             }
         }
         Ok(())
     }
 
-    /// Refuses what the scene (called `name`) leaves nothing to do: a renderer of Bézier
-    /// patches on a scene without any (it would draw exactly as the default renderer); a
-    /// setting given for world scenes ([`Setting::world_only`]) on a screen scene; a
-    /// tessellation given for a scene without Bézier meshes.
+    /// Refuses what the scene (called `name`) leaves nothing to do, or what this
+    /// renderer cannot draw of it: a renderer of Bézier patches on a scene without any
+    /// (it would draw exactly as the default renderer); a textured scene for a renderer
+    /// that draws no textures; a setting given for world scenes ([`Setting::world_only`])
+    /// on a screen scene; a tessellation given for a scene without Bézier meshes; a
+    /// texture filter for a scene without textures; a span tolerance that `settings`
+    /// and the scene leave idle.
     pub fn check_scene(
         &self,
         given: &[Setting],
         scene: &AnyScene,
         name: &str,
+        settings: &Settings,
     ) -> Result<(), String> {
+        let textured = scene.is_textured();
+        if textured && !self.textures {
+            let users: Vec<&str> = REGISTRY
+                .iter()
+                .filter(|e| e.textures)
+                .map(|e| e.name)
+                .collect();
+            return Err(format!(
+                "{} does not draw textures yet, and {name} has textured meshes: use --renderer {}",
+                self.name,
+                users.join(" or --renderer ")
+            ));
+        }
+        if given.contains(&Setting::ShadeTolerance) && self.uses.contains(&Setting::Shading) {
+            let fitted = (self.fits_rows && settings.aa.is_box()) || textured;
+            match Setting::ShadeTolerance.idle_under(settings) {
+                Some((_, why)) if !fitted => return Err(format!("{why}; {name} has no texture")),
+                _ => {}
+            }
+        }
         if self.patches && !scene.has_patches() {
             return Err(format!(
                 "--renderer {} draws Bézier patches, and {name} has none: it would draw exactly as {DEFAULT_RENDERER}; use --renderer {DEFAULT_RENDERER}",
@@ -96,6 +126,11 @@ impl Entry {
             if s == Setting::Tessellate && !scene.has_patches() {
                 return Err(format!(
                     "--tessellate applies to Bézier meshes; {name} has none"
+                ));
+            }
+            if s == Setting::TextureFilter && !textured && !matches!(scene, AnyScene::Screen(_)) {
+                return Err(format!(
+                    "--texture-filter applies to textured meshes; {name} has none (a material's \"texture\" gives one)"
                 ));
             }
         }
@@ -116,6 +151,7 @@ pub const REGISTRY: &[Entry] = &[
         patches: false,
         progressive: false,
         fits_rows: false,
+        textures: true,
         uses: &[
             Setting::Shading,
             Setting::Aa,
@@ -125,6 +161,7 @@ pub const REGISTRY: &[Entry] = &[
             Setting::ShadeTolerance,
             Setting::Tessellate,
             Setting::Shadows,
+            Setting::TextureFilter,
         ],
         draws: "it draws trapezia with the box filter or point sampling",
     },
@@ -136,6 +173,7 @@ pub const REGISTRY: &[Entry] = &[
         patches: false,
         progressive: false,
         fits_rows: false,
+        textures: true,
         uses: &[
             Setting::Shading,
             Setting::Size,
@@ -159,6 +197,7 @@ pub const REGISTRY: &[Entry] = &[
         patches: false,
         progressive: false,
         fits_rows: false,
+        textures: true,
         uses: &[
             Setting::Shading,
             Setting::Size,
@@ -181,6 +220,7 @@ pub const REGISTRY: &[Entry] = &[
         patches: false,
         progressive: false,
         fits_rows: false,
+        textures: true,
         uses: &[
             Setting::Shading,
             Setting::Size,
@@ -204,6 +244,7 @@ pub const REGISTRY: &[Entry] = &[
         patches: true,
         progressive: false,
         fits_rows: true,
+        textures: true,
         uses: &[
             Setting::Shading,
             Setting::Aa,
@@ -213,6 +254,7 @@ pub const REGISTRY: &[Entry] = &[
             Setting::Flatness,
             Setting::Band,
             Setting::Subscan,
+            Setting::TextureFilter,
         ],
         draws: "it cuts Bézier patches into pieces at most a row high, which no Eval0 claim could cover, and box-filters the exact visible ones as vanrij does",
     },
@@ -224,6 +266,7 @@ pub const REGISTRY: &[Entry] = &[
         patches: false,
         progressive: true,
         fits_rows: false,
+        textures: false,
         uses: &[
             Setting::Size,
             Setting::ShadeTolerance,
@@ -295,34 +338,48 @@ mod tests {
             vanrij.check_given(&[Setting::Shading, Setting::Samples], &settings),
             Err("--samples is not used by vanrij (it draws trapezia with the box filter or point sampling; --samples is for woo-chall, sbuffer, bsp)".into())
         );
+        let scene = |name: &str| {
+            crate::Source::resolve(Some(name.as_ref()))
+                .unwrap()
+                .load(None)
+                .unwrap()
+                .scene
+        };
+        let (pot, teapot) = (scene("pot"), scene("teapot"));
         // idle only where the renderer reads the setting that decides
         let gouraud = [Setting::ShadeTolerance];
-        assert!(vanrij.check_given(&gouraud, &settings).is_err());
+        assert_eq!(vanrij.check_given(&gouraud, &settings), Ok(()));
+        assert!(vanrij
+            .check_scene(&gouraud, &pot, "pot", &settings)
+            .unwrap_err()
+            .contains("pot has no texture"));
         assert_eq!(
-            find("refine").unwrap().check_given(&gouraud, &settings),
+            find("refine")
+                .unwrap()
+                .check_scene(&gouraud, &pot, "pot", &settings),
             Ok(())
         );
         // nishita fits a patch's row as one span under the box filter, whatever the shading
         let nishita = find("nishita").unwrap();
-        assert_eq!(nishita.check_given(&gouraud, &settings), Ok(()));
+        assert_eq!(
+            nishita.check_scene(&gouraud, &teapot, "teapot", &settings),
+            Ok(())
+        );
         let point = Settings {
             aa: cwisim_scene::Antialias::None,
             ..Settings::default()
         };
-        assert!(nishita.check_given(&gouraud, &point).is_err());
-        let pot = crate::Source::resolve(None)
-            .unwrap()
-            .load(None)
-            .unwrap()
-            .scene;
-        assert_eq!(vanrij.check_scene(&[], &pot, "pot"), Ok(()));
+        assert!(nishita
+            .check_scene(&gouraud, &teapot, "teapot", &point)
+            .is_err());
+        assert_eq!(vanrij.check_scene(&[], &pot, "pot", &settings), Ok(()));
         assert!(find("nishita")
             .unwrap()
-            .check_scene(&[], &pot, "pot")
+            .check_scene(&[], &pot, "pot", &settings)
             .unwrap_err()
             .contains("it would draw exactly as vanrij"));
         assert!(vanrij
-            .check_scene(&[Setting::Tessellate], &pot, "pot")
+            .check_scene(&[Setting::Tessellate], &pot, "pot", &settings)
             .is_err());
     }
 }

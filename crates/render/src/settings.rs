@@ -4,6 +4,7 @@
 use crate::cp::Increment;
 use crate::subsample::Grid;
 use cwisim_scene::{Antialias, Shading};
+use cwisim_world::texture::TextureFilter;
 use cwisim_world::Visibility;
 use std::fmt;
 use std::str::FromStr;
@@ -105,6 +106,9 @@ pub struct Settings {
     /// Shadows: `None` as each light of the scene says (`"shadows": true`), `Some(true)`
     /// every light casts them, `Some(false)` none does (`render --shadows on|off`).
     pub shadows: Option<bool>,
+    /// Textured scenes: how a pixel reads a texture (the mean over its footprint, or the
+    /// texel under its centre).
+    pub texture_filter: TextureFilter,
     /// Threads the host-side preparation may use (exact visibility; 0: one per core).
     /// The polygons are the same, bit for bit, at any count. `render --threads N` sets
     /// it with the pipeline's.
@@ -166,11 +170,13 @@ pub enum Setting {
     PhongAngle,
     /// [`Settings::shadows`].
     Shadows,
+    /// [`Settings::texture_filter`].
+    TextureFilter,
 }
 
 impl Setting {
     /// Every setting, in the order of the command line's drawing flags.
-    pub const ALL: [Setting; 25] = [
+    pub const ALL: [Setting; 26] = [
         Setting::Shading,
         Setting::Aa,
         Setting::Visibility,
@@ -196,6 +202,7 @@ impl Setting {
         Setting::AaThreshold,
         Setting::PhongAngle,
         Setting::Shadows,
+        Setting::TextureFilter,
     ];
 
     /// Its flag: `--samples`.
@@ -226,6 +233,7 @@ impl Setting {
             Setting::AaThreshold => "--aa-threshold",
             Setting::PhongAngle => "--phong-angle",
             Setting::Shadows => "--shadows",
+            Setting::TextureFilter => "--texture-filter",
         }
     }
 
@@ -298,6 +306,10 @@ impl Setting {
                     _ => return Err(format!("expected on or off, found `{value}`")),
                 })
             }
+            Setting::TextureFilter => {
+                s.texture_filter = TextureFilter::of_name(value.trim())
+                    .ok_or_else(|| format!("expected box or point, found `{value}`"))?
+            }
         }
         Ok(())
     }
@@ -314,6 +326,7 @@ impl Setting {
                 | Setting::AaThreshold
                 | Setting::PhongAngle
                 | Setting::Shadows
+                | Setting::TextureFilter
         )
     }
 
@@ -325,7 +338,7 @@ impl Setting {
         match self {
             Setting::ShadeTolerance if s.shading != Shading::Phong => why(
                 Setting::Shading,
-                "--shade-tolerance is the span fitter's, used with --shading phong only (and by nishita under the box filter)",
+                "--shade-tolerance is the span fitter's, used with --shading phong, on textured meshes, and by nishita under the box filter",
             ),
             Setting::Eval0Tolerance
                 if !(s.visibility == Visibility::Eval0 && s.shading == Shading::Gouraud) =>
@@ -526,6 +539,7 @@ impl Default for Settings {
             aa_threshold: Threshold::Above(DEFAULT_AA_THRESHOLD),
             phong_angle: Threshold::Above(DEFAULT_PHONG_ANGLE),
             shadows: None,
+            texture_filter: TextureFilter::Box,
             threads: 1,
         }
     }

@@ -13,6 +13,8 @@
 //!   the full-quality image and the naive sequence; [`refine_report`] its table, CSV and
 //!   sweeps, [`refine_plot`] its chart.
 //! * [`fit`] — the narrowest fixed-point registers within an error budget.
+//! * [`texture_cost`] — what a texture's frequency costs the array, against the filter
+//!   and the span tolerance, with its chart.
 //! * [`history`] — one pixel's history: every instruction that reached it on a scanline,
 //!   registers before and after; [`vcd`] — a scanline's per-cycle waveform as a Value
 //!   Change Dump; both from the cycle-stepped engine's probe. [`until`] ends a trace
@@ -36,6 +38,7 @@ pub mod refine;
 pub mod refine_ids;
 pub mod refine_plot;
 pub mod refine_report;
+pub mod texture_cost;
 pub mod tradeoff;
 pub mod tradeoff_plot;
 pub mod until;

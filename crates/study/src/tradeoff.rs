@@ -149,6 +149,10 @@ pub struct Axes {
     /// The shadows axis, for the renderers that draw shadows: each value a
     /// `Settings::shadows` to try (empty: as the scene says, one value).
     pub shadows: Vec<Option<bool>>,
+    /// A mesh of the scene is textured: every shading is drawn per pixel (exact
+    /// visibility, the per-pixel box filter), by the renderers that draw textures, and
+    /// measured against its own best image.
+    pub textured: bool,
 }
 
 /// The root tolerances of a renderer that draws Bézier patches directly (Nishita et
@@ -168,7 +172,7 @@ pub fn grid(
     formats: &[Numeric],
 ) -> Vec<Setting> {
     let mut out = Vec::new();
-    let visibilities: &[Visibility] = if axes.world {
+    let visibilities: &[Visibility] = if axes.world && !axes.textured {
         &[Visibility::Exact, Visibility::Eval0]
     } else {
         &[Visibility::Exact]
@@ -220,6 +224,9 @@ fn skipped(renderer: &registry::Entry, axes: &Axes) -> Option<String> {
     // axis's `off` rows)
     if axes.casting && !renderer.uses.contains(&Flag::Shadows) {
         return Some("it does not draw shadows, and the scene's lights cast them".into());
+    }
+    if axes.textured && !renderer.textures {
+        return Some("it does not draw textures, and the scene has textured meshes".into());
     }
     None
 }
@@ -292,7 +299,10 @@ fn grid_of(
                     // the report's box filter differs from the exact one only where
                     // the intensity varies over a polygon: Gouraud; Phong's box filter is
                     // the report's alone (`--aa box` is refused with Phong)
+                    // (a textured mesh's every shading is per pixel, as Phong's: its box
+                    // filter is the report's alone)
                     let filters: &[Antialias] = match shading {
+                        _ if axes.textured => &[Antialias::BoxCentre],
                         Shading::Gouraud => &[Antialias::Box, Antialias::BoxCentre],
                         _ => &[box_filter(shading)],
                     };
@@ -415,13 +425,16 @@ pub fn exact_image(scene: Option<&Path>, size: Option<Size>) -> Result<Vec<f64>,
 /// Phong, Phong's own best image — its box filter (`box-centre`), span tolerance 0 (the
 /// per-pixel value at every centre a triangle covers whole), `f64` registers — so that a
 /// Phong row's error is what its span tolerance, point sampling and register format add.
+/// On a textured scene every shading is drawn per pixel, as Phong is, and measured so
+/// against its own best image (with the texture's box filter).
 pub fn reference_image(scene: Option<&Path>, setting: &Settings) -> Result<Vec<f64>, StudyError> {
     let loaded = Source::resolve(scene)?.load_for(setting)?;
-    if setting.shading == Shading::Phong {
+    if setting.shading == Shading::Phong || loaded.scene.is_textured() {
         let best = Settings {
             aa: box_filter(Shading::Phong),
             visibility: Visibility::Exact,
             shade_tolerance: 0.0,
+            texture_filter: cwisim_world::texture::TextureFilter::Box,
             ..*setting
         };
         let renderer = cwisim_render::vanrij::VanRij::new(loaded, &best)?;
@@ -623,6 +636,7 @@ impl Plan {
                 Vec::new()
             },
             patches: probe.has_patches(),
+            textured: probe.is_textured(),
         };
         let settings = grid(&entries, &axes, formats);
         Ok(Plan {
@@ -663,7 +677,9 @@ impl Plan {
             .iter()
             .zip(measured)
             .map(|(setting, (measured, times))| {
-                let reference = self.references.get(scene, setting, self.axes.world)?;
+                let reference =
+                    self.references
+                        .get(scene, setting, self.axes.world, self.axes.textured)?;
                 Ok(row_of(setting, &measured, &times, &reference, &self.axes))
             })
             .collect()
@@ -826,8 +842,9 @@ struct References {
     made: std::sync::Mutex<BTreeMap<ReferenceKey, Reference>>,
 }
 
-/// What tells references apart: Phong's or Gouraud's, the tessellation, the shadows.
-type ReferenceKey = (bool, Option<u32>, Option<bool>);
+/// What tells references apart: the exact Gouraud image or a shading's own best (Phong's,
+/// or any shading's on a textured scene), the tessellation, the shadows.
+type ReferenceKey = (Option<String>, Option<u32>, Option<bool>);
 
 type Reference = std::sync::Arc<std::sync::Mutex<Option<std::sync::Arc<Vec<f64>>>>>;
 
@@ -840,10 +857,12 @@ impl References {
         scene: Option<&Path>,
         setting: &Setting,
         world: bool,
+        textured: bool,
     ) -> Result<std::sync::Arc<Vec<f64>>, StudyError> {
         let tessellation = reference_tessellation(setting, world);
+        let shading = setting.settings.shading;
         let key = (
-            setting.settings.shading == Shading::Phong,
+            (shading == Shading::Phong || textured).then(|| shading.to_string()),
             tessellation,
             setting.settings.shadows,
         );
@@ -1646,7 +1665,11 @@ mod tests {
                     parsed.shadows = Some(row.shadows == "on");
                 }
                 assert_eq!(entry.check_given(&given, &parsed), Ok(()), "{what}");
-                assert_eq!(entry.check_scene(&given, scene, name), Ok(()), "{what}");
+                assert_eq!(
+                    entry.check_scene(&given, scene, name, &parsed),
+                    Ok(()),
+                    "{what}"
+                );
                 assert_eq!(parsed, setting.settings, "{what}");
                 if row.shading == "phong" {
                     phong += 1;
@@ -1860,5 +1883,44 @@ mod tests {
         assert_eq!(a.stats.totals.opcodes, b.stats.totals.opcodes);
         let busy = |m: &Measured| -> u64 { m.stats.lines.iter().map(|l| l.busy_cycles).sum() };
         assert_eq!(busy(&a), busy(&b));
+    }
+
+    #[test]
+    fn a_textured_scene_is_measured_per_pixel_against_each_shading_s_own_best_image() {
+        let rows = tradeoff_rows(
+            Some(Path::new("textures4")),
+            Some(Size {
+                width: 40,
+                height: 30,
+            }),
+            &[],
+            &[],
+            &["vanrij".to_string(), "woo-chall".to_string()],
+            &[Numeric::F64],
+            &Machine::default(),
+            1,
+            1,
+            &mut |_| {},
+        )
+        .unwrap();
+        // exact visibility only (eval0 claims hold one value per run), the per-pixel box
+        // filter (box-centre) or point sampling, every shading
+        assert!(rows
+            .iter()
+            .all(|r| r.visibility != "eval0" && r.aa != "box"));
+        for shading in ["flat", "gouraud", "phong"] {
+            let best = rows
+                .iter()
+                .find(|r| r.renderer == "vanrij" && r.shading == shading && r.aa == "box-centre")
+                .unwrap_or_else(|| panic!("{shading}"));
+            // the default span tolerance against tolerance 0: small, not nothing
+            assert!(
+                best.max_error < 8.0 / 512.0,
+                "{shading}: {}",
+                best.max_error
+            );
+        }
+        assert!(rows.iter().any(|r| r.renderer == "woo-chall"));
+        assert!(rows.iter().all(|r| r.rms_error.is_finite()));
     }
 }

@@ -49,6 +49,16 @@ pub const EMBEDDED: &[Embedded] = &[
         about: "world, grey, 500×500: the teapot standing on a floor, its light casting the teapot's shadow (Nishita et al.'s §7 scene; vanrij draws the shadows, nishita refuses them on patches)",
         text: include_str!("../scenes/teapot-floor.json"),
     },
+    Embedded {
+        name: "teapot-textured",
+        about: "world, grey, 500×500: the teapot with a 4×4 checkerboard on each patch, in the patch's own (u, v) (Nishita et al.'s figure 10b; drawn by vanrij)",
+        text: include_str!("../scenes/teapot-textured.json"),
+    },
+    Embedded {
+        name: "textures4",
+        about: "world, RGB, 400×300: four textured objects (two pictures, a striped vase, a rug) placed so that at most three share a scanline — Woo & Chall's figure 10 case: four textures, memory for three (woo-chall loads and frees them in scanline order)",
+        text: include_str!("../scenes/textures4.json"),
+    },
 ];
 
 /// The embedded scene called `name`.

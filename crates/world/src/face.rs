@@ -40,6 +40,8 @@ pub struct Surface {
     pub world: [glam::DVec3; 3],
     /// Unit shading normals at the three corners.
     pub normals: [glam::DVec3; 3],
+    /// Texture coordinates `(u, v)` at the three corners (zero for a mesh without them).
+    pub uv: [[f64; 2]; 3],
 }
 
 impl ScreenTriangle {

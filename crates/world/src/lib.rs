@@ -20,6 +20,8 @@
 //!
 //! - [`bezier`] — bicubic Bézier patches (the Utah teapot), evaluated and tessellated.
 //! - [`clip`] — Bézier clipping: the roots of a curve in Bernstein form (Nishita et al.).
+//! - [`texture`] — textures (PNG images, checkerboards) and their summed-area tables;
+//!   [`shade`] looks them up at a pixel.
 
 #![warn(missing_docs)]
 
@@ -36,6 +38,7 @@ pub mod project;
 pub mod scene;
 pub mod shade;
 pub mod shadow;
+pub mod texture;
 pub mod visibility;
 
 use cwisim_scene::Shading;
@@ -51,6 +54,8 @@ pub const KINDS: &[&str] = &["screen", "world"];
 
 /// A scene of any kind.
 #[derive(Clone, Debug, PartialEq)]
+// one scene per run: its size on the stack does not matter
+#[allow(clippy::large_enum_variant)]
 pub enum AnyScene {
     /// Polygons in screen space.
     Screen(ScreenScene),
@@ -72,6 +77,14 @@ impl AnyScene {
         match self {
             AnyScene::Screen(s) => (s.width, s.height),
             AnyScene::World(w) => (w.width(), w.height()),
+        }
+    }
+
+    /// Whether a mesh of it has a texture.
+    pub fn is_textured(&self) -> bool {
+        match self {
+            AnyScene::Screen(_) => false,
+            AnyScene::World(w) => w.textures.iter().any(Option::is_some),
         }
     }
 

@@ -48,21 +48,8 @@ impl Lighting {
         eye: DVec3,
         reaches: impl Fn(usize) -> bool,
     ) -> Vector {
-        let v = (eye - point).normalize_or_zero();
         let mut out = vector(self.channels, |c| self.ambient.get(c) * m.k_a.get(c));
-        for (k, light) in self.lights.iter().enumerate() {
-            if !reaches(k) {
-                continue;
-            }
-            let l = (DVec3::from_array(light.position) - point).normalize_or_zero();
-            let n_dot_l = normal.dot(l);
-            if n_dot_l <= 0.0 {
-                continue;
-            }
-            let r = 2.0 * n_dot_l * normal - l;
-            // at most 1 (rounding can give 1 + 2^-52, which a large exponent `n` would
-            // raise to infinity): `(R·V)^n` is then in [0, 1] for every `n ≥ 0`
-            let r_dot_v = r.dot(v).min(1.0);
+        for (light, n_dot_l, r_dot_v) in self.facing(point, normal, eye, reaches) {
             for (c, value) in out.iter_mut().enumerate().take(self.channels) {
                 let specular = if r_dot_v > 0.0 && m.k_s.get(c) != 0.0 {
                     m.k_s.get(c) * r_dot_v.powf(m.n)
@@ -73,6 +60,57 @@ impl Lighting {
             }
         }
         out
+    }
+
+    /// The lights `reaches` says reach `point` that face it (`N·L > 0`), each with `N·L`
+    /// and `R·V` (at most 1: rounding can give 1 + 2^-52, which a large exponent `n`
+    /// would raise to infinity, so `(R·V)^n` is in [0, 1] for every `n ≥ 0`).
+    fn facing(
+        &self,
+        point: DVec3,
+        normal: DVec3,
+        eye: DVec3,
+        reaches: impl Fn(usize) -> bool,
+    ) -> impl Iterator<Item = (&LightSpec, f64, f64)> {
+        let v = (eye - point).normalize_or_zero();
+        self.lights
+            .iter()
+            .enumerate()
+            .filter(move |(k, _)| reaches(*k))
+            .filter_map(move |(_, light)| {
+                let l = (DVec3::from_array(light.position) - point).normalize_or_zero();
+                let n_dot_l = normal.dot(l);
+                if n_dot_l <= 0.0 {
+                    return None;
+                }
+                let r = 2.0 * n_dot_l * normal - l;
+                Some((light, n_dot_l, r.dot(v).min(1.0)))
+            })
+    }
+
+    /// [`Self::intensity_lit`] in two parts, `(ambient + diffuse, specular)`: what a
+    /// texture scales (it multiplies `k_a` and `k_d`) and what it leaves. Their sum is the
+    /// intensity up to rounding.
+    pub fn intensity_split(
+        &self,
+        m: &Material,
+        point: DVec3,
+        normal: DVec3,
+        eye: DVec3,
+        reaches: impl Fn(usize) -> bool,
+    ) -> (Vector, Vector) {
+        let mut diffuse = vector(self.channels, |c| self.ambient.get(c) * m.k_a.get(c));
+        let mut specular = Vector::default();
+        for (light, n_dot_l, r_dot_v) in self.facing(point, normal, eye, reaches) {
+            for c in 0..self.channels {
+                let i = light.intensity.get(c);
+                diffuse[c] += i * m.k_d.get(c) * n_dot_l;
+                if r_dot_v > 0.0 && m.k_s.get(c) != 0.0 {
+                    specular[c] += i * m.k_s.get(c) * r_dot_v.powf(m.n);
+                }
+            }
+        }
+        (diffuse, specular)
     }
 }
 
@@ -123,6 +161,7 @@ mod tests {
             k_s: PerChannel::All(0.4),
             n: 10.0,
             transmittance: 0.0,
+            texture: None,
         }
     }
 

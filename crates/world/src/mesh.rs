@@ -26,6 +26,8 @@ pub struct Face {
     pub corners: Vec<u32>,
     /// The shading normal at each corner (unit length).
     pub normals: Vec<DVec3>,
+    /// The texture coordinates `(u, v)` at each corner; empty when the mesh has none.
+    pub uv: Vec<[f64; 2]>,
 }
 
 impl Face {
@@ -47,6 +49,11 @@ pub struct Mesh {
 }
 
 impl Mesh {
+    /// Whether its faces carry texture coordinates (all of them do, or none).
+    pub fn has_uv(&self) -> bool {
+        self.faces.first().is_some_and(|f| !f.uv.is_empty())
+    }
+
     /// Triangles after fanning every face.
     pub fn triangle_count(&self) -> usize {
         self.faces.iter().map(|f| f.corners.len() - 2).sum()
@@ -93,6 +100,8 @@ pub(crate) struct Raw {
     pub positions: Vec<DVec3>,
     pub faces: Vec<Vec<u32>>,
     pub normals: Option<Vec<Vec<DVec3>>>,
+    /// Texture coordinates per face corner, when the source gives them.
+    pub uv: Option<Vec<Vec<[f64; 2]>>>,
 }
 
 /// Builds mesh `k` of a scene.
@@ -187,7 +196,8 @@ pub fn build(spec: &MeshSpec, k: usize, base: Option<&Path>) -> Result<Mesh, Bui
         }
         areas.push(n);
     }
-    let faces = match raw.normals {
+    let uv = raw.uv;
+    let mut faces: Vec<Face> = match raw.normals {
         Some(given) => raw
             .faces
             .into_iter()
@@ -198,10 +208,16 @@ pub fn build(spec: &MeshSpec, k: usize, base: Option<&Path>) -> Result<Mesh, Bui
                     .into_iter()
                     .map(|n| (normal_matrix * n).normalize_or_zero())
                     .collect(),
+                uv: Vec::new(),
             })
             .collect(),
         None => smooth_normals(raw.faces, &areas, positions.len(), spec.crease_angle),
     };
+    if let Some(uv) = uv {
+        for (face, corners) in faces.iter_mut().zip(uv) {
+            face.uv = corners;
+        }
+    }
     for (f, face) in faces.iter().enumerate() {
         if face
             .normals
@@ -288,7 +304,11 @@ fn smooth_normals(
                     sum.normalize_or(unit[f])
                 })
                 .collect();
-            Face { corners, normals }
+            Face {
+                corners,
+                normals,
+                uv: Vec::new(),
+            }
         })
         .collect()
 }
@@ -356,10 +376,45 @@ fn inline(spec: &MeshSpec, k: usize) -> Result<Raw, BuildError> {
             )
         }
     };
+    let uv = match &spec.uv {
+        None => None,
+        Some(uv) => {
+            if uv.len() != vertices.len() {
+                return Err(BuildError::Scene(SceneError::at_field(
+                    SceneErrorKind::Shape,
+                    format!("meshes[{k}].uv"),
+                    format!(
+                        "expected one [u, v] per vertex ({}), found {}",
+                        vertices.len(),
+                        uv.len()
+                    ),
+                )));
+            }
+            for (i, t) in uv.iter().enumerate() {
+                if !t
+                    .iter()
+                    .all(|x| x.is_finite() && x.abs() <= crate::scene::MAX_WORLD_COORDINATE)
+                {
+                    return Err(BuildError::Scene(SceneError::at_field(
+                        SceneErrorKind::Limit,
+                        format!("meshes[{k}].uv[{i}]"),
+                        format!("expected finite texture coordinates within ±1e9, found {t:?}"),
+                    )));
+                }
+            }
+            Some(
+                out_faces
+                    .iter()
+                    .map(|corners| corners.iter().map(|&c| uv[c as usize]).collect())
+                    .collect(),
+            )
+        }
+    };
     Ok(Raw {
         positions: vertices.iter().map(|v| DVec3::from_array(*v)).collect(),
         faces: out_faces,
         normals,
+        uv,
     })
 }
 
@@ -386,15 +441,27 @@ fn bezier(b: &BezierSource, k: usize) -> Result<Raw, BuildError> {
         positions: Vec::new(),
         faces: Vec::new(),
         normals: Some(Vec::new()),
+        uv: Some(Vec::new()),
     };
     let normals = raw.normals.as_mut().expect("set above");
+    let uv = raw.uv.as_mut().expect("set above");
     for patch in &patches {
         let grid = tessellate(patch, b.tessellate as usize);
         let base = raw.positions.len() as u32;
         raw.positions.extend(&grid.points);
+        // vertex (i, k) of the grid lies at the patch's (u, v) = (i/n, k/n)
+        let n = grid.n;
+        let at = |index: u32| {
+            let index = index as usize;
+            [
+                (index % (n + 1)) as f64 / n as f64,
+                (index / (n + 1)) as f64 / n as f64,
+            ]
+        };
         for t in &grid.triangles {
             raw.faces.push(t.iter().map(|&i| base + i).collect());
             normals.push(t.iter().map(|&i| grid.normals[i as usize]).collect());
+            uv.push(t.iter().map(|&i| at(i)).collect());
         }
     }
     Ok(raw)
@@ -467,29 +534,47 @@ pub(crate) fn revolution(r: &Revolution, k: usize) -> Result<Raw, BuildError> {
             rings[i] + (j % s) as u32
         }
     };
+    // texture coordinates: u the angle over a full turn, v the length along the profile
+    // over its whole length
+    let mut along = vec![0.0f64];
+    for w in r.profile.windows(2) {
+        let last = *along.last().expect("starts with 0");
+        along.push(last + (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]));
+    }
+    let total = *along.last().expect("at least 2 points");
+    let uv_at = |i: usize, j: usize| [j as f64 / s as f64, along[i] / total];
     let mut faces = Vec::new();
+    let mut uvs = Vec::new();
     for i in 0..r.profile.len() - 1 {
         let (p, q) = (r.profile[i], r.profile[i + 1]);
         for j in 0..s {
-            let mut face: Vec<u32> = vec![at(i, j), at(i, j + 1), at(i + 1, j + 1), at(i + 1, j)];
-            face.dedup();
-            if face.first() == face.last() {
-                face.pop();
+            let mut corners: Vec<(u32, [f64; 2])> =
+                [(i, j), (i, j + 1), (i + 1, j + 1), (i + 1, j)]
+                    .map(|(a, b)| (at(a, b), uv_at(a, b)))
+                    .to_vec();
+            corners.dedup_by_key(|c| c.0);
+            if corners.first().map(|c| c.0) == corners.last().map(|c| c.0) {
+                corners.pop();
             }
+            let mut face: Vec<u32> = corners.iter().map(|c| c.0).collect();
+            let mut uv: Vec<[f64; 2]> = corners.iter().map(|c| c.1).collect();
             // orient: the outward normal of the profile segment, turned to this segment
             let a = std::f64::consts::TAU * (j as f64 + 0.5) / s as f64;
             let (dr, dh) = (q[0] - p[0], q[1] - p[1]);
             let expected = DVec3::new(dh * a.cos(), -dr, -dh * a.sin());
             if newell(&face, &positions).dot(expected) < 0.0 {
                 face.reverse();
+                uv.reverse();
             }
             faces.push(face);
+            uvs.push(uv);
         }
     }
     Ok(Raw {
         positions,
         faces,
         normals: None,
+        uv: Some(uvs),
     })
 }
 
@@ -507,6 +592,7 @@ mod tests {
                 k_s: PerChannel::All(0.0),
                 n: 1.0,
                 transmittance: 0.0,
+                texture: None,
             },
             two_sided: false,
             crease_angle: 50.0,
@@ -517,6 +603,7 @@ mod tests {
             obj: None,
             revolution: None,
             bezier: None,
+            uv: None,
         }
     }
 

@@ -1,9 +1,9 @@
 //! Wavefront OBJ meshes, read with `tobj`.
 //!
-//! Positions (`v`), faces (`f`, any number of corners, negative indices allowed) and
-//! normals (`vn`, used when every corner of the file names one) are read; texture
-//! coordinates, materials (`mtllib`, `usemtl`: the scene gives the material), points and
-//! lines are ignored. All objects and groups of the file become one mesh.
+//! Positions (`v`), faces (`f`, any number of corners, negative indices allowed),
+//! normals (`vn`, used when every corner of the file names one) and texture coordinates
+//! (`vt`, likewise) are read; materials (`mtllib`, `usemtl`: the scene gives the material),
+//! points and lines are ignored. All objects and groups of the file become one mesh.
 //!
 //! `tobj` stops at the first bad line but does not say which; this module counts the
 //! lines it hands to `tobj`, so every error names the file and line.
@@ -75,12 +75,13 @@ fn error(path: &Path, line: Option<u64>, message: String) -> SceneError {
 
 /// The first `f` line naming a vertex or normal that is not defined before it.
 fn first_bad_index(text: &str) -> Option<u64> {
-    let (mut v, mut vn) = (0i64, 0i64);
+    let (mut v, mut vt, mut vn) = (0i64, 0i64, 0i64);
     for (n, line) in text.lines().enumerate() {
         let mut words = line.split_whitespace();
         match words.next() {
             Some("v") => v += 1,
             Some("vn") => vn += 1,
+            Some("vt") => vt += 1,
             Some("f") => {
                 for corner in words {
                     let mut parts = corner.split('/');
@@ -90,8 +91,8 @@ fn first_bad_index(text: &str) -> Option<u64> {
                             .map_or(true, |i| i == 0 || i > count || -i > count),
                         _ => false,
                     };
-                    let (pv, _, pn) = (parts.next(), parts.next(), parts.next());
-                    if bad(pv, v) || bad(pn, vn) {
+                    let (pv, pt, pn) = (parts.next(), parts.next(), parts.next());
+                    if bad(pv, v) || bad(pt, vt) || bad(pn, vn) {
                         return Some(n as u64 + 1);
                     }
                 }
@@ -143,7 +144,9 @@ pub(crate) fn read(path: &Path) -> Result<Raw, SceneError> {
             let counted = Some(reader.newlines + u64::from(reader.partial));
             let out_of_bounds = matches!(
                 e,
-                tobj::LoadError::FaceVertexOutOfBounds | tobj::LoadError::FaceNormalOutOfBounds
+                tobj::LoadError::FaceVertexOutOfBounds
+                    | tobj::LoadError::FaceTexCoordOutOfBounds
+                    | tobj::LoadError::FaceNormalOutOfBounds
             );
             let line = if reader.at_end && out_of_bounds {
                 // tobj checks indices only once the whole file is read: find the face.
@@ -159,6 +162,12 @@ pub(crate) fn read(path: &Path) -> Result<Raw, SceneError> {
                 }
                 tobj::LoadError::NormalParseError => {
                     "expected a normal `vn x y z` with 3 numbers".into()
+                }
+                tobj::LoadError::TexcoordParseError => {
+                    "expected texture coordinates `vt u v` with 2 (or 3) numbers".into()
+                }
+                tobj::LoadError::FaceTexCoordOutOfBounds => {
+                    "a face names texture coordinates that are not defined before them".into()
                 }
                 tobj::LoadError::FaceParseError | tobj::LoadError::InvalidPolygon => {
                     "expected a face `f i j k …` of vertex indices (v, v/t, v//n or v/t/n)".into()
@@ -187,7 +196,9 @@ pub(crate) fn read(path: &Path) -> Result<Raw, SceneError> {
     let mut faces = Vec::new();
     let mut normals: Vec<Vec<DVec3>> = Vec::new();
     let mut all_have_normals = true;
-    let (mut v_seen, mut vn_seen) = (0usize, 0usize);
+    let mut uvs: Vec<Vec<[f64; 2]>> = Vec::new();
+    let mut all_have_uv = true;
+    let (mut v_seen, mut vn_seen, mut vt_seen) = (0usize, 0usize, 0usize);
     for model in &models {
         let m = &model.mesh;
         let base = positions.len() as u32;
@@ -229,10 +240,36 @@ pub(crate) fn read(path: &Path) -> Result<Raw, SceneError> {
         };
         let has_normals = m.normal_indices.len() == m.indices.len() && !mesh_normals.is_empty();
         all_have_normals &= has_normals;
+        let has_uv = m.texcoord_indices.len() == m.indices.len() && !m.texcoords.is_empty();
+        all_have_uv &= has_uv;
+        if has_uv {
+            if let Some(bad) = m.texcoords.iter().position(|x| !x.is_finite()) {
+                return Err(SceneError {
+                    kind: SceneErrorKind::NonFinite,
+                    ..error(
+                        path,
+                        statement_line("vt", vt_seen + bad / 2),
+                        "expected finite texture coordinates".into(),
+                    )
+                });
+            }
+        }
+        vt_seen += m.texcoords.len() / 2;
         let mut at = 0usize;
         for arity in arities {
             let range = at..at + arity as usize;
             faces.push(m.indices[range.clone()].iter().map(|i| base + i).collect());
+            if has_uv {
+                uvs.push(
+                    m.texcoord_indices[range.clone()]
+                        .iter()
+                        .map(|&t| {
+                            let t = t as usize;
+                            [m.texcoords[2 * t], m.texcoords[2 * t + 1]]
+                        })
+                        .collect(),
+                );
+            }
             if has_normals {
                 normals.push(
                     m.normal_indices[range]
@@ -248,6 +285,7 @@ pub(crate) fn read(path: &Path) -> Result<Raw, SceneError> {
         positions,
         faces,
         normals: (all_have_normals && !normals.is_empty()).then_some(normals),
+        uv: (all_have_uv && !uvs.is_empty()).then_some(uvs),
     })
 }
 

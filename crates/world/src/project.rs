@@ -130,7 +130,16 @@ pub fn project(
                     Some((_, n)) => [toward * n; 3],
                     None => tri.map(|c| toward * face.normals[c]),
                 };
-                let surface = Surface { world: p, normals };
+                let uv = if face.uv.is_empty() {
+                    [[0.0; 2]; 3]
+                } else {
+                    tri.map(|c| face.uv[c])
+                };
+                let surface = Surface {
+                    world: p,
+                    normals,
+                    uv,
+                };
                 let centroid = flat.map(|(centroid, _)| centroid);
                 let intensity =
                     lit_corners(&lighting, material, centroid, &surface, camera.eye, |_| {

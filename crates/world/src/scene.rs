@@ -71,7 +71,7 @@ impl PerChannel {
     /// Checks the shape (one number, or `channels`), that every value is finite, at least
     /// `min` and at most [`MAX_INTENSITY`] in magnitude (a value beyond it is named by its
     /// own path, `field[c]`, when given per channel).
-    fn check(&self, field: &str, channels: usize, min: f64) -> Result<(), SceneError> {
+    pub(crate) fn check(&self, field: &str, channels: usize, min: f64) -> Result<(), SceneError> {
         let values: Vec<f64> = match self {
             PerChannel::All(v) => vec![*v],
             PerChannel::Each(v) => {
@@ -169,6 +169,10 @@ pub struct Material {
     /// (`woo-chall`); the others draw the mesh opaque and say so.
     #[serde(default, skip_serializing_if = "is_opaque")]
     pub transmittance: f64,
+    /// A texture multiplying `k_d` and `k_a` per channel ([`crate::texture`]); the mesh
+    /// needs texture coordinates.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub texture: Option<crate::texture::TextureSpec>,
 }
 
 fn is_opaque(t: &f64) -> bool {
@@ -330,6 +334,10 @@ pub struct MeshSpec {
     /// Inline normals, one per vertex (optional: otherwise from the faces).
     #[serde(default)]
     pub normals: Option<Vec<[f64; 3]>>,
+    /// Inline texture coordinates `[u, v]`, one per vertex (optional; what a texture
+    /// needs).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub uv: Option<Vec<[f64; 2]>>,
     /// A Wavefront OBJ file.
     #[serde(default)]
     pub obj: Option<String>,
@@ -375,6 +383,8 @@ pub struct WorldScene {
     pub spec: WorldSpec,
     /// The meshes, in the order of `spec.meshes`.
     pub meshes: Vec<Mesh>,
+    /// Per mesh, its material's texture, loaded ([`crate::texture`]).
+    pub textures: Vec<Option<std::sync::Arc<crate::texture::Texture>>>,
 }
 
 impl WorldScene {
@@ -603,6 +613,9 @@ impl WorldSpec {
                     ),
                 ));
             }
+            if let Some(t) = &mat.texture {
+                crate::texture::validate(t, &f("material.texture"), channels)?;
+            }
             finite(&f("crease_angle"), m.crease_angle)?;
             if !(0.0..=180.0).contains(&m.crease_angle) {
                 return Err(SceneError::at_field(
@@ -627,7 +640,7 @@ impl WorldSpec {
                 check_point(&f("transform.translate"), p)?;
             }
             let sources = [
-                m.vertices.is_some() || m.faces.is_some() || m.normals.is_some(),
+                m.vertices.is_some() || m.faces.is_some() || m.normals.is_some() || m.uv.is_some(),
                 m.obj.is_some(),
                 m.revolution.is_some(),
                 m.bezier.is_some(),
@@ -721,5 +734,42 @@ pub fn parse_world(text: &str, base: Option<&Path>) -> Result<WorldScene, SceneE
         crate::project::check_in_front(&camera, &built, k).map_err(locate)?;
         meshes.push(built);
     }
-    Ok(WorldScene { spec, meshes })
+    let textures = load_textures(&spec, &meshes, base).map_err(locate)?;
+    Ok(WorldScene {
+        spec,
+        meshes,
+        textures,
+    })
+}
+
+/// The textures of a scene's meshes (validated spec, built meshes): each loaded, and each
+/// textured mesh checked to have texture coordinates.
+pub(crate) fn load_textures(
+    spec: &WorldSpec,
+    meshes: &[Mesh],
+    base: Option<&Path>,
+) -> Result<Vec<Option<std::sync::Arc<crate::texture::Texture>>>, SceneError> {
+    let channels = spec.channels as usize;
+    spec.meshes
+        .iter()
+        .zip(meshes)
+        .enumerate()
+        .map(|(k, (m, built))| {
+            let Some(t) = &m.material.texture else {
+                return Ok(None);
+            };
+            let field = format!("meshes[{k}].material.texture");
+            if !built.has_uv() {
+                return Err(SceneError::at_field(
+                    SceneErrorKind::Shape,
+                    field,
+                    format!(
+                        "mesh {:?} has no texture coordinates: give inline \"uv\" (one per vertex), an OBJ file with `vt` at every corner, a \"revolution\" or \"bezier\" patches",
+                        built.name
+                    ),
+                ));
+            }
+            crate::texture::load(t, &field, channels, base).map(|t| Some(std::sync::Arc::new(t)))
+        })
+        .collect()
 }

@@ -6,12 +6,25 @@
 //! the weights of the world corners are `w_k = b_k · (1/z_k) / Σ_j b_j · (1/z_j)` (`1/z`
 //! is affine in screen space). The point is `Σ w_k P_k`, the normal `Σ w_k N_k`
 //! normalized — Phong's interpolation, in the world, not on the screen.
+//!
+//! A textured mesh ([`crate::texture`]) is shaded here for every shading, since its
+//! intensity changes within a triangle however it is lit. The texture multiplies `k_a` and
+//! `k_d`: the intensity is `T · (ambient + diffuse) + specular`, `T` the texture's value
+//! per channel. The lighting is Phong's at the point (`--shading phong`), the corners'
+//! two parts interpolated affinely on the screen as the array interpolates Gouraud's
+//! (`gouraud`), or the face's at its centroid (`flat`). `T` is read at the texture
+//! coordinates interpolated perspective-correctly: at the point ([`TextureFilter::Point`]),
+//! or averaged over a pixel's footprint ([`TextureFilter::Box`]): the pixel square's four
+//! corners mapped onto the triangle's plane, and the texture's mean over the bounding box
+//! of their `(u, v)` (a summed-area table; the footprint itself is a quadrilateral).
 
 use crate::face::ScreenTriangle;
 use crate::lighting::Lighting;
 use crate::scene::{Material, WorldScene};
-use cwisim_scene::Vector;
+use crate::texture::{Texture, TextureFilter};
+use cwisim_scene::{Shading, Vector};
 use glam::DVec3;
+use std::sync::Arc;
 
 /// The lighting of a world scene, ready to shade its triangles at any screen point.
 #[derive(Clone, Debug)]
@@ -20,12 +33,37 @@ pub struct PhongShader {
     eye: DVec3,
     /// Per mesh.
     materials: Vec<Material>,
+    /// Per mesh, its texture.
+    textures: Vec<Option<Arc<Texture>>>,
+    /// How a textured mesh is lit (every other mesh: Phong's).
+    shading: Shading,
+    /// With flat shading, per mesh and face, the face's centroid (where it is lit).
+    centroids: Vec<Vec<DVec3>>,
 }
 
 impl PhongShader {
-    /// The shader of `scene`'s lights, camera and materials.
+    /// The shader of `scene`'s lights, camera, materials and textures, for Phong shading.
     pub fn new(scene: &WorldScene) -> PhongShader {
+        PhongShader::for_shading(scene, Shading::Phong)
+    }
+
+    /// The shader of `scene` lit as `shading` says: Phong's at every point, or, for a
+    /// textured scene, Gouraud's or flat's lighting with the texture per point.
+    pub fn for_shading(scene: &WorldScene, shading: Shading) -> PhongShader {
         let spec = &scene.spec;
+        let centroids = if shading == Shading::Flat {
+            scene
+                .meshes
+                .iter()
+                .map(|m| {
+                    (0..m.faces.len())
+                        .map(|f| crate::project::face_centroid(m, f))
+                        .collect()
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
         PhongShader {
             lighting: Lighting {
                 ambient: spec.ambient.clone(),
@@ -34,6 +72,73 @@ impl PhongShader {
             },
             eye: DVec3::from_array(spec.camera.eye),
             materials: spec.meshes.iter().map(|m| m.material.clone()).collect(),
+            textures: scene.textures.clone(),
+            shading,
+            centroids,
+        }
+    }
+
+    /// The texture of mesh `mesh`, if it has one.
+    pub fn texture(&self, mesh: u32) -> Option<&Texture> {
+        self.textures.get(mesh as usize)?.as_deref()
+    }
+
+    /// Mesh `mesh`'s texture: `None` past the last mesh, `Some(None)` for an untextured
+    /// one.
+    pub fn mesh_texture(&self, mesh: usize) -> Option<Option<&Texture>> {
+        self.textures.get(mesh).map(Option::as_deref)
+    }
+
+    /// Whether any mesh is textured.
+    pub fn textured(&self) -> bool {
+        self.textures.iter().any(Option::is_some)
+    }
+
+    /// The texture coordinates of `t` at screen point `p`, perspective-correct; `None`
+    /// where the triangle's plane is degenerate or at or behind the eye there.
+    pub fn uv_at(&self, t: &ScreenTriangle, p: [f64; 2]) -> Option<[f64; 2]> {
+        let (w, sum) = t.perspective_weights(p)?;
+        if sum <= 0.0 {
+            return None;
+        }
+        let uv = &t.surface.uv;
+        Some([0, 1].map(|a| (w[0] * uv[0][a] + w[1] * uv[1][a] + w[2] * uv[2][a]) / sum))
+    }
+
+    /// The texture's factor for `t` at screen point `p`, per channel (all 1 for an
+    /// untextured mesh), read as `filter` says: at `p` itself, or averaged over the
+    /// footprint of the pixel whose centre is `centre` (at `p` where the footprint leaves
+    /// the triangle's visible plane).
+    pub fn texture_factor(
+        &self,
+        t: &ScreenTriangle,
+        p: [f64; 2],
+        centre: [f64; 2],
+        filter: TextureFilter,
+    ) -> [f64; 4] {
+        let Some(texture) = self.texture(t.mesh) else {
+            return [1.0; 4];
+        };
+        let at_p = || self.uv_at(t, p).map_or([1.0; 4], |uv| texture.point(uv));
+        match filter {
+            TextureFilter::Point => at_p(),
+            TextureFilter::Box => {
+                let mut lo = [f64::INFINITY; 2];
+                let mut hi = [f64::NEG_INFINITY; 2];
+                for (dx, dy) in [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)] {
+                    let Some(uv) = self.uv_at(t, [centre[0] + dx, centre[1] + dy]) else {
+                        return at_p();
+                    };
+                    for a in 0..2 {
+                        lo[a] = lo[a].min(uv[a]);
+                        hi[a] = hi[a].max(uv[a]);
+                    }
+                }
+                if !(lo.iter().chain(&hi).all(|x| x.is_finite())) {
+                    return at_p();
+                }
+                texture.mean(lo, hi)
+            }
         }
     }
 
@@ -91,20 +196,75 @@ impl PhongShader {
     }
 
     /// [`Self::at`] by the lights `reaches` says reach the point (light `k` of the scene;
-    /// [`crate::shadow`]): a shadowed point loses that light's terms.
+    /// [`crate::shadow`]): a shadowed point loses that light's terms. A textured mesh
+    /// reads its texture at `p` ([`TextureFilter::Point`]).
     pub fn at_lit(
         &self,
         t: &ScreenTriangle,
         p: [f64; 2],
         reaches: impl Fn(usize) -> bool,
     ) -> Option<Vector> {
-        let (point, normal) = self.surface_at(t, p)?;
-        Some(self.lighting.intensity_lit(
-            &self.materials[t.mesh as usize],
-            point,
-            normal,
-            self.eye,
-            reaches,
-        ))
+        self.at_pixel_lit(t, p, p, TextureFilter::Point, reaches)
+    }
+
+    /// The intensity of `t` at screen point `p` of the pixel whose centre is `centre`, by
+    /// the lights `reaches` says reach it, its texture read as `filter` says
+    /// ([`Self::texture_factor`]). An untextured mesh is Phong's [`Self::at_lit`] at `p`.
+    pub fn at_pixel_lit(
+        &self,
+        t: &ScreenTriangle,
+        p: [f64; 2],
+        centre: [f64; 2],
+        filter: TextureFilter,
+        reaches: impl Fn(usize) -> bool,
+    ) -> Option<Vector> {
+        let material = &self.materials[t.mesh as usize];
+        if self.texture(t.mesh).is_none() {
+            let (point, normal) = self.surface_at(t, p)?;
+            return Some(
+                self.lighting
+                    .intensity_lit(material, point, normal, self.eye, reaches),
+            );
+        }
+        let factor = self.texture_factor(t, p, centre, filter);
+        let (diffuse, specular) = match self.shading {
+            Shading::Flat => {
+                let centroid = self.centroids[t.mesh as usize][t.face as usize];
+                self.lighting.intensity_split(
+                    material,
+                    centroid,
+                    t.surface.normals[0],
+                    self.eye,
+                    reaches,
+                )
+            }
+            Shading::Gouraud => {
+                let b = t.barycentric(p)?;
+                let corners: [(Vector, Vector); 3] = std::array::from_fn(|k| {
+                    self.lighting.intensity_split(
+                        material,
+                        t.surface.world[k],
+                        t.surface.normals[k],
+                        self.eye,
+                        &reaches,
+                    )
+                });
+                let mix = |f: fn(&(Vector, Vector)) -> &Vector| {
+                    let [a, b1, c] = [f(&corners[0]), f(&corners[1]), f(&corners[2])];
+                    cwisim_scene::vector(self.lighting.channels, |k| {
+                        a[k] + b[1] * (b1[k] - a[k]) + b[2] * (c[k] - a[k])
+                    })
+                };
+                (mix(|c| &c.0), mix(|c| &c.1))
+            }
+            _ => {
+                let (point, normal) = self.surface_at(t, p)?;
+                self.lighting
+                    .intensity_split(material, point, normal, self.eye, reaches)
+            }
+        };
+        Some(cwisim_scene::vector(self.lighting.channels, |c| {
+            factor[c] * diffuse[c] + specular[c]
+        }))
     }
 }

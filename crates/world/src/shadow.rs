@@ -265,6 +265,7 @@ impl LightView {
                 surface: Surface {
                     world,
                     normals: [DVec3::ZERO; 3],
+                    uv: [[0.0; 2]; 3],
                 },
             })
             .collect();

@@ -202,6 +202,7 @@ fn draw_value(d: &DrawArgs, flag: &str) -> Result<Option<String>, ()> {
         "--aa-threshold" => Some(d.aa_threshold.to_string()),
         "--phong-angle" => Some(d.phong_angle.to_string()),
         "--shadows" => d.shadows.as_ref().and_then(name),
+        "--texture-filter" => name(&d.texture_filter),
         _ => return Err(()),
     })
 }

@@ -75,6 +75,11 @@ impl Bsp {
                 settings.shading
             )));
         }
+        if eval0 && polys.textured() {
+            return Err(RenderError::Usage(
+                "--unset eval0 claims each span with one Eval0 value, and a texture changes within a span: use --unset host".into(),
+            ));
+        }
         if eval0 && (sampler.l != 1 || sampler.grid != Grid::Centre) {
             return Err(RenderError::Usage(
                 "--unset eval0 locks whole pixels, so the first polygon to reach a pixel would own all its samples: exact at one sample per pixel only; use --samples 1 or --unset host".into(),

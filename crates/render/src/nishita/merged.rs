@@ -289,7 +289,7 @@ impl MergedFrame<'_> {
                                 let centre = [i as f64 + 0.5, f64::from(slice.row) + 0.5];
                                 let p = nearest_in(triangle, centre);
                                 let shade = surfaces
-                                    .shade(base + t.polygon as usize, p)
+                                    .shade_pixel(base + t.polygon as usize, p, centre)
                                     .unwrap_or_default();
                                 let i = i as usize;
                                 for (v, s) in slot.values[i * channels..(i + 1) * channels]

@@ -314,6 +314,7 @@ fn triangle(
         surface: Surface {
             world: p.world,
             normals,
+            uv: p.uv.map(|(u, v)| [u, v]),
         },
     })
 }
@@ -399,7 +400,9 @@ impl Nishita {
                 });
             }
         };
-        let phong = settings.shading == Shading::Phong;
+        // Phong, or a texture under any shading: lit per pixel
+        let phong = settings.shading == Shading::Phong || w.textures.iter().any(Option::is_some);
+        let shader = || PhongShader::for_shading(&w, settings.shading);
         // meshes that are not patches: projected as vanrij projects them
         let others: Vec<usize> = (0..w.spec.meshes.len())
             .filter(|&k| w.spec.meshes[k].bezier.is_none())
@@ -418,8 +421,10 @@ impl Nishita {
             if settings.aa.is_box() {
                 groups = Some((r.groups, r.rows));
             }
-            let surfaces =
-                phong.then(|| PhongSurfaces::new(r.triangles, r.sources, PhongShader::new(&w)));
+            let surfaces = phong.then(|| {
+                PhongSurfaces::new(r.triangles, r.sources, shader())
+                    .filtered(settings.texture_filter)
+            });
             (
                 r.pieces,
                 r.count,
@@ -454,11 +459,10 @@ impl Nishita {
                 (
                     polygons,
                     Some(stats),
-                    Some(PhongSurfaces::new(
-                        tris.clone(),
-                        sources,
-                        PhongShader::new(&w),
-                    )),
+                    Some(
+                        PhongSurfaces::new(tris.clone(), sources, shader())
+                            .filtered(settings.texture_filter),
+                    ),
                 )
             } else {
                 let (p, s) = cwisim_world::resolve_on(

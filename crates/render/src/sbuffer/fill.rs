@@ -311,6 +311,12 @@ pub(crate) struct Scan<'a> {
 }
 
 impl Scan<'_> {
+    /// Whether samples are lit one by one (Phong, or a textured scene under any shading)
+    /// rather than read off the spans' Gouraud chains.
+    pub(crate) fn per_pixel(&self) -> bool {
+        self.shading == Shading::Phong || self.scene.textured()
+    }
+
     /// Whether each row is one line of samples at the pixel centres.
     pub(crate) fn one_sample(&self) -> bool {
         self.sampler.l == 1 && self.sampler.grid == Grid::Centre
@@ -424,7 +430,7 @@ impl Scan<'_> {
                 // the span's values from `q`'s: its Gouraud chain's value at sample `at`
                 // and its step
                 let values = |q: &Poly, at: usize| -> (Vector, Vector) {
-                    if flat || self.shading == Shading::Phong {
+                    if flat || self.per_pixel() {
                         (q.flat, Vector::default())
                     } else {
                         let il = edge_value(q, a, y, ch);
@@ -561,7 +567,7 @@ impl Scan<'_> {
             }
             if o != NONE {
                 out.counts.visible_runs += 1;
-                if self.shading == Shading::Phong {
+                if self.per_pixel() {
                     let p = &self.list[o as usize];
                     targets.clear();
                     let y = f64::from(row) + 0.5;
@@ -613,7 +619,7 @@ impl Scan<'_> {
         for (c, &o) in line.owner.iter().enumerate() {
             sub.rgb.push(match o {
                 NONE => Vector::default(),
-                _ if self.shading == Shading::Phong => self
+                _ if self.per_pixel() => self
                     .scene
                     .phong(&self.list[o as usize], self.sampler.column_x(c), y)
                     .unwrap_or_default(),
@@ -646,7 +652,7 @@ impl Scan<'_> {
         // lit and fitted when the line is done: the unset list's runs wait for it too)
         let sends_while_filling = match self.rule {
             Rule::Nearer => self.overdraw,
-            Rule::Unset => self.shading != Shading::Phong,
+            Rule::Unset => !self.per_pixel(),
             Rule::Claim => true,
             Rule::Paint => false,
         };
@@ -711,7 +717,7 @@ impl Scan<'_> {
                 let refs: Vec<&Subline> = sublines.iter().collect();
                 let rule = EmitRule {
                     merge: self.merge,
-                    tolerance: (self.shading == Shading::Phong).then_some(self.shade_tolerance),
+                    tolerance: self.per_pixel().then_some(self.shade_tolerance),
                     channels: ch,
                 };
                 let c =

@@ -72,6 +72,11 @@ impl SBuffer {
                     "--sbuffer overdraw undoes runs exactly, which fitted Phong pieces do not allow: use --shading flat or gouraud, or --sbuffer host".into(),
                 ));
             }
+            if polys.textured() {
+                return Err(RenderError::Usage(
+                    "--sbuffer overdraw undoes runs exactly, which the fitted pieces of a texture do not allow: use --sbuffer host".into(),
+                ));
+            }
         }
         Ok(SBuffer {
             polys,
@@ -136,9 +141,10 @@ impl Renderer for SBuffer {
 
     fn settings_phrase(&self) -> String {
         let s = &self.sampler;
-        let fitted = match self.shading {
-            Shading::Phong => format!(" (span tolerance {})", self.shade_tolerance),
-            _ => String::new(),
+        let fitted = if self.scan().per_pixel() {
+            format!(" (span tolerance {})", self.shade_tolerance)
+        } else {
+            String::new()
         };
         let sampling = if self.scan().one_sample() {
             "one sample per pixel (its centre)".to_string()

@@ -93,7 +93,7 @@ pub struct Polys {
     pub polys: Vec<Poly>,
     /// World scenes: the projected triangles (`Poly::source` indexes them).
     pub triangles: Option<Vec<ScreenTriangle>>,
-    /// With Phong shading: the lighting.
+    /// With Phong shading, or textures: the lighting.
     pub shader: Option<PhongShader>,
     /// World scenes: the camera's eye, in the world.
     pub eye: Option<[f64; 3]>,
@@ -179,8 +179,9 @@ impl Polys {
                     });
                 }
                 project = Some(stats);
-                if shading == Shading::Phong {
-                    shader = Some(PhongShader::new(&w));
+                // a textured mesh is lit per sample whatever the shading, as Phong is
+                if shading == Shading::Phong || w.textures.iter().any(Option::is_some) {
+                    shader = Some(PhongShader::for_shading(&w, shading));
                 }
                 if let Some((test, time)) = crate::prepare::sampled_shadows(&w, &tris, settings)? {
                     shadows = Some(test);
@@ -223,7 +224,12 @@ impl Polys {
         usize::from(self.channels)
     }
 
-    /// With Phong shading: the lit colour of polygon `p` at `(x, y)` (negative terms
+    /// Whether a mesh is textured.
+    pub fn textured(&self) -> bool {
+        self.shader.as_ref().is_some_and(PhongShader::textured)
+    }
+
+    /// With Phong shading (or textures): the lit colour of polygon `p` at `(x, y)` (negative terms
     /// dropped), at the point of its triangle nearest `(x, y)`.
     pub fn phong(&self, p: &Poly, x: f64, y: f64) -> Option<Vector> {
         let (shader, tris) = (self.shader.as_ref()?, self.triangles.as_ref()?);

@@ -17,6 +17,7 @@ pub mod emit;
 pub mod lists;
 pub mod prepare;
 pub mod shade;
+pub mod textures;
 pub mod triangle;
 
 use crate::error::{NonFinite, RenderError};
@@ -35,6 +36,7 @@ use std::io;
 use std::ops::Range;
 use std::sync::{Condvar, Mutex, MutexGuard};
 use std::time::Duration;
+use textures::Residency;
 
 /// The registry's one line about it.
 pub const ABOUT: &str = "Woo & Chall's scanline visibility: triangles point-sampled on an l×l grid (--samples, --grid), nearest wins; keepObj and adaptive-stochastic shading calls; interior runs through the span fitter";
@@ -96,7 +98,8 @@ impl WooChall {
     fn emit_rule(&self) -> EmitRule {
         EmitRule {
             merge: self.merge,
-            tolerance: (self.shading == Shading::Phong).then_some(self.shade_tolerance),
+            tolerance: (self.shading == Shading::Phong || self.triangles.textured())
+                .then_some(self.shade_tolerance),
             channels: usize::from(self.triangles.channels),
         }
     }
@@ -123,6 +126,8 @@ struct Scan<'a> {
     layers: Layers,
     /// Per pixel row made: the lists', the shading's and the emitter's figures.
     figures: Vec<serde_json::Value>,
+    /// Which textures are loaded (§5).
+    residency: Residency,
 }
 
 impl<'a> Scan<'a> {
@@ -143,6 +148,7 @@ impl<'a> Scan<'a> {
             above: Vec::new(),
             layers: Layers::default(),
             figures: Vec::new(),
+            residency: Residency::new(&t.tris, &t.texture_bytes, s.height),
         }
     }
 
@@ -175,13 +181,17 @@ impl<'a> Scan<'a> {
                 shade::hidden_subline(&sub.winners, &self.above, channels, &mut sub.rgb);
             } else {
                 let y = s.subline_y(j);
+                let residency = &mut self.residency;
                 self.shader.subline(
                     y,
                     &sub.winners,
                     &self.layers,
                     &t.tris,
                     &mut sub.rgb,
-                    |tri, x, y| t.shade(tri, x, y),
+                    |tri, x, y| {
+                        residency.touch(tri.surface);
+                        t.shade(tri, x, y)
+                    },
                 );
             }
             self.above.clone_from(&sub.winners);
@@ -193,7 +203,8 @@ impl<'a> Scan<'a> {
         let counts = emit_row(s, &refs, rule, out).map_err(|e| NonFinite::at_row(e, row))?;
         self.list_stats.merge(&row_lists);
         let shaded = &self.shader.stats;
-        self.figures.push(serde_json::json!({
+        let resident = self.residency.end_row(row);
+        let mut figures = serde_json::json!({
             "row": row,
             "max_active": row_lists.max_active,
             "max_visible_spans": row_lists.max_visible_spans,
@@ -203,7 +214,11 @@ impl<'a> Scan<'a> {
             "instructions": counts.instructions,
             "eval1": counts.edge_pixels + counts.runs.eval1,
             "passes": counts.passes,
-        }));
+        });
+        if self.residency.any() {
+            figures["textures_resident"] = resident.into();
+        }
+        self.figures.push(figures);
         self.next_row += 1;
         Ok(counts)
     }
@@ -240,6 +255,15 @@ fn emit_counters(c: &EmitCounts) -> Counters {
         .with("instructions", c.instructions)
 }
 
+/// `n` bytes in B, KiB or MiB.
+fn bytes(n: u64) -> String {
+    match n {
+        0..1024 => format!("{n} B"),
+        1024..1_048_576 => format!("{:.1} KiB", n as f64 / 1024.0),
+        _ => format!("{:.1} MiB", n as f64 / 1_048_576.0),
+    }
+}
+
 /// A band's thread panicked holding the scan.
 fn poisoned<T>(_: T) -> io::Error {
     io::Error::other("woo-chall: the thread making an earlier band panicked")
@@ -269,7 +293,7 @@ impl FramePlan for WooFrame<'_> {
             return Counters::default();
         };
         let (l, s) = (&scan.list_stats, &scan.shader.stats);
-        Counters::default()
+        let counters = Counters::default()
             .with("triangles", self.renderer.triangles.tris.len() as u64)
             .with("triangles_sorted", self.sorted_triangles)
             .with("max_active", l.max_active)
@@ -282,7 +306,18 @@ impl FramePlan for WooFrame<'_> {
             .with("shading_stochastic", s.stochastic)
             .with("shading_forced", s.forced_calls)
             .with("forced_pixels", s.forced_pixels)
-            .with("shading_layers", s.layer_calls)
+            .with("shading_layers", s.layer_calls);
+        let r = &scan.residency.stats;
+        if r.textures == 0 {
+            return counters;
+        }
+        counters
+            .with("textures", r.textures)
+            .with("texture_loads", r.loads)
+            .with("texture_frees", r.frees)
+            .with("textures_peak", r.peak)
+            .with("textures_peak_row", r.peak_row)
+            .with("texture_peak_bytes", r.peak_bytes)
     }
 
     fn row_figures(&self) -> Option<serde_json::Value> {
@@ -376,9 +411,10 @@ impl Renderer for WooChall {
 
     fn settings_phrase(&self) -> String {
         let s = &self.sampler;
-        let fitted = match self.shading {
-            Shading::Phong => format!(" (span tolerance {})", self.shade_tolerance),
-            _ => String::new(),
+        let fitted = if self.emit_rule().tolerance.is_some() {
+            format!(" (span tolerance {})", self.shade_tolerance)
+        } else {
+            String::new()
         };
         let contrast = if self.rule.contrast.is_infinite() {
             "never forced".to_string()
@@ -426,6 +462,21 @@ impl Renderer for WooChall {
                 get("forced_pixels")
             ),
         ));
+        if get("textures") > 0 {
+            rows.push((
+                "textures",
+                format!(
+                    "{} textured mesh(es), each read at its shading calls' samples; loaded when first shaded ({} loaded, {} never: hidden), freed after their last row ({} freed); at most {} resident at once (first at row {}), {} of texels and tables",
+                    get("textures"),
+                    get("texture_loads"),
+                    get("textures") - get("texture_loads"),
+                    get("texture_frees"),
+                    get("textures_peak"),
+                    get("textures_peak_row"),
+                    bytes(get("texture_peak_bytes"))
+                ),
+            ));
+        }
         rows.push((
             "emitted",
             format!(

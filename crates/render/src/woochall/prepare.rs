@@ -48,6 +48,9 @@ pub struct Triangles {
     pub phong: Option<(Vec<ScreenTriangle>, PhongShader)>,
     /// With shadows: what the lights reach of each projected triangle.
     pub shadows: Option<Shadows>,
+    /// Per mesh, its texture's size in bytes (texels and summed-area table), if it has
+    /// one (empty for a screen scene).
+    pub texture_bytes: Vec<Option<u64>>,
     /// Wall time of the shadow pass (the lights' views).
     pub shadow_time: Duration,
     /// What projection did (world scenes).
@@ -67,8 +70,10 @@ impl Triangles {
         let shading = settings.shading;
         let start = Instant::now();
         let kind = loaded.scene.kind();
+        let loaded_textured = loaded.scene.is_textured();
         let (mut project, mut phong, mut polygons) = (None, None, 0);
         let (mut shadows, mut shadow_time) = (None, Duration::ZERO);
+        let mut texture_bytes = Vec::new();
         let (width, height, channels, tris) = match loaded.scene {
             AnyScene::Screen(s) => {
                 if shading == Shading::Phong {
@@ -109,8 +114,15 @@ impl Triangles {
                     });
                     shadow_time = time;
                 }
-                if shading == Shading::Phong {
-                    phong = Some((screen, PhongShader::new(&w)));
+                texture_bytes = w
+                    .textures
+                    .iter()
+                    .map(|t| t.as_ref().map(|t| t.bytes()))
+                    .collect();
+                // a textured mesh is shaded per call whatever the shading, as Phong is:
+                // its texture read at the sample
+                if shading == Shading::Phong || loaded_textured {
+                    phong = Some((screen, PhongShader::for_shading(&w, shading)));
                 }
                 (w.width(), w.height(), w.channels() as u8, tris)
             }
@@ -127,6 +139,7 @@ impl Triangles {
             tris,
             phong,
             shadows,
+            texture_bytes,
             shadow_time,
             project,
             polygons,
@@ -138,6 +151,11 @@ impl Triangles {
     /// The array it draws into.
     pub fn header(&self) -> TraceHeader {
         self.header
+    }
+
+    /// Whether a mesh is textured.
+    pub fn textured(&self) -> bool {
+        self.texture_bytes.iter().any(Option::is_some)
     }
 
     /// One shading call: the colour of `tri` at `(x, y)`.

@@ -1,5 +1,8 @@
 //! Helpers shared by the integration tests of `cwisim-render`.
 
+// (only tests/textures.rs reads it)
+#[allow(dead_code)]
+pub mod footprint;
 pub mod raycast;
 
 use cwisim_render::{registry, render, ArrayConfig, LoadedScene, Settings, Taps};
