@@ -266,7 +266,7 @@ pub const REGISTRY: &[Entry] = &[
         patches: false,
         progressive: true,
         fits_rows: false,
-        textures: false,
+        textures: true,
         uses: &[
             Setting::Size,
             Setting::ShadeTolerance,

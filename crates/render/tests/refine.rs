@@ -157,6 +157,65 @@ fn every_threshold_at_all_gives_van_rijs_phong_box_filter_bit_for_bit() {
     }
 }
 
+#[test]
+fn a_textured_scene_s_phases_are_van_rijs_textured_images_bit_for_bit() {
+    // every threshold at `none` but the texture: the Gouraud phase regenerates exactly the
+    // textured polygons, lit per pixel with their texture as vanrij draws them
+    // the first value that differs, not the whole image
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    let same = |a: &[f64], b: &[f64], what: &str| {
+        assert_eq!(a.len(), b.len(), "{what}");
+        if let Some(k) = (0..a.len()).find(|&k| a[k].to_bits() != b[k].to_bits()) {
+            panic!("{what}: value {k} is {} against {}", a[k], b[k]);
+        }
+    };
+    let all = thresholds(Threshold::All, Threshold::All, Threshold::All);
+    for name in ["teapot-textured", "textures4"] {
+        let (image, _) = full(name, 64);
+        let r = build("refine", scene(name, 64), &all);
+        let run = run(&*r, 1);
+        same(
+            run.frames.last().unwrap(),
+            &image,
+            &format!("{name}: last frame"),
+        );
+        let point = |shading| {
+            let r = build(
+                "vanrij",
+                scene(name, 64),
+                &Settings {
+                    aa: Antialias::None,
+                    shading,
+                    ..Settings::default()
+                },
+            );
+            self::run(&*r, 1).frames.remove(0)
+        };
+        let gouraud = run.frames.len() - 3;
+        same(
+            &run.frames[gouraud],
+            &point(Shading::Gouraud),
+            &format!("{name}: Gouraud phase"),
+        );
+        same(
+            &run.frames[gouraud + 1],
+            &point(Shading::Phong),
+            &format!("{name}: Phong phase"),
+        );
+        // with the Gouraud threshold at none, the textured polygons alone are regenerated
+        let none = thresholds(Threshold::None, Threshold::None, Threshold::None);
+        let r = build("refine", scene(name, 64), &none);
+        let textured_run = self::run(&*r, 1);
+        let regenerated = textured_run.counters.get("gouraud_polygons").unwrap();
+        assert!(regenerated > 0, "{name}");
+        assert_ne!(
+            bits(&textured_run.frames[0]),
+            bits(&textured_run.frames[1]),
+            "{name}: the texture shows from the Gouraud phase on"
+        );
+    }
+}
+
 /// With every light casting shadows: the shadow phase follows the flat one and darkens
 /// exactly the shadow polygons, and every later phase draws what `vanrij` draws with
 /// the same shadows, bit for bit.

@@ -51,7 +51,7 @@ pub const EMBEDDED: &[Embedded] = &[
     },
     Embedded {
         name: "teapot-textured",
-        about: "world, grey, 500×500: the teapot with a 4×4 checkerboard on each patch, in the patch's own (u, v) (Nishita et al.'s figure 10b; drawn by vanrij)",
+        about: "world, grey, 500×500: the teapot with a 4×4 checkerboard on each patch, in the patch's own (u, v) (Nishita et al.'s figure 10b)",
         text: include_str!("../scenes/teapot-textured.json"),
     },
     Embedded {

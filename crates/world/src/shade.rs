@@ -37,7 +37,8 @@ pub struct PhongShader {
     textures: Vec<Option<Arc<Texture>>>,
     /// How a textured mesh is lit (every other mesh: Phong's).
     shading: Shading,
-    /// With flat shading, per mesh and face, the face's centroid (where it is lit).
+    /// Per mesh and face of a textured mesh, the face's centroid (where flat shading
+    /// lights it); empty for the others.
     centroids: Vec<Vec<DVec3>>,
 }
 
@@ -51,19 +52,17 @@ impl PhongShader {
     /// textured scene, Gouraud's or flat's lighting with the texture per point.
     pub fn for_shading(scene: &WorldScene, shading: Shading) -> PhongShader {
         let spec = &scene.spec;
-        let centroids = if shading == Shading::Flat {
-            scene
-                .meshes
-                .iter()
-                .map(|m| {
-                    (0..m.faces.len())
-                        .map(|f| crate::project::face_centroid(m, f))
-                        .collect()
-                })
-                .collect()
-        } else {
-            Vec::new()
-        };
+        let centroids = scene
+            .meshes
+            .iter()
+            .zip(&scene.textures)
+            .map(|(m, t)| match t {
+                Some(_) => (0..m.faces.len())
+                    .map(|f| crate::project::face_centroid(m, f))
+                    .collect(),
+                None => Vec::new(),
+            })
+            .collect();
         PhongShader {
             lighting: Lighting {
                 ambient: spec.ambient.clone(),
@@ -76,6 +75,11 @@ impl PhongShader {
             shading,
             centroids,
         }
+    }
+
+    /// The same shader lighting textured meshes as `shading` says.
+    pub fn with_shading(self, shading: Shading) -> PhongShader {
+        PhongShader { shading, ..self }
     }
 
     /// The texture of mesh `mesh`, if it has one.

@@ -4,7 +4,8 @@
 
 use super::measure::flattened;
 use crate::prepare::{PhongSurfaces, PolygonLights, PolygonScene};
-use cwisim_scene::{Polygon, ScreenScene};
+use cwisim_scene::{Polygon, ScreenScene, Shading};
+use cwisim_world::shadow::LightSet;
 
 /// Polygon `k` (`p`) of `scene` as every light would shade it: its triangle's own
 /// intensities at its vertices (the polygon itself where it has no triangle, or no light
@@ -26,6 +27,66 @@ fn unshadowed(scene: &PolygonScene, k: usize, p: &Polygon) -> Polygon {
     Polygon::new(p.vertices.clone(), intensity)
 }
 
+/// Whether polygon `k` of `scene` is part of a textured mesh.
+pub fn is_textured(scene: &PolygonScene, k: usize) -> bool {
+    scene
+        .phong
+        .as_ref()
+        .is_some_and(|s| s.shader.texture(s.triangles[s.sources[k]].mesh).is_some())
+}
+
+/// Polygons lit per pixel, gathered with their source triangles and lights.
+struct PerPixel {
+    screen: ScreenScene,
+    sources: Vec<usize>,
+    lit: Vec<LightSet>,
+}
+
+impl PerPixel {
+    fn new(screen: ScreenScene) -> PerPixel {
+        PerPixel {
+            screen,
+            sources: Vec::new(),
+            lit: Vec::new(),
+        }
+    }
+
+    fn push(&mut self, scene: &PolygonScene, k: usize, p: &Polygon) {
+        self.screen.polygons.push(p.clone());
+        if let Some(s) = &scene.phong {
+            self.sources.push(s.sources[k]);
+            if let Some(l) = &s.shadows {
+                self.lit.push(l.lit[k]);
+            }
+        }
+    }
+
+    /// The polygons and what lighting them as `shading` says needs; `None` when there
+    /// are none.
+    fn surfaces(
+        self,
+        scene: &PolygonScene,
+        shading: Shading,
+    ) -> Option<(ScreenScene, PhongSurfaces)> {
+        let s = scene.phong.as_ref()?;
+        if self.screen.polygons.is_empty() {
+            return None;
+        }
+        let mut surfaces = PhongSurfaces::new(
+            s.triangles.clone(),
+            self.sources,
+            s.shader.clone().with_shading(shading),
+        )
+        .filtered(s.filter);
+        // the attribute the shadow phase set: the lights that reach each polygon
+        surfaces.shadows = s.shadows.as_ref().map(|l| PolygonLights {
+            casters: l.casters.clone(),
+            lit: self.lit,
+        });
+        Some((self.screen, surfaces))
+    }
+}
+
 /// How a polygon is drawn.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Mode {
@@ -34,7 +95,8 @@ pub enum Mode {
     Unshadowed,
     /// At one intensity (the mean of its vertex intensities).
     Flat,
-    /// Its vertex intensities interpolated (DO_FILL's Gouraud).
+    /// Its vertex intensities interpolated (DO_FILL's Gouraud); a textured polygon lit
+    /// per pixel with Gouraud's lighting and its texture.
     Gouraud,
     /// Lit per pixel (`crate::phong`).
     Phong,
@@ -48,6 +110,8 @@ pub struct Subset {
     pub dofill: ScreenScene,
     /// Phong polygons and what lighting them needs (`None` when there are none).
     pub phong: Option<(ScreenScene, PhongSurfaces)>,
+    /// Gouraud polygons of a textured scene, lit per pixel (`None` when there are none).
+    pub textured: Option<(ScreenScene, PhongSurfaces)>,
     /// How many polygons it holds.
     pub polygons: u64,
 }
@@ -63,9 +127,9 @@ impl Subset {
             polygons: Vec::new(),
         };
         let mut dofill = empty();
-        let mut phong = empty();
-        let mut sources = Vec::new();
-        let mut lit = Vec::new();
+        let mut phong = PerPixel::new(empty());
+        let mut textured = PerPixel::new(empty());
+        let textured_scene = scene.phong.as_ref().is_some_and(|s| s.shader.textured());
         let mut polygons = 0;
         for (k, p) in scene.screen.polygons.iter().enumerate() {
             if !pick(k) {
@@ -75,34 +139,17 @@ impl Subset {
             match modes[k] {
                 Mode::Unshadowed => dofill.polygons.push(flattened(&unshadowed(scene, k, p))),
                 Mode::Flat => dofill.polygons.push(flattened(p)),
+                // in a textured scene every Gouraud polygon is lit per pixel, as vanrij
+                // draws the scene
+                Mode::Gouraud if textured_scene => textured.push(scene, k, p),
                 Mode::Gouraud => dofill.polygons.push(p.clone()),
-                Mode::Phong => {
-                    phong.polygons.push(p.clone());
-                    if let Some(s) = &scene.phong {
-                        sources.push(s.sources[k]);
-                        if let Some(l) = &s.shadows {
-                            lit.push(l.lit[k]);
-                        }
-                    }
-                }
+                Mode::Phong => phong.push(scene, k, p),
             }
         }
-        let phong = match &scene.phong {
-            Some(s) if !phong.polygons.is_empty() => {
-                let mut surfaces =
-                    PhongSurfaces::new(s.triangles.clone(), sources, s.shader.clone());
-                // the attribute the shadow phase set: the lights that reach each polygon
-                surfaces.shadows = s.shadows.as_ref().map(|l| PolygonLights {
-                    casters: l.casters.clone(),
-                    lit,
-                });
-                Some((phong, surfaces))
-            }
-            _ => None,
-        };
         Subset {
             dofill,
-            phong,
+            phong: phong.surfaces(scene, Shading::Phong),
+            textured: textured.surfaces(scene, Shading::Gouraud),
             polygons,
         }
     }

@@ -44,7 +44,7 @@ impl<'a> Part<'a> {
             ScanPlan::new(&subset.dofill, options),
             options,
         )];
-        if let Some((screen, surfaces)) = &subset.phong {
+        for (screen, surfaces) in subset.textured.iter().chain(&subset.phong) {
             parts.push(Part::Phong(PhongFrame::new(
                 screen, surfaces, aa, tolerance,
             )));

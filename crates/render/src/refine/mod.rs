@@ -354,9 +354,11 @@ impl Refine {
                     let p = &scene.screen.polygons[k];
                     match phase {
                         Phase::Shadows if modes[k] == Mode::Unshadowed => Mode::Flat,
+                        // a textured polygon's texture shows from the Gouraud phase on
                         Phase::Gouraud
                             if modes[k] == Mode::Flat
-                                && self.gouraud_threshold.passes(intensity_range(p)) =>
+                                && (self.gouraud_threshold.passes(intensity_range(p))
+                                    || display::is_textured(scene, k)) =>
                         {
                             Mode::Gouraud
                         }
