@@ -47,7 +47,7 @@ pub enum OverflowArg {
     Saturate,
 }
 
-fn parse_error_budget(s: &str) -> Result<f64, String> {
+pub(crate) fn parse_error_budget(s: &str) -> Result<f64, String> {
     let v = match s.split_once('/') {
         Some((a, b)) => {
             let (a, b): (f64, f64) = (
