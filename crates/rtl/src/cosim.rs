@@ -63,6 +63,11 @@ pub fn cosimulate(
     sim: Simulator,
     dir: &Path,
 ) -> Result<Outcome, RtlError> {
+    if trace.is_empty() {
+        return Err(RtlError::Settings(
+            "the trace is empty: nothing to co-simulate".into(),
+        ));
+    }
     let started = Instant::now();
     let want = expected(d, header, trace, machine, watch)?;
     let reference = started.elapsed();
@@ -72,12 +77,13 @@ pub fn cosimulate(
     let conv = {
         let file = std::fs::File::create(&stim_path).map_err(|e| RtlError::io(&stim_path, e))?;
         let mut w = BufWriter::new(file);
-        let conv = stimulus::write(d, header, trace, limit, &mut w)?;
+        let conv = stimulus::write(d, header, trace, &mut w)?;
         std::io::Write::flush(&mut w).map_err(|e| RtlError::io(&stim_path, e))?;
         conv
     };
     write_file(&dir.join("design.v"), &verilog::design(d))?;
     write_file(&dir.join("testbench.v"), &verilog::testbench(d, watch))?;
+    let instructions = trace.len();
     let started = Instant::now();
     match sim {
         Simulator::Icarus => {
@@ -85,6 +91,8 @@ pub fn cosimulate(
                 "iverilog",
                 &[
                     "-g2005",
+                    &format!("-P{TESTBENCH_MODULE}.INSTRUCTIONS={instructions}"),
+                    &format!("-P{TESTBENCH_MODULE}.CYCLE_LIMIT={limit}"),
                     "-s",
                     TESTBENCH_MODULE,
                     "-o",
@@ -100,6 +108,8 @@ pub fn cosimulate(
                 "verilator",
                 &[
                     "--binary",
+                    &format!("-GINSTRUCTIONS={instructions}"),
+                    &format!("-GCYCLE_LIMIT={limit}"),
                     "--timing",
                     "-Wno-fatal",
                     "-Wno-lint",

@@ -11,8 +11,6 @@ pub enum End {
     Idle(u64),
     /// The cycle limit was reached first.
     Limit(u64),
-    /// The testbench could not read the stimulus.
-    BadStimulus,
     /// The dump stops without saying (the simulator was cut short).
     Missing,
 }
@@ -74,8 +72,7 @@ pub fn parse(text: &str, what: &str) -> Result<Observed, RtlError> {
             }
             "E" => obs.end = End::Idle(dec(words.next())?),
             "T" => obs.end = End::Limit(dec(words.next())?),
-            "F" => obs.end = End::BadStimulus,
-            _ => return Err(bad("expected A, O, X, E, T or F")),
+            _ => return Err(bad("expected A, O, X, E or T")),
         }
     }
     Ok(obs)
@@ -93,7 +90,7 @@ mod tests {
         assert_eq!(o.exits, vec![(9, 2)]);
         assert_eq!(o.end, End::Idle(12));
         let e = parse("A 0 3\nQ 1\n", "dump.txt").unwrap_err().to_string();
-        assert_eq!(e, "dump.txt: line 2: expected A, O, X, E, T or F: `Q 1`");
+        assert_eq!(e, "dump.txt: line 2: expected A, O, X, E or T: `Q 1`");
         assert!(parse("O 1 7 zz\n", "d").is_err());
     }
 }

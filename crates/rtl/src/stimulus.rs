@@ -41,20 +41,25 @@ fn hex(raw: i64, bits: u32) -> String {
     format!("{:x}", (raw as u64) & mask)
 }
 
-/// Writes the stimulus of `trace` for design `d` to `out`: a first line
-/// `INSTRUCTIONS CYCLE_LIMIT`, then one line per instruction. Every instruction must be
-/// one the design implements and fit its array.
+/// Writes the stimulus of `trace` for design `d` to `out`: a comment line, then one line
+/// per instruction, hex words for `$readmemh`. Every instruction must be one the design
+/// implements and fit its array.
 pub fn write(
     d: &Design,
     header: &TraceHeader,
     trace: &[Instruction],
-    cycle_limit: u64,
     out: &mut dyn Write,
 ) -> Result<Conversions, RtlError> {
     check_header(d, header)?;
     let arith = FixedArith::new(&d.format)?;
     let io = |e| RtlError::io("stimulus", e);
-    writeln!(out, "{} {cycle_limit}", trace.len()).map_err(io)?;
+    writeln!(
+        out,
+        "// {} instructions for the testbench of: {}",
+        trace.len(),
+        d.summary()
+    )
+    .map_err(io)?;
     let mut conv = Conversions {
         overflows_per_line: vec![0],
     };

@@ -67,13 +67,13 @@ pub fn testbench(d: &Design, watch: &Watch) -> String {
         "Co-simulation testbench of the CWI X-processor array",
     );
     v.line(&format!(
-        "// Reads {STIMULUS_FILE} (a line `INSTRUCTIONS CYCLE_LIMIT`, then one instruction a line: op, x, dx, then the"
+        "// Reads {STIMULUS_FILE} ($readmemh: one instruction a line: op, x, dx, then the value fields, hex) and writes"
     ));
     v.line(&format!(
-        "// value fields, hex) and writes {DUMP_FILE}: `A p cycle` (a token arrives at watched processor p), `O p cycle acc…`"
+        "// {DUMP_FILE}: `A p cycle` (a token arrives at watched processor p), `O p cycle acc…` (a Refresh moved p's"
     ));
-    v.line("// (a Refresh moved p's accumulators out), `X cycle overflows` (a token left the chain), `E cycle` (idle: done),");
-    v.line("// `T cycle` (the cycle limit was reached), `F` (the stimulus file is malformed).");
+    v.line("// accumulators out), `X cycle overflows` (a token left the chain), `E cycle` (idle: done), `T cycle` (the");
+    v.line("// cycle limit was reached).");
     v.line("`timescale 1ns / 1ns");
     v.line(&format!("module {TESTBENCH_MODULE};"));
     v.line("    reg clk = 1'b0;");
@@ -165,44 +165,34 @@ pub fn testbench(d: &Design, watch: &Watch) -> String {
             }
         }
     }
-    v.line("    integer stim, dump, got;");
-    v.line("    reg [63:0] left, limit;");
-    for (f, _, _) in &reads {
-        v.line(&format!("    reg [63:0] {f};"));
-    }
+    let k_n = reads.len();
+    v.line("    // the stimulus: INSTRUCTIONS instructions of FIELDS hex words each (set at compile time:");
+    v.line("    // iverilog -P cwisim_tb.INSTRUCTIONS=…, verilator -GINSTRUCTIONS=…)");
+    v.line("    parameter INSTRUCTIONS = 1;");
+    v.line("    parameter CYCLE_LIMIT = 1000;");
+    v.line(&format!("    localparam integer FIELDS = {k_n};"));
+    v.line("    reg [63:0] words [0:INSTRUCTIONS*FIELDS-1];");
+    v.line("    integer dump, next_index;");
     v.line("    // the next instruction onto the bus's inputs (or none left)");
     v.line("    task next;");
     v.line("        begin");
-    v.line("            if (left == 64'd0) in_valid <= 1'b0;");
+    v.line("            if (next_index == INSTRUCTIONS) in_valid <= 1'b0;");
     v.line("            else begin");
-    let fmt = vec!["%h"; reads.len()].join(" ");
-    let args: Vec<&str> = reads.iter().map(|(f, _, _)| f.as_str()).collect();
-    v.line(&format!(
-        "                got = $fscanf(stim, \"{fmt}\\n\", {});",
-        args.join(", ")
-    ));
-    v.line(&format!(
-        "                if (got != {}) begin",
-        reads.len()
-    ));
-    v.line("                    $fwrite(dump, \"F\\n\");");
-    v.line("                    $fclose(dump);");
-    v.line("                    $finish;");
-    v.line("                end");
     v.line("                in_valid <= 1'b1;");
-    for (f, target, bits) in &reads {
-        v.line(&format!("                {target} <= {f}[{}:0];", bits - 1));
+    for (k, (_, target, bits)) in reads.iter().enumerate() {
+        v.line(&format!(
+            "                {target} <= words[next_index*FIELDS+{k}][{}:0];",
+            bits - 1
+        ));
     }
-    v.line("                left = left - 64'd1;");
+    v.line("                next_index = next_index + 1;");
     v.line("            end");
     v.line("        end");
     v.line("    endtask");
     v.line("    initial begin");
-    v.line(&format!(
-        "        stim = $fopen(\"{STIMULUS_FILE}\", \"r\");"
-    ));
+    v.line(&format!("        $readmemh(\"{STIMULUS_FILE}\", words);"));
     v.line(&format!("        dump = $fopen(\"{DUMP_FILE}\", \"w\");"));
-    v.line("        got = $fscanf(stim, \"%d %d\\n\", left, limit);");
+    v.line("        next_index = 0;");
     v.line("        next;");
     v.line("        @(posedge clk);");
     v.line("        @(posedge clk);");
@@ -227,7 +217,7 @@ pub fn testbench(d: &Design, watch: &Watch) -> String {
     v.line("            $fclose(dump);");
     v.line("            $finish;");
     v.line("        end");
-    v.line("        if (cycle >= limit) begin");
+    v.line("        if (cycle >= CYCLE_LIMIT) begin");
     v.line("            $fwrite(dump, \"T %0d\\n\", cycle);");
     v.line("            $fclose(dump);");
     v.line("            $finish;");
