@@ -323,3 +323,144 @@ pub fn compare(
         cycles: expected.cycles,
     }))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::design::{all_opcodes, BusTiming};
+    use crate::reference::expected;
+    use crate::stimulus;
+    use crate::verilog::Watch;
+    use cwisim_isa::{Intensity, TraceHeader};
+    use cwisim_xproc::{Machine, Numeric};
+    use std::collections::BTreeMap;
+
+    /// A design, a trace, the stepped engine's account and the conversions.
+    fn setup() -> (Design, Vec<Instruction>, Expected, Conversions) {
+        let header = TraceHeader::new(4, 2, 1).unwrap();
+        let Numeric::Fixed(f) = "fixed:I=2.6,dI=2.6,ddI=2.6".parse::<Numeric>().unwrap() else {
+            unreachable!()
+        };
+        let machine = Machine::default();
+        let d = Design::new(
+            f,
+            all_opcodes(),
+            4,
+            1,
+            BusTiming::new(&machine, &header).unwrap(),
+        )
+        .unwrap();
+        let trace = vec![
+            Instruction::eval2(1, 3, Intensity::grey(0.5), Intensity::grey(0.25)),
+            Instruction::refresh(),
+            Instruction::eval1(0, 4, Intensity::grey(1.75)),
+            Instruction::eval1(0, 4, Intensity::grey(1.75)),
+            Instruction::refresh(),
+        ];
+        let want = expected(&d, &header, &trace, &machine, &Watch::all(4)).unwrap();
+        let conv = stimulus::write(&d, &header, &trace, &mut Vec::new()).unwrap();
+        (d, trace, want, conv)
+    }
+
+    /// What a faithful simulation of `want` dumps.
+    fn faithful(
+        d: &Design,
+        trace: &[Instruction],
+        want: &Expected,
+        conv: &Conversions,
+    ) -> Observed {
+        let arith = FixedArith::new(&d.format).unwrap();
+        let scale = d.format.acc.quantum();
+        let mut outputs: BTreeMap<u32, Vec<(u64, Vec<u64>)>> = BTreeMap::new();
+        for (n, line) in want.lines.iter().enumerate() {
+            for p in 0..d.width {
+                let raw = (line[p as usize] / scale) as i64;
+                assert_eq!(arith.out(raw), line[p as usize]);
+                let bits = (raw as u64) & ((1u64 << d.format.acc.width()) - 1);
+                outputs
+                    .entry(p)
+                    .or_default()
+                    .push((want.ready[n] - 4 + u64::from(p), vec![bits]));
+            }
+        }
+        // every scanline's overflow events in its Refresh's exit, less the conversions'
+        let mut exits = Vec::new();
+        let mut line = 0;
+        for (k, i) in trace.iter().enumerate() {
+            let ovf = if i.op == Opcode::Refresh {
+                want.overflows[line] - conv.overflows_per_line[line]
+            } else {
+                0
+            };
+            let cycle = if i.op == Opcode::Refresh {
+                want.ready[line]
+            } else {
+                want.arrivals[&3][k] + 1
+            };
+            exits.push((cycle, ovf));
+            if i.op == Opcode::Refresh {
+                line += 1;
+            }
+        }
+        Observed {
+            arrivals: want.arrivals.clone(),
+            outputs,
+            exits,
+            end: End::Idle(want.cycles + 1),
+        }
+    }
+
+    #[test]
+    fn a_faithful_dump_agrees_and_every_kind_of_difference_is_found() {
+        let (d, trace, want, conv) = setup();
+        let good = faithful(&d, &trace, &want, &conv);
+        let a = compare(&d, &trace, &want, &conv, &good).unwrap().unwrap();
+        assert_eq!((a.scanlines, a.values, a.arrivals), (2, 8, 20));
+        assert!(a.overflows > 0, "1.75 + 1.75 saturates Q2.6: {a:?}");
+
+        // one output bit
+        let mut bad = good.clone();
+        bad.outputs.get_mut(&2).unwrap()[1].1[0] ^= 1;
+        let m = compare(&d, &trace, &want, &conv, &bad)
+            .unwrap()
+            .unwrap_err();
+        assert_eq!((m.scanline, m.processor), (1, Some(2)), "{m}");
+        assert!(m.what.starts_with("output value"), "{m}");
+        assert_eq!(m.instruction.as_ref().map(|i| i.0), Some(4));
+
+        // a token a cycle late at processor 1: the earliest difference is reported
+        let mut bad = good.clone();
+        bad.arrivals.get_mut(&1).unwrap()[2] += 1;
+        bad.outputs.get_mut(&3).unwrap()[1].1[0] ^= 1;
+        let m = compare(&d, &trace, &want, &conv, &bad)
+            .unwrap()
+            .unwrap_err();
+        assert_eq!((m.scanline, m.processor), (1, Some(1)), "{m}");
+        assert_eq!(m.instruction.as_ref().map(|i| i.0), Some(2));
+        assert_eq!(m.cycle, want.arrivals[&1][2]);
+        assert!(
+            m.to_string().contains("instruction 2 (Eval1 0 4 1.75)"),
+            "{m}"
+        );
+
+        // overflow events, a ready cycle, the end
+        let mut bad = good.clone();
+        bad.exits[4].1 += 1;
+        let m = compare(&d, &trace, &want, &conv, &bad)
+            .unwrap()
+            .unwrap_err();
+        assert!(m.what.starts_with("overflow events"), "{m}");
+        let mut bad = good.clone();
+        bad.exits[1].0 += 1;
+        let m = compare(&d, &trace, &want, &conv, &bad)
+            .unwrap()
+            .unwrap_err();
+        assert!(m.what.contains("ready"), "{m}");
+        let mut bad = good.clone();
+        bad.end = End::Limit(99);
+        assert!(compare(&d, &trace, &want, &conv, &bad).unwrap().is_err());
+        let mut bad = good;
+        bad.end = End::Missing;
+        assert!(compare(&d, &trace, &want, &conv, &bad).is_err());
+    }
+}
