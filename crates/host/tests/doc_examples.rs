@@ -181,6 +181,7 @@ const LONG: &[&str] = &[
     "cwisim --help: cwisim rtl --for pot --max-error 1/512 -o pot_xproc.v --area",
     "docs/HARDWARE.md: --cosim icarus --watch all",
     "docs/HARDWARE.md: cwisim rtl --for pot --max-error 1/512 -o pot_xproc.v --area",
+    "docs/HARDWARE.md: cwisim fit pot --max-error 1/512 --area",
 ];
 
 /// Whether a command of a document is [`LONG`].

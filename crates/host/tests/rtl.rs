@@ -126,3 +126,54 @@ fn a_trace_co_simulates_identically_in_icarus() {
     );
     assert!(stdout.contains("at 16 watched processor(s)"), "{stdout}");
 }
+
+#[test]
+fn fit_reports_the_area_of_the_format_it_finds() {
+    if std::env::var("CWISIM_SKIP_HDL_TESTS").is_ok_and(|v| v == "1") {
+        eprintln!("SKIPPED: cwisim fit --area (CWISIM_SKIP_HDL_TESTS=1)");
+        return;
+    }
+    let dir = scratch("rtl-fit-area");
+    let out = cwisim_ok(&dir, &["fit", "fig25", "--max-error", "1/256", "--area"]);
+    let area = out
+        .lines()
+        .find(|l| l.starts_with("area"))
+        .unwrap_or_else(|| panic!("no area line: {out}"));
+    assert!(
+        area.contains("one processor:") && area.contains("NAND2 equivalents"),
+        "{area}"
+    );
+    // the same processor as `cwisim rtl --area` for the format fit found
+    let format = out
+        .lines()
+        .find_map(|l| l.strip_prefix("registers"))
+        .unwrap()
+        .trim()
+        .to_string();
+    let rtl = cwisim_ok(
+        &dir,
+        &[
+            "rtl",
+            "--for",
+            "fig25",
+            "--numeric",
+            &format,
+            "-o",
+            "f.v",
+            "--area",
+        ],
+    );
+    let cells = |s: &str| {
+        s.split("one processor:")
+            .nth(1)
+            .unwrap()
+            .split(',')
+            .next()
+            .unwrap()
+            .to_string()
+    };
+    assert_eq!(
+        cells(area),
+        cells(rtl.lines().find(|l| l.starts_with("area")).unwrap())
+    );
+}

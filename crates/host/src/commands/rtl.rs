@@ -118,6 +118,31 @@ fn rtl_error(e: RtlError) -> CliError {
     }
 }
 
+/// The area of one processor in `format` for the opcodes of the stream `renderer` emits
+/// (Yosys in a temporary directory): what `fit --area` prints.
+pub(crate) fn scene_area(
+    renderer: &dyn cwisim_render::Renderer,
+    machine: &cwisim_xproc::Machine,
+    format: cwisim_xproc::FixedFormat,
+) -> Result<area::Area, CliError> {
+    let (mut reader, _) = crate::input::emitted(renderer, false)?;
+    let header = *reader.header();
+    let trace = read_all(&mut *reader)?;
+    let timing = BusTiming::new(machine, &header).map_err(rtl_error)?;
+    let design = Design::new(
+        format,
+        opcodes_used(&trace),
+        header.width,
+        header.channel_count(),
+        timing,
+    )
+    .map_err(rtl_error)?;
+    let (dir, _) = work_dir(None, "area")?;
+    let a = area::synthesize(&design, &dir).map_err(rtl_error);
+    let _ = std::fs::remove_dir_all(&dir);
+    a
+}
+
 /// A fresh directory for the tools' files.
 fn work_dir(given: Option<&Path>, what: &str) -> Result<(PathBuf, bool), CliError> {
     match given {
