@@ -42,15 +42,15 @@ pub struct RtlArgs {
     /// With --max-error: what the registers do when a value does not fit.
     #[arg(long, value_enum, default_value_t = OverflowArg::Saturate)]
     pub overflow: OverflowArg,
-    /// Without --for: processors in the array.
+    /// Without --for: array width (X-processors).
     #[arg(
         long,
-        value_name = "N",
+        value_name = "W",
         default_value_t = 16,
         conflicts_with = "for_input"
     )]
     pub width: u32,
-    /// Without --for: channels (1 grey, 3 RGB).
+    /// Without --for: channels per intensity (1 grey, 3 RGB).
     #[arg(
         long,
         value_name = "C",
@@ -58,9 +58,10 @@ pub struct RtlArgs {
         conflicts_with = "for_input"
     )]
     pub channels: u8,
-    /// Without --for: scanlines per frame (for the display's line period).
+    /// Without --for: scanlines per frame (the display's height) to derive the line
+    /// period for.
     #[arg(
-        long,
+        long = "height",
         value_name = "H",
         default_value_t = 1024,
         conflicts_with = "for_input"
@@ -184,7 +185,7 @@ pub fn run(args: &RtlArgs, stdout: &mut dyn Write, progress: bool) -> Result<(),
         }
         None => (
             TraceHeader::new(args.width, args.lines, args.channels)
-                .map_err(|e| CliError::Usage(format!("--width/--lines/--channels: {e}")))?,
+                .map_err(|e| CliError::Usage(format!("--width/--height/--channels: {e}")))?,
             None,
         ),
     };
