@@ -35,6 +35,7 @@ fn golden_traces_agree_bit_and_cycle_for_cycle() {
         return;
     }
     let wide = "fixed:I=8.24,dI=4.28,ddI=2.30,acc=10.24";
+    let mut used = std::collections::BTreeSet::<cwisim_isa::Opcode>::new();
     for name in [
         "antialiased",
         "flat",

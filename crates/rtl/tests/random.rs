@@ -1,4 +1,4 @@
-//! Random traces (proptest: a few cases, every opcode, random narrow formats that
+//! Random traces (proptest: eight cases, every opcode, random narrow formats that
 //! overflow, random machines with late scanlines) co-simulated in Icarus Verilog against
 //! the stepped engine, on the design of all fourteen opcodes.
 
@@ -103,7 +103,7 @@ fn case() -> impl Strategy<Value = (TraceHeader, Vec<Instruction>, FixedFormat, 
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 4, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 8, ..ProptestConfig::default() })]
 
     #[test]
     fn random_traces_agree_bit_and_cycle_for_cycle((header, trace, format, machine) in case()) {
