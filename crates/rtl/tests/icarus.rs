@@ -51,7 +51,11 @@ fn golden_traces_agree_bit_and_cycle_for_cycle() {
             a.scanlines > 0 && a.values > 0 && a.arrivals > 0,
             "{name}: {a:?}"
         );
+        used.extend(cwisim_rtl::opcodes_used(&trace(name).1));
     }
+    // with overrun.cwt (co-simulated under its own machine below), every opcode
+    used.extend(cwisim_rtl::opcodes_used(&trace("overrun").1));
+    assert_eq!(used, cwisim_rtl::all_opcodes());
 }
 
 #[test]
