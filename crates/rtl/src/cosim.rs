@@ -142,6 +142,12 @@ pub fn cosimulate(
     };
     let simulate = started.elapsed();
     let dump_path = dir.join(DUMP_FILE);
+    let size = std::fs::metadata(&dump_path)
+        .map_err(|e| RtlError::io(&dump_path, e))?
+        .len();
+    // the text and what is parsed from it, about as much again
+    cwisim_scene::budget::Budget::current()
+        .check_memory("the simulator's dump", size.saturating_mul(2))?;
     let text = std::fs::read_to_string(&dump_path).map_err(|e| RtlError::io(&dump_path, e))?;
     let observed = dump::parse(&text, &dump_path.display().to_string())?;
     let result = compare(d, trace, &want, &conv, &observed)?;
