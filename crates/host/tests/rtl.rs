@@ -112,6 +112,8 @@ fn a_trace_co_simulates_identically_in_icarus() {
             "icarus",
             "--watch",
             "all",
+            "--work-dir",
+            "run",
         ],
     );
     let (stdout, stderr) = text(&out);
@@ -125,6 +127,10 @@ fn a_trace_co_simulates_identically_in_icarus() {
         "{stdout}"
     );
     assert!(stdout.contains("at 16 watched processor(s)"), "{stdout}");
+    // --work-dir (relative to where cwisim runs) keeps the files
+    for f in ["design.v", "testbench.v", "stimulus.hex", "dump.txt"] {
+        assert!(dir.join("run").join(f).is_file(), "{f}");
+    }
 }
 
 #[test]

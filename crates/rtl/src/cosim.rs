@@ -68,6 +68,8 @@ pub fn cosimulate(
             "the trace is empty: nothing to co-simulate".into(),
         ));
     }
+    // absolute: the tools run in it, and the compiled simulator is named by its path
+    let dir = &dir.canonicalize().map_err(|e| RtlError::io(dir, e))?;
     let started = Instant::now();
     let want = expected(d, header, trace, machine, watch)?;
     let reference = started.elapsed();

@@ -35,7 +35,11 @@ pub fn run(program: &str, args: &[&str], dir: &Path) -> Result<String, RtlError>
         .args(args)
         .current_dir(dir)
         .output()
-        .map_err(|e| RtlError::io(bin.clone(), e))?;
+        .map_err(|e| RtlError::ToolFailed {
+            command: command.clone(),
+            status: "not started".into(),
+            output: e.to_string(),
+        })?;
     let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
     let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
     if !out.status.success() {
