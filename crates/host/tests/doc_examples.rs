@@ -180,6 +180,7 @@ const LONG: &[&str] = &[
     "cwisim --help: --cosim icarus",
     "cwisim --help: cwisim rtl --for pot --max-error 1/512 -o pot_xproc.v --area",
     "docs/HARDWARE.md: --cosim icarus --watch all",
+    "docs/HARDWARE.md: --cosim icarus --work-dir run1",
     "docs/HARDWARE.md: cwisim rtl --for pot --max-error 1/512 -o pot_xproc.v --area",
     "docs/HARDWARE.md: cwisim fit pot --max-error 1/512 --area",
 ];

@@ -67,8 +67,8 @@ pub struct RtlArgs {
         conflicts_with = "for_input"
     )]
     pub lines: u32,
-    /// Also write the co-simulation testbench (it reads stimulus.hex and writes dump.txt
-    /// in its working directory; docs/HARDWARE.md).
+    /// Also write the co-simulation testbench (it reads stimulus.hex, as --cosim writes it
+    /// into --work-dir, and writes dump.txt; docs/HARDWARE.md says how to run it by hand).
     #[arg(long, value_name = "TB.v")]
     pub testbench: Option<PathBuf>,
     /// Co-simulate the --for trace or scene in this simulator against the stepped engine,
