@@ -241,25 +241,8 @@ pub fn run(args: &RtlArgs, stdout: &mut dyn Write, progress: bool) -> Result<(),
     })?;
     let watch = match args.watch.as_deref() {
         None => Watch::ends(design.width),
-        Some("all") => Watch::all(design.width),
-        Some(list) => {
-            let ps = list
-                .split(',')
-                .map(|p| {
-                    p.trim()
-                        .parse::<u32>()
-                        .ok()
-                        .filter(|p| *p < design.width)
-                        .ok_or_else(|| {
-                            CliError::Usage(format!(
-                                "--watch {list}: `{p}` is not a processor of the array (0 to {})",
-                                design.width - 1
-                            ))
-                        })
-                })
-                .collect::<Result<Vec<u32>, _>>()?;
-            Watch::new(ps, design.width)
-        }
+        Some(list) => Watch::parse(list, design.width)
+            .map_err(|e| CliError::Usage(format!("--watch {list}: {e}")))?,
     };
     if let Some(tb) = &args.testbench {
         let text = verilog::testbench(&design, &watch);

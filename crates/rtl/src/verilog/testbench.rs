@@ -42,6 +42,30 @@ impl Watch {
     pub fn processors(&self) -> &[u32] {
         &self.0
     }
+
+    /// `all`, or processors separated by commas (`0,200,399`), each in the array.
+    pub fn parse(list: &str, width: u32) -> Result<Watch, String> {
+        if list.trim() == "all" {
+            return Ok(Watch::all(width));
+        }
+        let ps = list
+            .split(',')
+            .map(|p| {
+                p.trim()
+                    .parse::<u32>()
+                    .ok()
+                    .filter(|p| *p < width)
+                    .ok_or_else(|| {
+                        format!(
+                            "`{}` is not a processor of the array (0 to {})",
+                            p.trim(),
+                            width.saturating_sub(1)
+                        )
+                    })
+            })
+            .collect::<Result<Vec<u32>, _>>()?;
+        Ok(Watch::new(ps, width))
+    }
 }
 
 /// The testbench's Verilog for `design`, reporting arrivals at `watch`.
@@ -245,4 +269,23 @@ pub fn testbench(d: &Design, watch: &Watch) -> String {
     v.line("    endgenerate");
     v.line("endmodule");
     v.into_string()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn watch_lists_parse_and_refuse_processors_outside_the_array() {
+        assert_eq!(Watch::parse("3, 1,3", 8).unwrap().processors(), &[1, 3]);
+        assert_eq!(Watch::parse("all", 3).unwrap().processors(), &[0, 1, 2]);
+        assert_eq!(Watch::ends(9).processors(), &[0, 4, 8]);
+        assert_eq!(Watch::ends(1).processors(), &[0]);
+        assert_eq!(
+            Watch::parse("1,8", 8).unwrap_err(),
+            "`8` is not a processor of the array (0 to 7)"
+        );
+        assert!(Watch::parse("x", 8).is_err());
+        assert!(Watch::parse("", 8).is_err());
+    }
 }
