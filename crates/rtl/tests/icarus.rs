@@ -100,3 +100,18 @@ fn the_timing_model_holds_with_other_machines() {
         cosim(name, fmt, &slow);
     }
 }
+
+#[test]
+fn the_widest_registers_agree() {
+    if !hdl_tools("the Icarus co-simulation of 64-bit registers") {
+        return;
+    }
+    for fmt in [
+        "fixed:I=16.48,dI=16.48,ddI=16.48,acc=16.48,overflow=wrap",
+        "fixed:I=1.63,dI=64.0,ddI=2.62,acc=40.24",
+    ] {
+        for name in ["rgb", "visibility"] {
+            cosim(name, fmt, &Machine::default());
+        }
+    }
+}
