@@ -8,8 +8,8 @@ use crate::commands::machine::MachineCmdArgs;
 use crate::commands::run::RunArgs;
 use crate::commands::scene::{EmitArgs, RenderArgs};
 use crate::commands::{
-    convert, diff, dump, fit, history, inspect, machine, refine, renderers, run, scene, scenes,
-    stats, tradeoff, vcd,
+    convert, diff, dump, fit, history, inspect, machine, refine, renderers, rtl, run, scene,
+    scenes, stats, tradeoff, vcd,
 };
 use crate::error::CliError;
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
@@ -199,6 +199,28 @@ Example:\n  cwisim fit pot --max-error 1/512",
         after_help = AFTER_HELP
     )]
     Fit(fit::FitArgs),
+
+    /// Synthesizable Verilog of the array for a format and opcode set; co-simulation; area
+    #[command(
+        long_about = "Write synthesizable Verilog of the X-processor array: one processor (its registers, \
+the adders of the forward-differencing chain, the stage that holds a token for a hop) and an array of \
+them with the instruction bus and the display's deadlines exactly as docs/TIMING.md models them, \
+generated from the opcode table and the fixed-point model, for a format (--numeric fixed:…) and the \
+opcodes a trace or scene uses (--for TRACE|SCENE; all fourteen without it). With --for SCENE, \
+--max-error E finds the format as `cwisim fit` does.\n\n\
+--cosim icarus|verilator co-simulates the --for stream against the cycle-stepped engine (cwisim run \
+--timing stepped --numeric fixed:…): every scanline bit for bit, every scanline's overflow events and \
+ready cycle, and the cycle every token arrives at the watched processors (--watch); the first \
+difference is printed with its scanline, processor, cycle and instruction (exit status 4). --area \
+synthesizes one processor in Yosys and prints its cells, flip-flops and NAND2 estimate. The tools \
+are Debian's iverilog, verilator and yosys (crates/rtl/tools/install-hdl.sh installs them). The \
+Verilog is the same byte for byte for the same settings. docs/HARDWARE.md describes the design.\n\n\
+Examples:\n  cwisim rtl --numeric fixed:I=12.20,dI=4.28,ddI=1.36 --width 64 -o xproc.v --area\n  \
+cwisim rtl --for traces/gouraud.cwt --numeric fixed:I=8.24,dI=4.28,ddI=2.30 -o g.v --cosim icarus\n  \
+cwisim rtl --for pot --max-error 1/512 -o pot_xproc.v --area",
+        after_help = AFTER_HELP
+    )]
+    Rtl(rtl::RtlArgs),
 
     /// Per-scanline statistics of a trace or scene: table, plot, CSV, JSON
     #[command(
@@ -402,6 +424,7 @@ impl Command {
             Command::History(a) => Some(&mut a.draw),
             Command::Inspect(a) => Some(&mut a.draw),
             Command::Vcd(a) => Some(&mut a.draw),
+            Command::Rtl(a) => Some(&mut a.draw),
             Command::Diff(a) => Some(&mut a.draw),
             Command::Dump(a) => Some(&mut a.draw),
             Command::Scenes(_)
@@ -484,6 +507,7 @@ fn dispatch(
         Command::Tradeoff(args) => tradeoff::run(args, stdout, progress).map(|()| 0),
         Command::Refine(args) => refine::run(args, stdout, progress).map(|()| 0),
         Command::Fit(args) => fit::run(args, stdout, progress).map(|()| 0),
+        Command::Rtl(args) => rtl::run(args, stdout, progress).map(|()| 0),
         Command::Emit(args) => scene::run_emit(args).map(|()| 0),
         Command::Stats(args) => stats::run(args, stdout, stderr).map(|()| 0),
         Command::History(args) => history::run(args, stdout, progress).map(|()| 0),

@@ -98,6 +98,22 @@ const SKIPPED: &[(&str, &str)] = &[
         "time chromium ",
         "the browser; crates/host/tests/browser.rs opens the page in headless Chromium",
     ),
+    (
+        "crates/rtl/tools/install-hdl.sh",
+        "installs Debian's iverilog, verilator and yosys (apt-get); .ci/run runs it before the tests",
+    ),
+    (
+        "verilator ",
+        "Verilator's lint by hand; crates/rtl/tests/lint_synth.rs lints every generated design",
+    ),
+    (
+        "yosys ",
+        "Yosys by hand; crates/rtl/tests/lint_synth.rs and `cwisim rtl --area` synthesize the designs",
+    ),
+    (
+        "cwisim rtl --for pot --max-error 1/512 -o pot_xproc.v --cosim verilator",
+        "the pot at full width under Verilator: 2 minutes on 2 cores (its time is in docs/HARDWARE.md); crates/rtl/tests/verilator.rs co-simulates in Verilator",
+    ),
 ];
 
 /// Commands that are not `cwisim` but are run, because the `cwisim` commands after them
@@ -160,6 +176,15 @@ const LONG: &[&str] = &[
     "cwisim --help: cwisim tradeoff pot",
     "cwisim --help: cwisim inspect pot",
     "cwisim --help: cwisim vcd pot --line 200 -o l.vcd",
+    // the hardware examples need iverilog and yosys, which .ci/run installs before the long
+    // examples run (crates/rtl/tools/install-hdl.sh); each takes a few seconds
+    "cwisim --help: cwisim rtl --numeric fixed:I=12.20,dI=4.28,ddI=1.36 --width 64 -o xproc.v --area",
+    "cwisim --help: --cosim icarus",
+    "cwisim --help: cwisim rtl --for pot --max-error 1/512 -o pot_xproc.v --area",
+    "docs/HARDWARE.md: --cosim icarus --watch all",
+    "docs/HARDWARE.md: --cosim icarus --work-dir run1",
+    "docs/HARDWARE.md: cwisim rtl --for pot --max-error 1/512 -o pot_xproc.v --area",
+    "docs/HARDWARE.md: cwisim fit pot --max-error 1/512 --area",
 ];
 
 /// Whether a command of a document is [`LONG`].
@@ -192,6 +217,7 @@ const DOCUMENTS: &[&str] = &[
     "docs/ACCURACY.md",
     "docs/ERRATA.md",
     "docs/FUZZING.md",
+    "docs/HARDWARE.md",
     "docs/PERFORMANCE.md",
     "docs/PYTHON.md",
     "docs/RENDERERS.md",
@@ -221,6 +247,11 @@ fn errata() {
 #[test]
 fn fuzzing() {
     run_document("docs/FUZZING.md");
+}
+
+#[test]
+fn hardware() {
+    run_document("docs/HARDWARE.md");
 }
 
 #[test]

@@ -31,6 +31,11 @@ pub struct FitArgs {
     /// The machine model (timing only; the formats do not change cycles).
     #[command(flatten)]
     pub machine: MachineArgs,
+    /// Also synthesize one X-processor of the format found, for the scene's opcodes, in
+    /// Yosys (`cwisim rtl --area`; docs/HARDWARE.md): its cells, flip-flops and NAND2
+    /// equivalents.
+    #[arg(long)]
+    pub area: bool,
     /// Threads: the scene's exact visibility, then the candidate formats, replayed on N
     /// threads at once (0: one per core); the format found, its figures and the count of
     /// replays are the same at any N.
@@ -47,7 +52,7 @@ pub enum OverflowArg {
     Saturate,
 }
 
-fn parse_error_budget(s: &str) -> Result<f64, String> {
+pub(crate) fn parse_error_budget(s: &str) -> Result<f64, String> {
     let v = match s.split_once('/') {
         Some((a, b)) => {
             let (a, b): (f64, f64) = (
@@ -158,7 +163,23 @@ pub fn run(args: &FitArgs, stdout: &mut dyn Write, progress: bool) -> Result<(),
         w(out, "replays", fit.runs.to_string())?;
         out.flush()
     })()
-    .map_err(CliError::Stdout)
+    .map_err(CliError::Stdout)?;
+    if args.area {
+        let stage = crate::progress::Stage::new(progress, "fit: synthesizing one processor");
+        let a = super::rtl::scene_area(&*drawn.renderer, &machine, fit.format)?;
+        drop(stage);
+        w(
+            out,
+            "area",
+            format!(
+                "one processor: {} cells ({} flip-flops, {} logic), about {:.0} NAND2 equivalents (Yosys synth; docs/HARDWARE.md)",
+                a.total, a.flip_flops, a.logic, a.nand2
+            ),
+        )
+        .and_then(|()| out.flush())
+        .map_err(CliError::Stdout)?;
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -9,6 +9,7 @@ pub mod inspect;
 pub mod machine;
 pub mod refine;
 pub mod renderers;
+pub mod rtl;
 pub mod run;
 pub mod scene;
 pub mod scenes;

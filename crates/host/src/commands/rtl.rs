@@ -1,0 +1,330 @@
+//! `cwisim rtl`: synthesizable Verilog of the X-processor array for a fixed-point format
+//! and an opcode set — all fourteen, or those a trace or scene uses (`--for`, with the
+//! format `fit` finds for `--max-error`) —, and on request its co-simulation against the
+//! stepped engine (`--cosim icarus|verilator`) and the area of one processor in Yosys
+//! (`--area`). The generator, the co-simulation and the area are `cwisim_rtl`'s; this is
+//! the command.
+
+use super::fit::OverflowArg;
+use super::MachineArgs;
+use crate::error::CliError;
+use crate::files::write_atomic;
+use clap::Args;
+use cwisim_isa::{io::read_all, TraceHeader};
+use cwisim_rtl::verilog::{self, Watch};
+use cwisim_rtl::{
+    all_opcodes, area, cosimulate, opcodes_used, BusTiming, Design, RtlError, Simulator,
+};
+use cwisim_study::fit::fit_scene;
+use cwisim_xproc::numeric::Overflow;
+use cwisim_xproc::Numeric;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// The arguments of `cwisim rtl`.
+#[derive(Args, Clone, Debug, PartialEq)]
+pub struct RtlArgs {
+    /// The Verilog file to write (the adders, the processor and the array).
+    #[arg(short = 'o', long = "output", value_name = "OUT.v")]
+    pub output: PathBuf,
+    /// Generate for this trace (.cwt, .jsonl, .cwb) or scene (a .json file or an embedded
+    /// name): its width, channels and the opcodes it uses; with --cosim, co-simulate it.
+    #[arg(long = "for", value_name = "TRACE|SCENE")]
+    pub for_input: Option<PathBuf>,
+    /// The registers: fixed:I=M.N,dI=M.N,ddI=M.N[,acc=M.N][,overflow=wrap|saturate]
+    /// (docs/ACCURACY.md). Required unless --max-error finds it.
+    #[arg(long, value_name = "FORMAT")]
+    pub numeric: Option<Numeric>,
+    /// Find the format as `cwisim fit` does for the --for scene: the narrowest whose output
+    /// stays within E of the f64 array (e.g. 1/512).
+    #[arg(long, value_name = "E", value_parser = super::fit::parse_error_budget, conflicts_with = "numeric", requires = "for_input")]
+    pub max_error: Option<f64>,
+    /// With --max-error: what the registers do when a value does not fit.
+    #[arg(long, value_enum, default_value_t = OverflowArg::Saturate)]
+    pub overflow: OverflowArg,
+    /// Without --for: array width (X-processors).
+    #[arg(
+        long,
+        value_name = "W",
+        default_value_t = 16,
+        conflicts_with = "for_input"
+    )]
+    pub width: u32,
+    /// Without --for: channels per intensity (1 grey, 3 RGB).
+    #[arg(
+        long,
+        value_name = "C",
+        default_value_t = 1,
+        conflicts_with = "for_input"
+    )]
+    pub channels: u8,
+    /// Without --for: scanlines per frame (the display's height) to derive the line
+    /// period for.
+    #[arg(
+        long = "height",
+        value_name = "H",
+        default_value_t = 1024,
+        conflicts_with = "for_input"
+    )]
+    pub lines: u32,
+    /// Also write the co-simulation testbench (it reads stimulus.hex, as --cosim writes it
+    /// into --work-dir, and writes dump.txt; docs/HARDWARE.md says how to run it by hand).
+    #[arg(long, value_name = "TB.v")]
+    pub testbench: Option<PathBuf>,
+    /// Co-simulate the --for trace or scene in this simulator against the stepped engine,
+    /// and print the first difference or what agreed.
+    #[arg(long, value_enum, value_name = "SIM", requires = "for_input")]
+    pub cosim: Option<SimArg>,
+    /// Keep the co-simulation's files (design, testbench, stimulus, dump) in this new
+    /// directory; otherwise they go in a temporary one, kept only on a mismatch.
+    #[arg(long, value_name = "DIR", requires = "cosim")]
+    pub work_dir: Option<PathBuf>,
+    /// Processors whose token arrivals are compared, e.g. 0,200,399 (default: the first,
+    /// the middle and the last; `all` for every one).
+    #[arg(long, value_name = "P,P,…|all")]
+    pub watch: Option<String>,
+    /// Synthesize one processor in Yosys and print its cells, flip-flops and NAND2 estimate.
+    #[arg(long)]
+    pub area: bool,
+    /// The machine model (the bus and display timing built into the design).
+    #[command(flatten)]
+    pub machine: MachineArgs,
+    /// How to draw a --for scene.
+    #[command(flatten, next_help_heading = crate::draw::SCENE_ONLY)]
+    pub draw: crate::draw::DrawArgs,
+}
+
+/// `--cosim`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum SimArg {
+    /// Icarus Verilog (iverilog, vvp).
+    Icarus,
+    /// Verilator (compiled to C++ first).
+    Verilator,
+}
+
+/// A `cwisim_rtl` error as the command's.
+fn rtl_error(e: RtlError) -> CliError {
+    match e {
+        RtlError::Machine(e) => CliError::Machine(e),
+        RtlError::Budget(e) => CliError::Budget(e),
+        RtlError::Io { path, source } => CliError::write(path, source),
+        e @ (RtlError::Settings(_)
+        | RtlError::Numeric(_)
+        | RtlError::Trace { .. }
+        | RtlError::ToolMissing { .. }) => CliError::Usage(e.to_string()),
+        e @ (RtlError::ToolFailed { .. } | RtlError::Parse { .. }) => {
+            CliError::Internal(e.to_string())
+        }
+    }
+}
+
+/// The area of one processor in `format` for the opcodes of the stream `renderer` emits
+/// (Yosys in a temporary directory): what `fit --area` prints.
+pub(crate) fn scene_area(
+    renderer: &dyn cwisim_render::Renderer,
+    machine: &cwisim_xproc::Machine,
+    format: cwisim_xproc::FixedFormat,
+) -> Result<area::Area, CliError> {
+    let (mut reader, _) = crate::input::emitted(renderer, false)?;
+    let header = *reader.header();
+    let trace = read_all(&mut *reader)?;
+    let timing = BusTiming::new(machine, &header).map_err(rtl_error)?;
+    let design = Design::new(
+        format,
+        opcodes_used(&trace),
+        header.width,
+        header.channel_count(),
+        timing,
+    )
+    .map_err(rtl_error)?;
+    let (dir, _) = work_dir(None, "area")?;
+    let a = area::synthesize(&design, &dir).map_err(rtl_error);
+    let _ = std::fs::remove_dir_all(&dir);
+    a
+}
+
+/// A fresh directory for the tools' files.
+fn work_dir(given: Option<&Path>, what: &str) -> Result<(PathBuf, bool), CliError> {
+    match given {
+        Some(d) => {
+            std::fs::create_dir(d).map_err(|e| CliError::write(d, e))?;
+            Ok((d.to_path_buf(), true))
+        }
+        None => {
+            let d = std::env::temp_dir().join(format!("cwisim-rtl-{what}-{}", std::process::id()));
+            let _ = std::fs::remove_dir_all(&d);
+            std::fs::create_dir_all(&d).map_err(|e| CliError::write(&d, e))?;
+            Ok((d, false))
+        }
+    }
+}
+
+/// Runs `cwisim rtl`.
+pub fn run(args: &RtlArgs, stdout: &mut dyn Write, progress: bool) -> Result<(), CliError> {
+    crate::input::drawing_applies(&args.draw, &[args.for_input.as_deref()])?;
+    let machine = args.machine.load()?;
+    let out = stdout;
+    let say = |out: &mut dyn Write, label: &str, value: String| {
+        writeln!(out, "{label:<12}{value}").map_err(CliError::Stdout)
+    };
+    // the stream, the format
+    let mut fit_error = None;
+    let (header, trace) = match &args.for_input {
+        Some(input) => {
+            let stage = crate::progress::Stage::new(progress, "rtl: reading the stream");
+            let (mut file, size) = crate::input::open_sized(input, &args.draw, false)?;
+            cwisim_scene::budget::Budget::current().check_memory(
+                "the stream held in memory (about 8 times its encoded size)",
+                size.saturating_mul(8),
+            )?;
+            let header = *file.header();
+            let trace = read_all(&mut *file)?;
+            drop(stage);
+            (header, Some(trace))
+        }
+        None => (
+            TraceHeader::new(args.width, args.lines, args.channels)
+                .map_err(|e| CliError::Usage(format!("--width/--height/--channels: {e}")))?,
+            None,
+        ),
+    };
+    let format = match (args.numeric, args.max_error) {
+        (Some(Numeric::Fixed(f)), _) => f,
+        (Some(other), _) => {
+            return Err(CliError::Usage(format!(
+                "--numeric {other}: the hardware has fixed-point registers; give fixed:I=M.N,dI=M.N,ddI=M.N[,acc=M.N]"
+            )))
+        }
+        (None, Some(budget)) => {
+            let input = args.for_input.as_deref().expect("clap: requires --for");
+            if crate::input::InputKind::of(input)? != crate::input::InputKind::Scene {
+                return Err(CliError::Usage(format!(
+                    "--max-error needs a scene to fit (the exact image is the reference); {} is a trace: give --numeric",
+                    input.display()
+                )));
+            }
+            let stage = crate::progress::Stage::new(progress, "rtl: fitting the registers");
+            let drawn = args.draw.draw(Some(input))?;
+            let overflow = match args.overflow {
+                OverflowArg::Wrap => Overflow::Wrap,
+                OverflowArg::Saturate => Overflow::Saturate,
+            };
+            let found = fit_scene(&*drawn.renderer, Some(input), args.draw.size, &machine, budget, overflow, 0, None)?;
+            drop(stage);
+            fit_error = Some(found.fit.error);
+            found.fit.format
+        }
+        (None, None) => {
+            return Err(CliError::Usage(
+                "give the registers' format: --numeric fixed:… or, with --for SCENE, --max-error E".into(),
+            ))
+        }
+    };
+    let opcodes = match &trace {
+        Some(t) => opcodes_used(t),
+        None => all_opcodes(),
+    };
+    let timing = BusTiming::new(&machine, &header).map_err(rtl_error)?;
+    let design = Design::new(
+        format,
+        opcodes,
+        header.width,
+        header.channel_count(),
+        timing,
+    )
+    .map_err(rtl_error)?;
+    let text = verilog::design(&design);
+    write_atomic(&args.output, |w| {
+        w.write_all(text.as_bytes())
+            .map_err(|e| CliError::write(&args.output, e))
+    })?;
+    let watch = match args.watch.as_deref() {
+        None => Watch::ends(design.width),
+        Some(list) => Watch::parse(list, design.width)
+            .map_err(|e| CliError::Usage(format!("--watch {list}: {e}")))?,
+    };
+    if let Some(tb) = &args.testbench {
+        let text = verilog::testbench(&design, &watch);
+        write_atomic(tb, |w| {
+            w.write_all(text.as_bytes())
+                .map_err(|e| CliError::write(tb, e))
+        })?;
+    }
+    say(out, "design", design.summary())?;
+    if let Some(e) = fit_error {
+        say(
+            out,
+            "fit",
+            format!("max error {e:.4e} against the f64 array"),
+        )?;
+    }
+    say(out, "wrote", args.output.display().to_string())?;
+    if args.area {
+        let (dir, keep) = work_dir(None, "area")?;
+        let a = area::synthesize(&design, &dir).map_err(rtl_error);
+        if !keep {
+            let _ = std::fs::remove_dir_all(&dir);
+        }
+        let a = a?;
+        say(
+            out,
+            "area",
+            format!(
+                "one processor: {} cells ({} flip-flops, {} logic), about {:.0} NAND2 equivalents (Yosys synth; docs/HARDWARE.md has the mapping)",
+                a.total, a.flip_flops, a.logic, a.nand2
+            ),
+        )?;
+    }
+    if let (Some(sim), Some(trace)) = (args.cosim, &trace) {
+        let sim = match sim {
+            SimArg::Icarus => Simulator::Icarus,
+            SimArg::Verilator => Simulator::Verilator,
+        };
+        let (dir, keep) = work_dir(args.work_dir.as_deref(), "cosim")?;
+        let stage = crate::progress::Stage::new(progress, "rtl: co-simulating");
+        let outcome =
+            cosimulate(&design, &header, trace, &machine, &watch, sim, &dir).map_err(rtl_error)?;
+        drop(stage);
+        match outcome.result {
+            Ok(a) => {
+                if !keep {
+                    let _ = std::fs::remove_dir_all(&dir);
+                }
+                say(
+                    out,
+                    "co-sim",
+                    format!(
+                        "{}: identical to the stepped engine: {} scanline(s), {} value(s) bit for bit, {} token arrival(s) at {} watched processor(s), {} overflow event(s) ({} in the adders), {} cycles",
+                        sim.name(),
+                        a.scanlines,
+                        a.values,
+                        a.arrivals,
+                        watch.processors().len(),
+                        a.overflows,
+                        a.adder_overflows,
+                        a.cycles
+                    ),
+                )?;
+                say(
+                    out,
+                    "times",
+                    format!(
+                        "build {:.1} s, simulation {:.1} s, stepped engine {:.1} s",
+                        outcome.build.as_secs_f64(),
+                        outcome.simulate.as_secs_f64(),
+                        outcome.reference.as_secs_f64()
+                    ),
+                )?;
+            }
+            Err(m) => {
+                return Err(CliError::Internal(format!(
+                    "the {} co-simulation differs from the stepped engine: {m} (files in {})",
+                    sim.name(),
+                    dir.display()
+                )))
+            }
+        }
+    }
+    Ok(())
+}

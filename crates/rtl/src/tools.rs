@@ -1,0 +1,84 @@
+//! Running the HDL tools: Icarus Verilog (`iverilog`, `vvp`), Verilator and Yosys, from
+//! the PATH (Debian's packages, installed by `crates/rtl/tools/install-hdl.sh`).
+
+use crate::error::RtlError;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// The project's script that installs the tools.
+pub const INSTALL_SCRIPT: &str = "crates/rtl/tools/install-hdl.sh";
+
+/// `name` on the PATH, if there.
+pub fn find(name: &str) -> Option<PathBuf> {
+    std::env::var_os("PATH").and_then(|paths| {
+        std::env::split_paths(&paths)
+            .map(|d| d.join(name))
+            .find(|p| p.is_file())
+    })
+}
+
+/// `name` on the PATH, or [`RtlError::ToolMissing`].
+pub fn require(name: &str) -> Result<PathBuf, RtlError> {
+    find(name).ok_or_else(|| RtlError::ToolMissing { tool: name.into() })
+}
+
+/// Runs `program args…` in `dir`; its standard output, or [`RtlError::ToolFailed`] with
+/// the first lines of what it printed.
+pub fn run(program: &str, args: &[&str], dir: &Path) -> Result<String, RtlError> {
+    let bin = if program.contains('/') {
+        PathBuf::from(program)
+    } else {
+        require(program)?
+    };
+    let command = format!("{program} {}", args.join(" "));
+    let out = Command::new(&bin)
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .map_err(|e| RtlError::ToolFailed {
+            command: command.clone(),
+            status: "not started".into(),
+            output: e.to_string(),
+        })?;
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    if !out.status.success() {
+        let text: Vec<&str> = stderr.lines().chain(stdout.lines()).take(12).collect();
+        return Err(RtlError::ToolFailed {
+            command,
+            status: out.status.to_string(),
+            output: text.join(" | "),
+        });
+    }
+    Ok(format!("{stdout}{stderr}"))
+}
+
+/// Verilator's lint of a design file: `verilator --lint-only -Wall`, the warnings it
+/// printed (none is clean).
+pub fn lint(design: &Path, top: &str) -> Result<Vec<String>, RtlError> {
+    let dir = design.parent().unwrap_or(Path::new("."));
+    let file = design
+        .file_name()
+        .and_then(|f| f.to_str())
+        .unwrap_or("design.v");
+    let bin = require("verilator")?;
+    let out = Command::new(&bin)
+        .args(["--lint-only", "-Wall", "--top-module", top, file])
+        .current_dir(dir)
+        .output()
+        .map_err(|e| RtlError::io(bin.clone(), e))?;
+    let text = String::from_utf8_lossy(&out.stderr).into_owned();
+    let warnings: Vec<String> = text
+        .lines()
+        .filter(|l| l.starts_with("%Warning") || l.starts_with("%Error"))
+        .map(str::to_string)
+        .collect();
+    if !out.status.success() && warnings.is_empty() {
+        return Err(RtlError::ToolFailed {
+            command: format!("verilator --lint-only -Wall --top-module {top} {file}"),
+            status: out.status.to_string(),
+            output: text.lines().take(12).collect::<Vec<_>>().join(" | "),
+        });
+    }
+    Ok(warnings)
+}
