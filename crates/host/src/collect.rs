@@ -6,7 +6,7 @@
 //! grey), and a fresh process pays a page fault for every 4 KB it first writes: collecting
 //! the `f64` image only to map it to bytes at the end cost `cwisim render` about 4 ms of
 //! its "array in order" stage on the pot at 1024², and the mapping pass another 3 ms
-//! (docs/PERFORMANCE.md, "Fifth round: what the user runs").
+//! (docs/PERFORMANCE.md, "What the user runs").
 
 use crate::output::{png_sample, PngSamples};
 use cwisim_xproc::{Image, ImageLimit, ImageSink, LineOut, LineSink};
