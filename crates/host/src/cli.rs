@@ -169,7 +169,7 @@ polygons whose highlight vector is within --phong-angle degrees of the eye, and 
 pixels whose 3x3 range in the previous frame exceeds --aa-threshold (the previous frame's \
 instructions re-sent around them, masked with Dis). Per phase it prints the pixels processed, instructions (total, regenerated), bus-busy \
 and cumulative cycles, the worst scanline against the line period, late scanlines, RMS error \
-and PSNR against the full-quality image (render --shading phong --aa box) and the display \
+and PSNR against the full-quality image (render --shading phong) and the display \
 list's bytes against a frame buffer's; then the naive sequence, every phase's renderer in full \
 (the paper's figure 1).\n\n\
 --plot draws error against cumulative cycles (with the naive sequence) and busy cycles per \
