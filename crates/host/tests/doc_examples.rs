@@ -139,7 +139,7 @@ const LONG: &[&str] = &[
     "README.md: refine teapot --phases flat,phong --sweep",
     // five renderers × tessellations × settings, 150 rows: 250 s release
     "README.md: tradeoff teapot --numeric f64",
-    // 270 rows: 95 s release
+    // 240 rows: 8–10 s release on two cores
     "README.md: tradeoff pot --csv pot.csv --plot pot-tradeoff.png",
     // 100 s debug, 9 s release
     "README.md: inspect pot -o pot.html",
