@@ -130,6 +130,27 @@ impl Design {
         self.format.q(reg).width()
     }
 
+    /// Whether tokens carry an address (any opcode with an `x` operand): `skip` and
+    /// `count`.
+    pub fn addressed(&self) -> bool {
+        self.opcodes
+            .iter()
+            .any(|op| op.operands().contains(&OperandKind::X))
+    }
+
+    /// The value fields a token carries, in order, each with its bits per channel:
+    /// `("v", …)`, `("d", …)`, `("dd", …)` for the opcodes that carry them.
+    pub fn value_fields(&self) -> Vec<(&'static str, u32)> {
+        [
+            (self.carries_v(), "v", self.v_bits()),
+            (self.carries_d(), "d", self.bits(Register::DI)),
+            (self.carries_dd(), "dd", self.bits(Register::DDI)),
+        ]
+        .into_iter()
+        .filter_map(|(on, name, bits)| on.then_some((name, bits)))
+        .collect()
+    }
+
     /// Whether tokens carry a value operand `I` (any opcode with an `I` operand).
     pub fn carries_v(&self) -> bool {
         self.opcodes

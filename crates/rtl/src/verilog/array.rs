@@ -17,17 +17,9 @@ pub(crate) fn write(d: &Design, out: &mut Text) {
     let n = d.channels as u32;
     let w = d.width;
     let (aw, cw, ow) = (d.skip_bits(), d.count_bits(), d.op_bits());
-    let vw = d.v_bits();
-    let (wd, wdd, wa) = (
-        d.bits(Register::DI),
-        d.bits(Register::DDI),
-        d.bits(Register::Acc),
-    );
-    let addressed = d
-        .opcodes
-        .iter()
-        .any(|o| o.operands().contains(&OperandKind::X));
-    let (carry_v, carry_d, carry_dd) = (d.carries_v(), d.carries_d(), d.carries_dd());
+    let wa = d.bits(Register::Acc);
+    let addressed = d.addressed();
+    let fields = d.value_fields();
     let counting = d.order() >= 1;
     let ovw = overflow_count_bits(d);
     let ev_bits = bits_for(d.events_per_visit());
@@ -51,14 +43,8 @@ pub(crate) fn write(d: &Design, out: &mut Text) {
         ports.push(format!("    input  wire [{}:0] in_x", aw - 1));
         ports.push(format!("    input  wire [{}:0] in_dx", cw - 1));
     }
-    if carry_v {
-        ports.push(format!("    input  wire [{}:0] in_v", vw * n - 1));
-    }
-    if carry_d {
-        ports.push(format!("    input  wire [{}:0] in_d", wd * n - 1));
-    }
-    if carry_dd {
-        ports.push(format!("    input  wire [{}:0] in_dd", wdd * n - 1));
+    for &(name, bits) in &fields {
+        ports.push(format!("    input  wire [{}:0] in_{name}", bits * n - 1));
     }
     ports.push("    // the bus starts issuing it this cycle".into());
     ports.push("    output wire in_take".into());
@@ -103,14 +89,8 @@ pub(crate) fn write(d: &Design, out: &mut Text) {
         out.line(&format!("    reg [{}:0] bus_skip;", aw - 1));
         out.line(&format!("    reg [{}:0] bus_count;", cw - 1));
     }
-    if carry_v {
-        out.line(&format!("    reg [{}:0] bus_v;", vw * n - 1));
-    }
-    if carry_d {
-        out.line(&format!("    reg [{}:0] bus_d;", wd * n - 1));
-    }
-    if carry_dd {
-        out.line(&format!("    reg [{}:0] bus_dd;", wdd * n - 1));
+    for &(name, bits) in &fields {
+        out.line(&format!("    reg [{}:0] bus_{name};", bits * n - 1));
     }
     out.line(&format!(
         "    wire [{}:0] leave;    // the token in processor p moves on this cycle",
@@ -229,14 +209,8 @@ pub(crate) fn write(d: &Design, out: &mut Text) {
         out.line("            bus_skip <= in_x;");
         out.line("            bus_count <= in_count;");
     }
-    if carry_v {
-        out.line("            bus_v <= in_v;");
-    }
-    if carry_d {
-        out.line("            bus_d <= in_d;");
-    }
-    if carry_dd {
-        out.line("            bus_dd <= in_dd;");
+    for &(name, _) in &fields {
+        out.line(&format!("            bus_{name} <= in_{name};"));
     }
     out.line("        end");
     out.line("    end");
@@ -267,14 +241,8 @@ pub(crate) fn write(d: &Design, out: &mut Text) {
         chain(out, "skip", aw, "bus_skip");
         chain(out, "count", cw, "bus_count");
     }
-    if carry_v {
-        chain(out, "v", vw * n, "bus_v");
-    }
-    if carry_d {
-        chain(out, "d", wd * n, "bus_d");
-    }
-    if carry_dd {
-        chain(out, "dd", wdd * n, "bus_dd");
+    for &(name, bits) in &fields {
+        chain(out, name, bits * n, &format!("bus_{name}"));
     }
     if counting {
         chain(out, "ovf", ovw, &format!("{ovw}'d0"));
@@ -297,15 +265,9 @@ pub(crate) fn write(d: &Design, out: &mut Text) {
         conns.push(format!(".in_skip(chain_skip[p*{aw} +: {aw}])"));
         conns.push(format!(".in_count(chain_count[p*{cw} +: {cw}])"));
     }
-    let fields = [
-        (carry_v, "v", vw * n),
-        (carry_d, "d", wd * n),
-        (carry_dd, "dd", wdd * n),
-    ];
-    for (on, name, bits) in fields {
-        if on {
-            conns.push(format!(".in_{name}(chain_{name}[p*{bits} +: {bits}])"));
-        }
+    for &(name, bits) in &fields {
+        let bits = bits * n;
+        conns.push(format!(".in_{name}(chain_{name}[p*{bits} +: {bits}])"));
     }
     conns.push(".tok_valid(tok_valid[p])".into());
     conns.push(".tok_leave(leave[p])".into());
@@ -314,10 +276,9 @@ pub(crate) fn write(d: &Design, out: &mut Text) {
         conns.push(format!(".tok_skip(chain_skip[(p+1)*{aw} +: {aw}])"));
         conns.push(format!(".tok_count(chain_count[(p+1)*{cw} +: {cw}])"));
     }
-    for (on, name, bits) in fields {
-        if on {
-            conns.push(format!(".tok_{name}(chain_{name}[(p+1)*{bits} +: {bits}])"));
-        }
+    for &(name, bits) in &fields {
+        let bits = bits * n;
+        conns.push(format!(".tok_{name}(chain_{name}[(p+1)*{bits} +: {bits}])"));
     }
     conns.push(format!(".out(out_flat[p*{} +: {}])", wa * n, wa * n));
     if counting {
@@ -366,10 +327,9 @@ pub(crate) fn write(d: &Design, out: &mut Text) {
         leftovers.push(format!("chain_skip[W*{aw} +: {aw}]"));
         leftovers.push(format!("chain_count[W*{cw} +: {cw}]"));
     }
-    for (on, name, bits) in fields {
-        if on {
-            leftovers.push(format!("chain_{name}[W*{bits} +: {bits}]"));
-        }
+    for &(name, bits) in &fields {
+        let bits = bits * n;
+        leftovers.push(format!("chain_{name}[W*{bits} +: {bits}]"));
     }
     out.line(&format!(
         "    wire unused_leaving = ^{{{}}};",

@@ -69,10 +69,7 @@ pub(crate) fn write(d: &Design, out: &mut Text) {
     );
     let vw = d.v_bits();
     let (aw, cw, ow) = (d.skip_bits(), d.count_bits(), d.op_bits());
-    let addressed = d
-        .opcodes
-        .iter()
-        .any(|o| o.operands().contains(&cwisim_isa::OperandKind::X));
+    let addressed = d.addressed();
     let order = d.order();
     let pre = [
         d.preload(0) && order >= 1,
@@ -452,14 +449,9 @@ pub(crate) fn write(d: &Design, out: &mut Text) {
         ports.push(format!("    input  wire [{}:0] in_skip", aw - 1));
         ports.push(format!("    input  wire [{}:0] in_count", cw - 1));
     }
-    if carry_v {
-        ports.push(format!("    input  wire [{}:0] in_v", vw * n - 1));
-    }
-    if carry_d {
-        ports.push(format!("    input  wire [{}:0] in_d", wd * n - 1));
-    }
-    if carry_dd {
-        ports.push(format!("    input  wire [{}:0] in_dd", wdd * n - 1));
+    let fields = d.value_fields();
+    for &(name, bits) in &fields {
+        ports.push(format!("    input  wire [{}:0] in_{name}", bits * n - 1));
     }
     ports.push("    // the token held here; it moves on to the right when `tok_leave`".into());
     ports.push("    output reg  tok_valid".into());
@@ -469,14 +461,8 @@ pub(crate) fn write(d: &Design, out: &mut Text) {
         ports.push(format!("    output reg  [{}:0] tok_skip", aw - 1));
         ports.push(format!("    output reg  [{}:0] tok_count", cw - 1));
     }
-    if carry_v {
-        ports.push(format!("    output reg  [{}:0] tok_v", vw * n - 1));
-    }
-    if carry_d {
-        ports.push(format!("    output reg  [{}:0] tok_d", wd * n - 1));
-    }
-    if carry_dd {
-        ports.push(format!("    output reg  [{}:0] tok_dd", wdd * n - 1));
+    for &(name, bits) in &fields {
+        ports.push(format!("    output reg  [{}:0] tok_{name}", bits * n - 1));
     }
     ports.push("    // the accumulator, per channel, as the last Refresh moved it out".into());
     ports.push(format!("    output reg  [{}:0] out", wa * n - 1));

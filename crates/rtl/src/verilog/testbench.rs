@@ -7,7 +7,6 @@
 use super::array::overflow_count_bits;
 use super::{header, Text, ARRAY_MODULE, TESTBENCH_MODULE};
 use crate::design::Design;
-use cwisim_isa::OperandKind;
 use cwisim_xproc::Register;
 
 /// The stimulus file the testbench reads, in its working directory.
@@ -73,16 +72,8 @@ pub fn testbench(d: &Design, watch: &Watch) -> String {
     let n = d.channels as u32;
     let w = d.width;
     let (aw, cw, ow) = (d.skip_bits(), d.count_bits(), d.op_bits());
-    let vw = d.v_bits();
-    let (wd, wdd, wa) = (
-        d.bits(Register::DI),
-        d.bits(Register::DDI),
-        d.bits(Register::Acc),
-    );
-    let addressed = d
-        .opcodes
-        .iter()
-        .any(|o| o.operands().contains(&OperandKind::X));
+    let wa = d.bits(Register::Acc);
+    let addressed = d.addressed();
     let counting = d.order() >= 1;
     let mut v = Text::new();
     header(
@@ -112,19 +103,13 @@ pub fn testbench(d: &Design, watch: &Watch) -> String {
         fields.push(("in_x".into(), aw));
         fields.push(("in_dx".into(), cw));
     }
-    let values = [
-        (d.carries_v(), "in_v", vw),
-        (d.carries_d(), "in_d", wd),
-        (d.carries_dd(), "in_dd", wdd),
-    ];
-    for (on, name, bits) in values {
-        if on {
-            v.line(&format!(
-                "    reg [{}:0] {name} = {}'d0;",
-                bits * n - 1,
-                bits * n
-            ));
-        }
+    let values = d.value_fields();
+    for &(field, bits) in &values {
+        v.line(&format!(
+            "    reg [{}:0] in_{field} = {}'d0;",
+            bits * n - 1,
+            bits * n
+        ));
     }
     v.line("    wire in_take;");
     v.line("    wire [63:0] cycle;");
@@ -148,10 +133,8 @@ pub fn testbench(d: &Design, watch: &Watch) -> String {
         conns.push(".in_x(in_x)".into());
         conns.push(".in_dx(in_dx)".into());
     }
-    for (on, name, _) in values {
-        if on {
-            conns.push(format!(".{name}({name})"));
-        }
+    for &(field, _) in &values {
+        conns.push(format!(".in_{field}(in_{field})"));
     }
     for s in [
         "in_take",
@@ -178,15 +161,13 @@ pub fn testbench(d: &Design, watch: &Watch) -> String {
         .iter()
         .map(|(name, bits)| (format!("f_{}", &name[3..]), name.to_string(), *bits))
         .collect();
-    for (on, name, bits) in values {
-        if on {
-            for c in 0..n {
-                reads.push((
-                    format!("f_{}_c{c}", &name[3..]),
-                    format!("{name}[{}:{}]", (c + 1) * bits - 1, c * bits),
-                    bits,
-                ));
-            }
+    for &(field, bits) in &values {
+        for c in 0..n {
+            reads.push((
+                format!("f_{field}_c{c}"),
+                format!("in_{field}[{}:{}]", (c + 1) * bits - 1, c * bits),
+                bits,
+            ));
         }
     }
     let k_n = reads.len();
