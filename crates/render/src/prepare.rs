@@ -106,18 +106,6 @@ impl PhongSurfaces {
                 }),
         }
     }
-
-    /// The intensity of polygon `polygon` at screen point `p` (on its triangle), by the
-    /// lights that reach it.
-    pub fn shade(&self, polygon: usize, p: [f64; 2]) -> Option<Vector> {
-        let triangle = &self.triangles[self.sources[polygon]];
-        match &self.shadows {
-            None => self.shader.at(triangle, p),
-            Some(s) => self
-                .shader
-                .at_lit(triangle, p, |k| s.casters.reaches(s.lit[polygon], k)),
-        }
-    }
 }
 
 /// The lights of world scene `w` that cast shadows under `settings`, refusing a
@@ -424,8 +412,8 @@ impl PolygonScene {
         let Some(s) = &self.phong else {
             return Vec::new();
         };
-        (0..)
-            .map_while(|k| s.shader.mesh_texture(k))
+        s.shader
+            .textures()
             .enumerate()
             .filter_map(|(k, t)| {
                 t.map(|t| {

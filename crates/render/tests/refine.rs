@@ -100,6 +100,17 @@ fn full(name: &str, size: u32) -> (Vec<f64>, Vec<Instruction>) {
     (run.frames[0].clone(), stream)
 }
 
+/// `vanrij`'s point-sampled image of the embedded scene `name` at `size` in `shading`.
+fn point_sampled(name: &str, size: u32, shading: Shading) -> Vec<f64> {
+    let point = Settings {
+        aa: Antialias::None,
+        shading,
+        ..Settings::default()
+    };
+    let r = build("vanrij", scene(name, size), &point);
+    run(&*r, 1).frames.remove(0)
+}
+
 fn rms(a: &[f64], b: &[f64]) -> f64 {
     assert_eq!(a.len(), b.len());
     (a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum::<f64>() / a.len() as f64).sqrt()
@@ -130,18 +141,7 @@ fn every_threshold_at_all_gives_van_rijs_phong_box_filter_bit_for_bit() {
         assert_eq!(bits(last), bits(&image), "{name}: last frame");
         assert_eq!(run.streams.last().unwrap(), &stream, "{name}: last stream");
         // the Gouraud phase Gouraud-shades every polygon: van Rij point-sampled
-        let point = |shading| {
-            let r = build(
-                "vanrij",
-                scene(name, 96),
-                &Settings {
-                    aa: Antialias::None,
-                    shading,
-                    ..Settings::default()
-                },
-            );
-            self::run(&*r, 1).frames.remove(0)
-        };
+        let point = |shading| point_sampled(name, 96, shading);
         // (with a light casting shadows, the shadow phase would come second)
         let gouraud = run.frames.len() - 3;
         assert_eq!(bits(&run.frames[gouraud]), bits(&point(Shading::Gouraud)));
@@ -179,18 +179,7 @@ fn a_textured_scene_s_phases_are_van_rijs_textured_images_bit_for_bit() {
             &image,
             &format!("{name}: last frame"),
         );
-        let point = |shading| {
-            let r = build(
-                "vanrij",
-                scene(name, 64),
-                &Settings {
-                    aa: Antialias::None,
-                    shading,
-                    ..Settings::default()
-                },
-            );
-            self::run(&*r, 1).frames.remove(0)
-        };
+        let point = |shading| point_sampled(name, 64, shading);
         let gouraud = run.frames.len() - 3;
         same(
             &run.frames[gouraud],

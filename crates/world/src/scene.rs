@@ -742,34 +742,50 @@ pub fn parse_world(text: &str, base: Option<&Path>) -> Result<WorldScene, SceneE
     })
 }
 
-/// The textures of a scene's meshes (validated spec, built meshes): each loaded, and each
-/// textured mesh checked to have texture coordinates.
+/// The textures of a scene's meshes (validated spec, built meshes): each textured mesh
+/// checked to have texture coordinates and each texture's size read (a checker's, an
+/// image's header) first; then what they all need checked against the memory budget
+/// (`cwisim_scene::budget`), refused at the texture that passes it; then each loaded.
 pub(crate) fn load_textures(
     spec: &WorldSpec,
     meshes: &[Mesh],
     base: Option<&Path>,
 ) -> Result<Vec<Option<std::sync::Arc<crate::texture::Texture>>>, SceneError> {
+    use crate::texture;
     let channels = spec.channels as usize;
+    let field = |k: usize| format!("meshes[{k}].material.texture");
+    let mut needed = 0u64;
+    for (k, (m, built)) in spec.meshes.iter().zip(meshes).enumerate() {
+        let Some(t) = &m.material.texture else {
+            continue;
+        };
+        if !built.has_uv() {
+            return Err(SceneError::at_field(
+                SceneErrorKind::Shape,
+                field(k),
+                format!(
+                    "mesh {:?} has no texture coordinates: give inline \"uv\" (one per vertex), an OBJ file with `vt` at every corner, a \"revolution\" or \"bezier\" patches",
+                    built.name
+                ),
+            ));
+        }
+        let (w, h) = texture::extent(t, &field(k), base)?;
+        needed += texture::bytes_for(w, h, channels);
+        cwisim_scene::budget::Budget::current()
+            .check_memory(
+                &format!("the scene's textures (up to meshes[{k}], {w}×{h} texels)"),
+                needed,
+            )
+            .map_err(|e| SceneError::at_field(SceneErrorKind::Limit, field(k), e.to_string()))?;
+    }
     spec.meshes
         .iter()
-        .zip(meshes)
         .enumerate()
-        .map(|(k, (m, built))| {
-            let Some(t) = &m.material.texture else {
-                return Ok(None);
-            };
-            let field = format!("meshes[{k}].material.texture");
-            if !built.has_uv() {
-                return Err(SceneError::at_field(
-                    SceneErrorKind::Shape,
-                    field,
-                    format!(
-                        "mesh {:?} has no texture coordinates: give inline \"uv\" (one per vertex), an OBJ file with `vt` at every corner, a \"revolution\" or \"bezier\" patches",
-                        built.name
-                    ),
-                ));
+        .map(|(k, m)| match &m.material.texture {
+            None => Ok(None),
+            Some(t) => {
+                texture::load(t, &field(k), channels, base).map(|t| Some(std::sync::Arc::new(t)))
             }
-            crate::texture::load(t, &field, channels, base).map(|t| Some(std::sync::Arc::new(t)))
         })
         .collect()
 }

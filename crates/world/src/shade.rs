@@ -87,10 +87,9 @@ impl PhongShader {
         self.textures.get(mesh as usize)?.as_deref()
     }
 
-    /// Mesh `mesh`'s texture: `None` past the last mesh, `Some(None)` for an untextured
-    /// one.
-    pub fn mesh_texture(&self, mesh: usize) -> Option<Option<&Texture>> {
-        self.textures.get(mesh).map(Option::as_deref)
+    /// Each mesh's texture, in mesh order (`None` for an untextured mesh).
+    pub fn textures(&self) -> impl Iterator<Item = Option<&Texture>> {
+        self.textures.iter().map(Option::as_deref)
     }
 
     /// Whether any mesh is textured.

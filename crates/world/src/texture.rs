@@ -172,7 +172,7 @@ impl Texture {
 
     /// The texels' memory, bytes (texels and table).
     pub fn bytes(&self) -> u64 {
-        ((self.texels.len() + self.table.len()) * std::mem::size_of::<f64>()) as u64
+        bytes_for(self.width, self.height, self.channels)
     }
 
     /// `(u, v)` in texels, repeat applied.
@@ -186,11 +186,11 @@ impl Texture {
     /// The texel under `(u, v)` (wrapped), per channel; unused channels 1.
     pub fn point(&self, uv: [f64; 2]) -> [f64; 4] {
         let [x, y] = self.to_texels(uv);
-        let i = wrap(x.floor(), self.width);
-        let j = wrap(y.floor(), self.height);
+        let (i, j) = (x.floor() as i64, y.floor() as i64);
         let mut out = [1.0; 4];
-        let at = (j * self.width + i) * self.channels;
-        out[..self.channels].copy_from_slice(&self.texels[at..at + self.channels]);
+        for (c, value) in out.iter_mut().enumerate().take(self.channels) {
+            *value = self.texel(i, j, c);
+        }
         out
     }
 
@@ -318,12 +318,6 @@ fn overlap(i: i64, x0: f64, x1: f64) -> f64 {
     (x1.min(i + 1.0) - x0.max(i)).max(0.0)
 }
 
-fn wrap(x: f64, n: usize) -> usize {
-    let n_f = n as f64;
-    let r = x - (x / n_f).floor() * n_f;
-    (r as usize).min(n - 1)
-}
-
 /// Checks a texture spec at JSON path `field` (`meshes[k].material.texture`).
 pub fn validate(spec: &TextureSpec, field: &str, channels: usize) -> Result<(), SceneError> {
     use SceneErrorKind as K;
@@ -371,10 +365,114 @@ pub fn validate(spec: &TextureSpec, field: &str, channels: usize) -> Result<(), 
     Ok(())
 }
 
+/// A texture's image file: its name as the scene gives it, its path, and the JSON path of
+/// the name, for errors.
+struct ImageFile<'a> {
+    name: &'a str,
+    path: PathBuf,
+    field: String,
+}
+
+impl ImageFile<'_> {
+    fn of<'a>(name: &'a str, field: &str, base: Option<&Path>) -> ImageFile<'a> {
+        ImageFile {
+            name,
+            path: base.map_or_else(|| PathBuf::from(name), |b| b.join(name)),
+            field: format!("{field}.image"),
+        }
+    }
+
+    fn fail(&self, kind: SceneErrorKind, what: String) -> SceneError {
+        SceneError::at_field(
+            kind,
+            self.field.clone(),
+            format!("texture {:?}: {what}", self.name),
+        )
+    }
+
+    fn io(&self, e: std::io::Error) -> SceneError {
+        self.fail(SceneErrorKind::Io, format!("cannot read it: {e}"))
+    }
+
+    fn not_png(&self, e: image::ImageError) -> SceneError {
+        self.fail(
+            SceneErrorKind::Shape,
+            format!("not a readable PNG image ({e})"),
+        )
+    }
+
+    /// Its size from its header, the file checked first: a regular file within
+    /// [`MAX_TEXTURE_BYTES`], a PNG, not empty, within [`MAX_TEXELS`]. Nothing decoded.
+    fn extent(&self) -> Result<(u32, u32), SceneError> {
+        let meta = std::fs::metadata(&self.path).map_err(|e| self.io(e))?;
+        if !meta.is_file() {
+            return Err(self.fail(
+                SceneErrorKind::Io,
+                "not a regular file (a PNG file is expected)".into(),
+            ));
+        }
+        if meta.len() > MAX_TEXTURE_BYTES {
+            return Err(self.fail(
+                SceneErrorKind::Limit,
+                format!(
+                    "the file has {} bytes; the limit is {MAX_TEXTURE_BYTES}",
+                    meta.len()
+                ),
+            ));
+        }
+        let file = std::fs::File::open(&self.path).map_err(|e| self.io(e))?;
+        let reader =
+            image::ImageReader::with_format(std::io::BufReader::new(file), image::ImageFormat::Png);
+        let (width, height) = reader.into_dimensions().map_err(|e| self.not_png(e))?;
+        if width == 0 || height == 0 {
+            return Err(self.fail(
+                SceneErrorKind::Shape,
+                format!("the image is empty ({width}×{height})"),
+            ));
+        }
+        let texels = u64::from(width) * u64::from(height);
+        if texels > MAX_TEXELS {
+            return Err(self.fail(
+                SceneErrorKind::Limit,
+                format!(
+                    "{width}×{height} = {texels} texels; the limit is {MAX_TEXELS} (2048×2048)"
+                ),
+            ));
+        }
+        Ok((width, height))
+    }
+}
+
+/// The size in texels, `(width, height)`, of the texture a (validated) spec makes: a
+/// checker's squares, or the PNG file's size read from its header (the file checked as
+/// [`load`] checks it; nothing decoded). What a scene's textures will need is known from
+/// it before any is built ([`bytes_for`]).
+pub fn extent(
+    spec: &TextureSpec,
+    field: &str,
+    base: Option<&Path>,
+) -> Result<(usize, usize), SceneError> {
+    match (&spec.checker, &spec.image) {
+        (Some(c), _) => Ok((c.squares[0] as usize, c.squares[1] as usize)),
+        (None, image) => {
+            let (w, h) =
+                ImageFile::of(image.as_deref().unwrap_or_default(), field, base).extent()?;
+            Ok((w as usize, h as usize))
+        }
+    }
+}
+
+/// The memory a texture of `width × height` texels takes in `channels` channels: its
+/// texels and its summed-area table, `f64` each.
+pub fn bytes_for(width: usize, height: usize, channels: usize) -> u64 {
+    let values = (width * height + (width + 1) * (height + 1)) * channels;
+    (values * std::mem::size_of::<f64>()) as u64
+}
+
 /// Builds the texture of a (validated) spec for a scene of `channels` channels: a
 /// checkerboard, or the PNG file `image` relative to `base`. A file that is missing,
 /// unreadable, not a PNG, empty or over the limits is an error at `field.image` naming
-/// the file, found before its texels are allocated.
+/// the file, found from its header before its texels are allocated.
 pub fn load(
     spec: &TextureSpec,
     field: &str,
@@ -400,67 +498,22 @@ pub fn load(
         ));
     }
     let name = spec.image.as_deref().unwrap_or_default();
-    let path = match base {
-        Some(b) => b.join(name),
-        None => PathBuf::from(name),
-    };
-    let field = format!("{field}.image");
-    let fail = |kind: SceneErrorKind, what: String| {
-        SceneError::at_field(kind, field.clone(), format!("texture {name:?}: {what}"))
-    };
-    let io = |e: std::io::Error| fail(SceneErrorKind::Io, format!("cannot read it: {e}"));
-    let meta = std::fs::metadata(&path).map_err(io)?;
-    if !meta.is_file() {
-        return Err(fail(
-            SceneErrorKind::Io,
-            "not a regular file (a PNG file is expected)".into(),
-        ));
-    }
-    if meta.len() > MAX_TEXTURE_BYTES {
-        return Err(fail(
-            SceneErrorKind::Limit,
-            format!(
-                "the file has {} bytes; the limit is {MAX_TEXTURE_BYTES}",
-                meta.len()
-            ),
-        ));
-    }
+    let file = ImageFile::of(name, field, base);
+    let (width, height) = file.extent()?;
     let mut bytes = Vec::new();
-    std::fs::File::open(&path)
-        .map_err(io)?
+    std::fs::File::open(&file.path)
+        .map_err(|e| file.io(e))?
         .take(MAX_TEXTURE_BYTES + 1)
         .read_to_end(&mut bytes)
-        .map_err(io)?;
-    let not_png = |e: image::ImageError| {
-        fail(
-            SceneErrorKind::Shape,
-            format!("not a readable PNG image ({e})"),
-        )
-    };
-    let reader =
-        image::ImageReader::with_format(std::io::Cursor::new(&bytes), image::ImageFormat::Png);
-    let (width, height) = reader.into_dimensions().map_err(not_png)?;
-    if width == 0 || height == 0 {
-        return Err(fail(
-            SceneErrorKind::Shape,
-            format!("the image is empty ({width}×{height})"),
-        ));
-    }
-    let texels = u64::from(width) * u64::from(height);
-    if texels > MAX_TEXELS {
-        return Err(fail(
-            SceneErrorKind::Limit,
-            format!("{width}×{height} = {texels} texels; the limit is {MAX_TEXELS} (2048×2048)"),
-        ));
-    }
+        .map_err(|e| file.io(e))?;
     let mut reader =
         image::ImageReader::with_format(std::io::Cursor::new(&bytes), image::ImageFormat::Png);
     let mut limits = image::Limits::default();
     limits.max_image_width = Some(width);
     limits.max_image_height = Some(height);
-    limits.max_alloc = Some(texels * 16 + (1 << 20));
+    limits.max_alloc = Some(u64::from(width) * u64::from(height) * 16 + (1 << 20));
     reader.limits(limits);
-    let decoded = reader.decode().map_err(not_png)?;
+    let decoded = reader.decode().map_err(|e| file.not_png(e))?;
     let (w, h) = (width as usize, height as usize);
     let mut out = Vec::with_capacity(w * h * channels);
     let rgb = decoded.to_rgb8();

@@ -237,3 +237,33 @@ fn every_geometry_source_gives_texture_coordinates() {
     assert!(uv.contains(&[0.0, 0.0]) && uv.contains(&[1.0, 1.0]));
     assert!(uv.contains(&[0.125, 0.875]));
 }
+
+#[test]
+fn textures_past_the_memory_budget_are_refused_before_any_is_built() {
+    // 70 grey checkerboards of 2048 × 2048: 67 MB each with their tables, 4.7 GB in all,
+    // over the default budget of 4 GiB — refused from their sizes, nothing allocated
+    let meshes: Vec<String> = (0..70)
+        .map(|k| {
+            format!(
+                r#"{{ "material": {{ "k_a": 1, "k_d": 0, "k_s": 0, "n": 1,
+      "texture": {{ "checker": {{ "squares": [2048, 2048] }} }} }},
+    "vertices": [[-1, -1, {k}], [1, -1, {k}], [1, 1, {k}], [-1, 1, {k}]],
+    "uv": [[0, 0], [1, 0], [1, 1], [0, 1]], "faces": [[0, 1, 2, 3]] }}"#
+            )
+        })
+        .collect();
+    let text = format!(
+        r#"{{ "kind": "world", "width": 32, "height": 32, "channels": 1,
+  "camera": {{ "eye": [0, 0, 100], "target": [0, 0, 0], "fov_y": 30 }}, "ambient": 1,
+  "meshes": [ {} ] }}"#,
+        meshes.join(",\n")
+    );
+    let e = cwisim_world::parse_any(&text, None)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("meshes[63].material.texture: the scene's textures"),
+        "{e}"
+    );
+    assert!(e.contains("over the budget"), "{e}");
+}

@@ -95,6 +95,8 @@ pub struct Polys {
     pub triangles: Option<Vec<ScreenTriangle>>,
     /// With Phong shading, or textures: the lighting.
     pub shader: Option<PhongShader>,
+    /// A mesh is textured (so every sample is lit one by one).
+    textured: bool,
     /// World scenes: the camera's eye, in the world.
     pub eye: Option<[f64; 3]>,
     /// What projection did (world scenes).
@@ -203,6 +205,7 @@ impl Polys {
             header,
             polys,
             triangles,
+            textured: shader.as_ref().is_some_and(PhongShader::textured),
             shader,
             eye,
             project,
@@ -226,7 +229,7 @@ impl Polys {
 
     /// Whether a mesh is textured.
     pub fn textured(&self) -> bool {
-        self.shader.as_ref().is_some_and(PhongShader::textured)
+        self.textured
     }
 
     /// With Phong shading (or textures): the lit colour of polygon `p` at `(x, y)` (negative terms
