@@ -24,6 +24,16 @@
 //! `CWISIM_BIN` pointing at the release binary (`CWISIM_BIN` replaces the binary Cargo
 //! built for this test).
 //!
+//! **Outputs.** In a block tagged `console`, a line `$ COMMAND` is a command and the lines
+//! under it are what its standard output must show, matched with `snapbox` (`...` on a line
+//! of its own for any lines, `[..]` for any text within a line). A Markdown table right
+//! under a line `<!-- table from: COMMAND; varying: COLUMN, … -->` must be, row for row, the
+//! table with the same header that the command prints, but for the varying columns (host
+//! times). So a figure a document quotes from a command fails here when it drifts. A command
+//! `cargo run --release -p PACKAGE --example NAME` whose output is checked so runs the
+//! example's release binary from `CWISIM_EXAMPLES_DIR`, which `.ci/run` builds and sets;
+//! without it, it is skipped, saying so.
+//!
 //! **Help.** The `Example:`/`Examples:` lines of every command's long help run the same way,
 //! in one directory holding the files their generic names stand for ([`HELP_FILES`]).
 //!
@@ -156,12 +166,14 @@ const LONG: &[&str] = &[
     "docs/RENDERERS.md: tradeoff teapot --renderers vanrij,nishita",
     // 1000 polygons of 500 vertices through the S-buffer: 35 s debug, 3.5 s release
     "docs/REPRODUCTION.md: render many500.json",
-    // three nishita teapots: 3 × 10 s debug, 4 s release
-    "docs/REPRODUCTION.md: --renderer nishita --root-tolerance $t",
-    // seven nishita teapots, flatness 16 to 0.25 px: 10–90 s debug each, 1–5 s release
-    "docs/REPRODUCTION.md: --root-tolerance 1e-3 --flatness $f",
+    // 21 nishita teapots, three tolerances, flatness 16 to 0.25 px: 10–90 s debug each,
+    // 35 s release in all; and the defaults' one, 2 s release
+    "docs/REPRODUCTION.md: --renderer nishita --root-tolerance $t --flatness $f",
+    "docs/REPRODUCTION.md: render teapot --renderer nishita -o f.png",
     // the plain and the textured teapot by nishita: 2 × 40 s debug, 2 s release
     "docs/REPRODUCTION.md: --renderer nishita --threads 1",
+    // still-life through the S-buffer with its shadows: 20 s debug, 0.2 s release
+    "docs/REPRODUCTION.md: render still-life --renderer sbuffer",
     // eight refinements of the pot: 15 s debug, 2 s release
     "docs/REPRODUCTION.md: refine pot --sweep",
     // 50–200 s debug, 9–14 s release
@@ -330,7 +342,7 @@ fn the_lists_are_complete_and_current() {
                 }
             }
         }
-        let units: Vec<Unit> = shell_units(&blocks);
+        let units: Vec<Unit> = document_units(&text);
         if !units.is_empty() {
             with_examples.push(doc.clone());
         }
@@ -412,6 +424,7 @@ fn help_examples_run() {
             status: 0,
             block: 0,
             shell: "sh",
+            check: Check::Status,
         })
         .collect();
     for u in &setup {
@@ -475,6 +488,31 @@ fn shell_units(blocks: &[Block]) -> Vec<Unit> {
         .collect()
 }
 
+/// A document's commands in order: its shell blocks' and its tables' ([`table_units`]).
+fn document_units(text: &str) -> Vec<Unit> {
+    let mut units = shell_units(&blocks(text));
+    units.extend(table_units(text));
+    units.sort_by_key(|u| u.line);
+    units
+}
+
+/// `cargo run --release -p PACKAGE --example NAME [-- ARGS]` as the example's built binary
+/// in `dir` (`.ci/run` builds the release examples and sets `CWISIM_EXAMPLES_DIR`).
+fn example_command(code: &str, dir: &Path) -> Option<String> {
+    let rest = code.trim_start().strip_prefix("cargo run --release -p ")?;
+    let (_package, rest) = rest.split_once(' ')?;
+    let rest = rest.trim_start().strip_prefix("--example ")?;
+    let (name, args) = rest.split_once(' ').unwrap_or((rest, ""));
+    let args = args.trim_start();
+    let args = args.strip_prefix("--").unwrap_or(args).trim();
+    let program = dir.join(name.trim());
+    Some(
+        format!("{} {args}", program.display())
+            .trim_end()
+            .to_owned(),
+    )
+}
+
 /// One command of a block (or several that go together).
 #[derive(Clone, Debug)]
 struct Unit {
@@ -490,19 +528,46 @@ struct Unit {
     block: usize,
     /// The shell that runs it: `bash` for a block tagged so, else `sh`.
     shell: &'static str,
+    /// What its output must show.
+    check: Check,
+}
+
+/// What a command's standard output must show.
+#[derive(Clone, Debug, Default)]
+enum Check {
+    /// Nothing: only its exit status is checked.
+    #[default]
+    Status,
+    /// The lines under it in a `console` block, with `...` (any lines) and `[..]` (any
+    /// text within a line).
+    Output(String),
+    /// A table of the document: the command prints a Markdown table with the same header,
+    /// and every row of the document's is in it, cell for cell but for the columns named
+    /// as varying.
+    Table(Table),
+}
+
+/// A Markdown table of a document that a command prints.
+#[derive(Clone, Debug)]
+struct Table {
+    /// The header's cells.
+    header: Vec<String>,
+    /// The rows' cells (the separator row left out).
+    rows: Vec<Vec<String>>,
+    /// Columns (by header) whose cells vary from run to run: host times.
+    varying: Vec<String>,
 }
 
 /// The commands of a block, the `id`th of its document.
 fn units(block: &Block, id: usize) -> Vec<Unit> {
+    if block.lang == "console" {
+        return console_units(block, id);
+    }
     let mut out: Vec<Unit> = Vec::new();
     let mut cur: Option<Unit> = None;
     let mut depth = 0i32;
     for (n, raw) in &block.lines {
-        let line = if block.lang == "console" {
-            raw.trim_start().strip_prefix("$ ").unwrap_or(raw)
-        } else {
-            raw.as_str()
-        };
+        let line = raw.as_str();
         let code = without_comment(line).trim_end();
         if cur.is_none() && code.trim().is_empty() {
             continue;
@@ -514,6 +579,7 @@ fn units(block: &Block, id: usize) -> Vec<Unit> {
             status: 0,
             block: id,
             shell: if block.lang == "bash" { "bash" } else { "sh" },
+            check: Check::Status,
         });
         if !u.text.is_empty() {
             u.text.push('\n');
@@ -541,6 +607,177 @@ fn units(block: &Block, id: usize) -> Vec<Unit> {
     }
     out.extend(cur);
     out
+}
+
+/// The commands of a `console` block: each line `$ COMMAND` (with its `\` continuations)
+/// is one, and the lines under it are what its standard output must show ([`Check::Output`]:
+/// `...` on a line of its own stands for any lines, `[..]` for any text within a line).
+fn console_units(block: &Block, id: usize) -> Vec<Unit> {
+    let mut out: Vec<Unit> = Vec::new();
+    let mut continued = false;
+    for (n, raw) in &block.lines {
+        let command = raw.strip_prefix("$ ");
+        if continued || command.is_some() {
+            let line = command.unwrap_or(raw);
+            let code = without_comment(line).trim_end();
+            if continued {
+                let u = out.last_mut().expect("a command before its continuation");
+                u.text = format!("{}\n{line}", u.text);
+                u.code = format!("{}\n{code}", u.code);
+            } else {
+                out.push(Unit {
+                    line: *n,
+                    text: line.to_owned(),
+                    code: code.to_owned(),
+                    status: 0,
+                    block: id,
+                    shell: "sh",
+                    check: Check::Status,
+                });
+            }
+            if let Some(s) = comment(line).and_then(stated_status) {
+                out.last_mut().expect("a command").status = s;
+            }
+            continued = code.ends_with('\\');
+            continue;
+        }
+        let Some(u) = out.last_mut() else {
+            panic!("line {n}: output in a console block before any `$ ` command");
+        };
+        match &mut u.check {
+            Check::Output(expected) => {
+                expected.push('\n');
+                expected.push_str(raw);
+            }
+            check => *check = Check::Output(raw.clone()),
+        }
+    }
+    out
+}
+
+/// The tables of a document that a command prints: a Markdown table right under a line
+/// `<!-- table from: COMMAND -->` (or `<!-- table from: COMMAND; varying: COLUMN, … -->`
+/// for columns, such as host times, that differ from run to run), as commands to run
+/// with [`Check::Table`], at the comment's line.
+fn table_units(text: &str) -> Vec<Unit> {
+    let lines: Vec<&str> = text.lines().collect();
+    let mut out = Vec::new();
+    for (i, line) in lines.iter().enumerate() {
+        let Some(rest) = line.trim().strip_prefix("<!-- table from:") else {
+            continue;
+        };
+        let rest = rest
+            .strip_suffix("-->")
+            .unwrap_or_else(|| panic!("line {}: `<!-- table from: … -->` on one line", i + 1))
+            .trim();
+        let (command, varying) = match rest.split_once("; varying:") {
+            Some((c, v)) => (
+                c.trim(),
+                v.split(',').map(|c| c.trim().to_owned()).collect(),
+            ),
+            None => (rest, Vec::new()),
+        };
+        let command = command.trim_matches('`');
+        let rows: Vec<Vec<String>> = lines[i + 1..]
+            .iter()
+            .take_while(|l| l.trim_start().starts_with('|'))
+            .map(|l| cells(l))
+            .collect();
+        assert!(
+            rows.len() >= 3,
+            "line {}: a Markdown table (header, separator, rows) right under the comment",
+            i + 1
+        );
+        let header = rows[0].clone();
+        for v in &varying {
+            assert!(
+                header.contains(v),
+                "line {}: no column {v:?} in the table",
+                i + 1
+            );
+        }
+        out.push(Unit {
+            line: i + 1,
+            text: command.to_owned(),
+            code: command.to_owned(),
+            status: 0,
+            block: usize::MAX,
+            shell: "sh",
+            check: Check::Table(Table {
+                header,
+                rows: rows[2..].to_vec(),
+                varying,
+            }),
+        });
+    }
+    out
+}
+
+/// The cells of a Markdown table's row, trimmed.
+fn cells(row: &str) -> Vec<String> {
+    let row = row.trim();
+    let row = row.strip_prefix('|').unwrap_or(row);
+    let row = row.strip_suffix('|').unwrap_or(row);
+    row.split('|').map(|c| c.trim().to_owned()).collect()
+}
+
+/// Whether `printed` (a command's output) holds `table`: a Markdown table with its header
+/// whose rows are the table's, cell for cell but in the varying columns. `Err` says where
+/// they part.
+fn holds_table(printed: &str, table: &Table) -> Result<(), String> {
+    let lines: Vec<&str> = printed.lines().collect();
+    let Some(start) = lines
+        .iter()
+        .position(|l| l.trim_start().starts_with('|') && cells(l) == table.header)
+    else {
+        return Err(format!(
+            "the output has no table with the header {:?}",
+            table.header
+        ));
+    };
+    let rows: Vec<Vec<String>> = lines[start + 1..]
+        .iter()
+        .take_while(|l| l.trim_start().starts_with('|'))
+        .skip(1)
+        .map(|l| cells(l))
+        .collect();
+    let compared: Vec<bool> = table
+        .header
+        .iter()
+        .map(|h| !table.varying.contains(h))
+        .collect();
+    let same = |a: &[String], b: &[String]| {
+        a.len() == b.len()
+            && a.iter()
+                .zip(b)
+                .zip(&compared)
+                .all(|((x, y), c)| !c || x == y)
+    };
+    let mut problems = Vec::new();
+    for (k, row) in table.rows.iter().enumerate() {
+        match rows.get(k) {
+            Some(printed) if same(row, printed) => {}
+            Some(printed) => problems.push(format!(
+                "row {}: the document has\n      {}\n    the command printed\n      {}",
+                k + 1,
+                row.join(" | "),
+                printed.join(" | ")
+            )),
+            None => problems.push(format!("row {}: the command printed no such row", k + 1)),
+        }
+    }
+    if rows.len() > table.rows.len() {
+        problems.push(format!(
+            "the command printed {} rows, the document has {}",
+            rows.len(),
+            table.rows.len()
+        ));
+    }
+    if problems.is_empty() {
+        Ok(())
+    } else {
+        Err(problems.join("\n    "))
+    }
 }
 
 /// The comment of a shell line: after a `#` that begins a word, outside quotes.
@@ -727,6 +964,7 @@ fn help_examples() -> Vec<Unit> {
                     status,
                     block: 0,
                     shell: "sh",
+                    check: Check::Status,
                 });
             } else {
                 in_examples = false;
@@ -777,6 +1015,8 @@ struct Runner {
     /// The variables the current block set (`N=1000000`), for its later commands.
     variables: (usize, String),
     total: Duration,
+    /// What each command whose tables a document shows printed, so that it runs once.
+    printed: std::collections::HashMap<String, String>,
 }
 
 impl Runner {
@@ -800,6 +1040,7 @@ impl Runner {
             skip_block: None,
             variables: (usize::MAX, String::new()),
             total: Duration::ZERO,
+            printed: Default::default(),
         }
     }
 
@@ -825,6 +1066,24 @@ impl Runner {
         let head = code.trim_start();
         if self.skip_block == Some(u.block) {
             return self.skip(u, "an earlier command of its block could not run");
+        }
+        if !matches!(u.check, Check::Status) && head.starts_with("cargo run --release -p ") {
+            // an example program whose output the document shows
+            let Some(dir) = std::env::var_os("CWISIM_EXAMPLES_DIR") else {
+                return self.skip(
+                    u,
+                    "an example whose output the document shows: CWISIM_EXAMPLES_DIR (the built release examples, as .ci/run sets it) runs it",
+                );
+            };
+            let Some(code) = example_command(&code, Path::new(&dir)) else {
+                self.failures.push(format!(
+                    "{}: not `cargo run --release -p PACKAGE --example NAME [-- ARGS]`: {}",
+                    self.at(u),
+                    u.text
+                ));
+                return;
+            };
+            return self.run(&Unit { code, ..u.clone() });
         }
         if let Some((_, why)) = SKIPPED.iter().find(|(p, _)| head.starts_with(p)) {
             return self.skip(u, why);
@@ -856,6 +1115,16 @@ impl Runner {
     /// Runs a command (its `cwisim`s already spelled so) and checks its status and flags.
     fn run(&mut self, u: &Unit) {
         let at = self.at(u);
+        if let Some(printed) = self.printed.get(&u.code) {
+            // a command already run for another of the document's tables
+            if let Err(e) = output_shows(printed, &u.check) {
+                self.failures.push(format!(
+                    "{at}: the table is not what the command prints\n    {}\n  {e}",
+                    u.text
+                ));
+            }
+            return;
+        }
         for args in invocations(&u.code) {
             if let Err(e) = check_flags(&self.root, &args) {
                 self.failures.push(format!("{at}: {e}\n    {}", u.text));
@@ -890,7 +1159,18 @@ impl Runner {
             took.as_secs_f64(),
             first_line(&u.text)
         );
-        if code != u.status {
+        if code == u.status {
+            let printed = std::fs::read_to_string(&out).unwrap_or_default();
+            if matches!(u.check, Check::Table(_)) {
+                self.printed.insert(u.code.clone(), printed.clone());
+            }
+            if let Err(e) = output_shows(&printed, &u.check) {
+                self.failures.push(format!(
+                    "{at}: the output is not what the document shows\n    {}\n  {e}",
+                    u.text.replace('\n', "\n    ")
+                ));
+            }
+        } else {
             let stderr = std::fs::read_to_string(&err).unwrap_or_default();
             let tail: Vec<&str> = stderr.lines().rev().take(20).collect();
             let tail: Vec<&str> = tail.into_iter().rev().collect();
@@ -944,6 +1224,21 @@ impl Runner {
     }
 }
 
+/// Whether a command's standard output shows what its [`Check`] asks.
+fn output_shows(printed: &str, check: &Check) -> Result<(), String> {
+    match check {
+        Check::Status => Ok(()),
+        Check::Table(table) => holds_table(printed, table),
+        Check::Output(expected) => snapbox::Assert::new()
+            .try_eq(
+                Some(&"the command's output"),
+                printed.to_owned().into(),
+                (expected.clone() + "\n").into(),
+            )
+            .map_err(|e| e.to_string()),
+    }
+}
+
 /// The command without `/usr/bin/time -f FORMAT` before it.
 fn without_time(code: &str) -> String {
     let Some(at) = code.find("/usr/bin/time -f ") else {
@@ -977,7 +1272,7 @@ fn run_document(doc: &str) {
     let text = std::fs::read_to_string(common::repo().join(doc)).expect("read the document");
     let mut runner = Runner::new(doc);
     prepare(doc, &text, &runner.work);
-    for u in shell_units(&blocks(&text)) {
+    for u in document_units(&text) {
         runner.consider(&u);
     }
     runner.finish();
@@ -1004,6 +1299,61 @@ fn prepare(doc: &str, text: &str, work: &Path) {
         std::fs::write(work.join("expected/rectangles.cwt"), trace)
             .expect("expected/rectangles.cwt");
     }
+}
+
+#[test]
+fn console_blocks_and_tables_give_the_output_to_check() {
+    let block = Block {
+        lang: "console".into(),
+        lines: [
+            "$ cwisim render fig25 -o f.png \\",
+            "    --threads 1   # exits 0",
+            "...",
+            "instructions 70 (Eval1 45, Eval2 7, Eval3 4, Refresh 14)",
+            "...",
+            "$ cwisim scenes pot > pot.json",
+            "$ cwisim tradeoff fig25",
+            "vanrij [..] 95 [..]",
+        ]
+        .iter()
+        .enumerate()
+        .map(|(i, l)| (i + 1, (*l).to_owned()))
+        .collect(),
+    };
+    let units = units(&block, 0);
+    assert_eq!(units.len(), 3);
+    assert_eq!(
+        units[0].code,
+        "cwisim render fig25 -o f.png \\\n    --threads 1"
+    );
+    let Check::Output(expected) = &units[0].check else {
+        panic!("the lines under the command are its output")
+    };
+    assert_eq!(expected.lines().count(), 3);
+    assert!(matches!(units[1].check, Check::Status));
+    let printed = "scene x\ninstructions 70 (Eval1 45, Eval2 7, Eval3 4, Refresh 14)\ncycles 1\n";
+    assert!(output_shows(printed, &units[0].check).is_ok());
+    let drifted = printed.replace("Eval2 7", "Eval2 8");
+    assert!(output_shows(&drifted, &units[0].check).is_err());
+    assert!(output_shows("vanrij  - 95  1.0\n", &units[2].check).is_ok());
+    assert!(output_shows("vanrij  - 96  1.0\n", &units[2].check).is_err());
+
+    let doc =
+        "text\n\n<!-- table from: cargo run --release -p p --example e -- 1 2; varying: ms -->\n\
+               | a | ms |\n| --- | ---: |\n| x | 1.0 |\n| y | 2.0 |\n\nmore\n";
+    let tables = table_units(doc);
+    assert_eq!(tables.len(), 1);
+    assert_eq!(tables[0].line, 3);
+    assert_eq!(
+        example_command(&tables[0].code, Path::new("/ex")).as_deref(),
+        Some("/ex/e 1 2")
+    );
+    let table = |printed: &str| output_shows(printed, &tables[0].check);
+    assert!(table("## T\n\n| a | ms |\n| --- | --- |\n| x | 9.9 |\n| y | 0.1 |\n").is_ok());
+    assert!(table("| a | ms |\n| --- | --- |\n| x | 9.9 |\n| z | 0.1 |\n").is_err());
+    assert!(table("| a | ms |\n| --- | --- |\n| x | 9.9 |\n").is_err());
+    assert!(table("| a | ms |\n| --- | --- |\n| x | 9.9 |\n| y | 0.1 |\n| w | 0 |\n").is_err());
+    assert!(table("| b | ms |\n| --- | --- |\n| x | 9.9 |\n| y | 0.1 |\n").is_err());
 }
 
 #[test]
