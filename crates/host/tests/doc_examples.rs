@@ -162,8 +162,9 @@ const LONG: &[&str] = &[
     "docs/RENDERERS.md: tradeoff pot --renderers vanrij,woo-chall",
     // four nishita teapots, 10–85 s debug each, 1–13 s release
     "docs/RENDERERS.md: --renderer nishita",
-    // 170 s release
+    // 60 s release on two threads
     "docs/RENDERERS.md: tradeoff teapot --renderers vanrij,nishita",
+    "docs/TRADEOFF.md: tradeoff teapot --renderers vanrij,nishita",
     // 1000 polygons of 500 vertices through the S-buffer: 35 s debug, 3.5 s release
     "docs/REPRODUCTION.md: render many500.json",
     // 21 nishita teapots, three tolerances, flatness 16 to 0.25 px: 10–90 s debug each,

@@ -3,7 +3,7 @@
 //! 1e-9, from the pieces themselves), the silhouette against a fine tessellation drawn by
 //! `vanrij`, and `--threads N` byte-identical.
 
-use cwisim_render::nishita::band::{subpatches, BandStats, Params, View};
+use cwisim_render::nishita::band::{subpatches, BandStats, Facings, Params, View};
 use cwisim_render::nishita::classify::Facing;
 use cwisim_render::nishita::{pieces, Pieces};
 use cwisim_render::{registry, render, ArrayConfig, LoadedScene, Settings, Taps};
@@ -79,7 +79,15 @@ fn band_clipping_is_conservative() {
     while top < w.height() {
         let rows = band.min(w.height() - top);
         let mut stats = BandStats::default();
-        let (cells, level, _) = subpatches(&view, &patches, top, rows, &params, &mut stats);
+        let (cells, level, _) = subpatches(
+            &view,
+            &patches,
+            &Facings::default(),
+            top,
+            rows,
+            &params,
+            &mut stats,
+        );
         let scale = f64::from(1u32 << level);
         for (k, p) in patches.iter().enumerate() {
             for a in 0..=60 {

@@ -651,17 +651,24 @@ fn inside_triangle(poly: &[Pt], t: &ScreenTriangle, out: &mut Small, spare: &mut
         let (a, b) = (t.points[k], t.points[(k + 1) % 3]);
         move |p: Pt| s * cross(a, b, p)
     };
-    // poly → spare → out → spare… ending in out after three clips
+    // poly → spare → out → spare… ending in out after three clips. Fewer than three points
+    // left after a clip (a triangle sharing an edge of `t` from outside keeps just that
+    // edge's two ends) have no area, and nor has anything clipped from them: their overlap
+    // is none, so the clipping stops there.
     clip_into(poly, edge(0), out);
-    if out.is_empty() {
+    if out.len() < 3 {
+        out.clear();
         return;
     }
     clip_into(out, edge(1), spare);
-    if spare.is_empty() {
+    if spare.len() < 3 {
         out.clear();
         return;
     }
     clip_into(spare, edge(2), out);
+    if out.len() < 3 {
+        out.clear();
+    }
 }
 
 /// The usable triangles' screen bounding boxes in a uniform grid of cells, to find the

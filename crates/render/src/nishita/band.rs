@@ -30,6 +30,7 @@ use cwisim_world::camera::Camera;
 use cwisim_world::clip::{self, ClipStats};
 use glam::DVec3;
 use std::collections::HashMap;
+use std::sync::Mutex;
 
 /// The deepest quadtree level (4^7 cells per patch).
 pub const MAX_LEVEL: u32 = 7;
@@ -453,6 +454,7 @@ struct PolyVertex {
 pub fn band_pieces(
     view: &View,
     patches: &[Patch],
+    known: &Facings,
     two_sided: bool,
     top: u32,
     rows: u32,
@@ -461,7 +463,7 @@ pub fn band_pieces(
     stats: &mut BandStats,
 ) {
     let start = std::time::Instant::now();
-    let (cells, level, facings) = subpatches(view, patches, top, rows, params, stats);
+    let (cells, level, facings) = subpatches(view, patches, known, top, rows, params, stats);
     stats.subpatch_ns += start.elapsed().as_nanos() as u64;
     if cells.is_empty() {
         return;
@@ -692,6 +694,37 @@ fn silhouette_split(
     None
 }
 
+/// How the quadtree cells of one mesh's patches face the eye, remembered across bands. A
+/// cell meets every band its rows span and is built from its patch alike, bit for bit, in
+/// each, so its facing (the degree-8 × 8 product of [`super::classify`], the costliest
+/// test of a band) is computed once. A pure function of the cell, so the threads that take
+/// bands share it and get the same at any thread count. One entry (about 24 bytes) per cell
+/// classified.
+#[derive(Debug, Default)]
+pub struct Facings(Mutex<HashMap<(u32, u32, u32, u32), Facing>>);
+
+impl Facings {
+    /// How `c` faces the eye.
+    pub fn of(&self, view: &View, c: &Cell) -> Facing {
+        let key = (c.patch, c.level, c.index.0, c.index.1);
+        let known = |m: &Mutex<HashMap<_, Facing>>| {
+            m.lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner)
+                .get(&key)
+                .copied()
+        };
+        if let Some(f) = known(&self.0) {
+            return f;
+        }
+        let f = facing(&c.points, view.camera.eye);
+        self.0
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .insert(key, f);
+        f
+    }
+}
+
 /// The subpatches of `patches` that meet the band of rows `top .. top + rows`: the
 /// quadtree cells of the band's level (the smallest that makes every kept cell flat,
 /// twisted ones to a quarter of the flatness, at most [`MAX_LEVEL`]), the level, and
@@ -699,6 +732,7 @@ fn silhouette_split(
 pub fn subpatches(
     view: &View,
     patches: &[Patch],
+    known: &Facings,
     top: u32,
     rows: u32,
     params: &Params,
@@ -728,7 +762,7 @@ pub fn subpatches(
                 break;
             }
             if flat > 0.25 * params.flatness {
-                let fc = facing(&c.points, view.camera.eye);
+                let fc = known.of(view, c);
                 *f = Some(fc);
                 if fc == Facing::Twisted {
                     done = false;
@@ -761,7 +795,7 @@ pub fn subpatches(
     let facings: Vec<Facing> = cells
         .iter()
         .zip(facings)
-        .map(|(c, f)| f.unwrap_or_else(|| facing(&c.points, view.camera.eye)))
+        .map(|(c, f)| f.unwrap_or_else(|| known.of(view, c)))
         .collect();
     for f in &facings {
         match f {

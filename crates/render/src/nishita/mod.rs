@@ -31,7 +31,7 @@ use crate::renderer::{Counters, FramePlan, Renderer};
 use crate::settings::Settings;
 use crate::source::LoadedScene;
 use crate::vanrij::VanRij;
-use band::{band_pieces, BandStats, Params, View};
+use band::{band_pieces, BandStats, Facings, Params, View};
 use classify::Facing;
 use cwisim_isa::{TraceHeader, TraceWrite};
 use cwisim_scene::{SceneError, SceneErrorKind, Shading, MAX_COORDINATE};
@@ -110,6 +110,8 @@ pub struct PatchScene<'w> {
     params: Params,
     lighting: Lighting,
     meshes: Vec<(usize, Vec<cwisim_world::bezier::Patch>)>,
+    /// For each of `meshes`: how its cells face the eye, as the bands find out.
+    facings: Vec<Facings>,
 }
 
 impl<'w> PatchScene<'w> {
@@ -165,6 +167,7 @@ impl<'w> PatchScene<'w> {
             }
             meshes.push((k, patches));
         }
+        let facings = meshes.iter().map(|_| Facings::default()).collect();
         Ok(PatchScene {
             w,
             camera,
@@ -172,6 +175,7 @@ impl<'w> PatchScene<'w> {
             params,
             lighting,
             meshes,
+            facings,
         })
     }
 
@@ -202,12 +206,13 @@ impl<'w> PatchScene<'w> {
     /// mesh, appended to `out` (its `stats` counting what the band did).
     pub fn band(&self, top: u32, rows: u32, out: &mut Pieces) -> Result<(), RenderError> {
         let mut raw = Vec::new();
-        for (k, patches) in &self.meshes {
+        for ((k, patches), known) in self.meshes.iter().zip(&self.facings) {
             let m = &self.w.spec.meshes[*k];
             raw.clear();
             band_pieces(
                 &self.view,
                 patches,
+                known,
                 m.two_sided,
                 top,
                 rows,
