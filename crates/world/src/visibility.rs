@@ -681,8 +681,8 @@ struct BoxIndex {
     /// The grid's lower corner and cell size.
     origin: Pt,
     cell: Pt,
-    /// Cells per side.
-    side: usize,
+    /// Cells along `x` and along `y`.
+    side: [usize; 2],
     /// `starts[c]..starts[c + 1]` indexes `cells`' entries for cell `c` (row-major).
     starts: Vec<usize>,
     /// Triangle indices, cell by cell, ascending within a cell.
@@ -720,10 +720,27 @@ impl BoxIndex {
             lo = [lo[0].min(b[0]), lo[1].min(b[1])];
             hi = [hi[0].max(b[2]), hi[1].max(b[3])];
         }
-        // about one triangle per cell, at most 1024 × 1024 cells
-        let side = ((count as f64).sqrt().ceil() as usize).clamp(1, 1024);
-        let size = |a: f64, b: f64| {
-            let s = (b - a) / side as f64;
+        // about one triangle per cell, at most 1024 cells along each axis, the cells shaped
+        // like the average box: a row strip of small pieces (nishita's) is one cell high and
+        // hundreds wide, where a square grid would enter every piece in a whole column of
+        // cells and list each cell's neighbours many times over
+        let mean = |axis: usize| {
+            let sum: f64 = used().map(|b| b[axis + 2] - b[axis]).sum();
+            sum / count.max(1) as f64
+        };
+        let (width, height) = (hi[0] - lo[0], hi[1] - lo[1]);
+        let (box_w, box_h) = (mean(0), mean(1));
+        let ratio = (width * box_h) / (height * box_w);
+        let along_x = if ratio.is_finite() && ratio > 0.0 {
+            (count as f64 * ratio).sqrt()
+        } else {
+            (count as f64).sqrt()
+        };
+        let along_x = (along_x.ceil() as usize).clamp(1, 1024);
+        let along_y = (count.div_ceil(along_x)).clamp(1, 1024);
+        let side = [along_x, along_y];
+        let size = |a: f64, b: f64, n: usize| {
+            let s = (b - a) / n as f64;
             if s > 0.0 && s.is_finite() {
                 s
             } else {
@@ -733,19 +750,19 @@ impl BoxIndex {
         let mut index = BoxIndex {
             origin: if count > 0 { lo } else { [0.0; 2] },
             cell: if count > 0 {
-                [size(lo[0], hi[0]), size(lo[1], hi[1])]
+                [size(lo[0], hi[0], side[0]), size(lo[1], hi[1], side[1])]
             } else {
                 [1.0; 2]
             },
             side,
-            starts: vec![0; side * side + 1],
+            starts: vec![0; side[0] * side[1] + 1],
             entries: Vec::new(),
             big: Vec::new(),
             boxes,
             usable: usable.to_vec(),
         };
         // two passes: count each cell's entries, then fill them in triangle order
-        let mut fill = vec![0usize; side * side];
+        let mut fill = vec![0usize; side[0] * side[1]];
         for pass in 0..2 {
             for k in 0..index.boxes.len() {
                 if !index.usable[k] {
@@ -760,7 +777,7 @@ impl BoxIndex {
                 }
                 for y in y0..=y1 {
                     for x in x0..=x1 {
-                        let c = y * side + x;
+                        let c = y * side[0] + x;
                         if pass == 0 {
                             index.starts[c + 1] += 1;
                         } else {
@@ -771,10 +788,10 @@ impl BoxIndex {
                 }
             }
             if pass == 0 {
-                for c in 0..side * side {
+                for c in 0..side[0] * side[1] {
                     index.starts[c + 1] += index.starts[c];
                 }
-                index.entries = vec![0; index.starts[side * side]];
+                index.entries = vec![0; index.starts[side[0] * side[1]]];
             }
         }
         index
@@ -784,7 +801,7 @@ impl BoxIndex {
     fn cells_of(&self, b: &[f64; 4]) -> ([usize; 2], [usize; 2]) {
         let at = |v: f64, axis: usize| {
             let c = ((v - self.origin[axis]) / self.cell[axis]).floor();
-            c.clamp(0.0, (self.side - 1) as f64) as usize
+            c.clamp(0.0, (self.side[axis] - 1) as f64) as usize
         };
         ([at(b[0], 0), at(b[1], 1)], [at(b[2], 0), at(b[3], 1)])
     }
@@ -796,7 +813,7 @@ impl BoxIndex {
     }
 
     /// Into `out` (cleared first): the usable triangles other than `k` whose boxes
-    /// overlap `k`'s, in no particular order. `stamp` is scratch space kept between calls.
+    /// overlap `k`'s, in index order. `stamp` is scratch space kept between calls.
     fn candidates(&self, k: usize, out: &mut Vec<usize>, stamp: &mut Vec<usize>) {
         out.clear();
         // stamp[c] == k + 1: c already looked at for k (no sort to drop repeats)
@@ -813,7 +830,7 @@ impl BoxIndex {
         let ([x0, y0], [x1, y1]) = self.cells_of(&self.boxes[k]);
         for y in y0..=y1 {
             for x in x0..=x1 {
-                let c = y * self.side + x;
+                let c = y * self.side[0] + x;
                 for &e in &self.entries[self.starts[c]..self.starts[c + 1]] {
                     take(e as usize);
                 }
@@ -822,6 +839,8 @@ impl BoxIndex {
         for &e in &self.big {
             take(e as usize);
         }
+        // in index order, whatever the grid's shape
+        out.sort_unstable();
     }
 }
 

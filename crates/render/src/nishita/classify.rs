@@ -26,13 +26,15 @@ pub enum Facing {
     Twisted,
 }
 
-/// A bivariate polynomial in Bernstein form: degree `(m, n)`, coefficients `c[i][j]`
-/// (`i` along `u`, `j` along `v`) stored row-major with `n + 1` per row.
-#[derive(Clone, Debug)]
+/// A bivariate polynomial in Bernstein form: degree `(m, n)`, at most `(8, 8)`,
+/// coefficients `c[i][j]` (`i` along `u`, `j` along `v`) stored row-major with `n + 1` per
+/// row. Fixed-size: a subpatch's facing takes six products of these, and a band classifies
+/// thousands of subpatches.
+#[derive(Clone, Copy, Debug)]
 struct Bern2 {
     m: usize,
     n: usize,
-    c: Vec<f64>,
+    c: [f64; 81],
 }
 
 /// `C(n, k)` for `n ≤ 8` (exact: small integers).
@@ -52,10 +54,15 @@ const BINOMIAL: [[f64; 9]; 9] = {
 };
 
 impl Bern2 {
+    /// The coefficients' count.
+    fn len(&self) -> usize {
+        (self.m + 1) * (self.n + 1)
+    }
+
     /// The coefficients times `C(m, i)·C(n, j)`: the scaled form, in which a product is
     /// a plain convolution.
-    fn scaled(&self) -> Vec<f64> {
-        let mut s = self.c.clone();
+    fn scaled(&self) -> [f64; 81] {
+        let mut s = self.c;
         for i in 0..=self.m {
             for j in 0..=self.n {
                 s[i * (self.n + 1) + j] *= BINOMIAL[self.m][i] * BINOMIAL[self.n][j];
@@ -68,7 +75,7 @@ impl Bern2 {
     fn mul(&self, o: &Bern2) -> Bern2 {
         let (m, n) = (self.m + o.m, self.n + o.n);
         let (sa, sb) = (self.scaled(), o.scaled());
-        let mut c = vec![0.0; (m + 1) * (n + 1)];
+        let mut c = [0.0; 81];
         for i1 in 0..=self.m {
             for j1 in 0..=self.n {
                 let a = sa[i1 * (self.n + 1) + j1];
@@ -92,14 +99,16 @@ impl Bern2 {
     }
 
     fn sub(mut self, o: &Bern2) -> Bern2 {
-        for (a, b) in self.c.iter_mut().zip(&o.c) {
+        let k = self.len();
+        for (a, b) in self.c[..k].iter_mut().zip(&o.c[..k]) {
             *a -= b;
         }
         self
     }
 
     fn add(mut self, o: &Bern2) -> Bern2 {
-        for (a, b) in self.c.iter_mut().zip(&o.c) {
+        let k = self.len();
+        for (a, b) in self.c[..k].iter_mut().zip(&o.c[..k]) {
             *a += b;
         }
         self
@@ -107,45 +116,48 @@ impl Bern2 {
 }
 
 /// One coordinate of control points `q[i][j]` (`i` along `u`) as a [`Bern2`].
-fn coordinate(q: &[Vec<DVec3>], axis: usize) -> Bern2 {
-    let m = q.len() - 1;
-    let n = q[0].len() - 1;
+fn coordinate<const M: usize, const N: usize>(q: &[[DVec3; N]; M], axis: usize) -> Bern2 {
+    let mut c = [0.0; 81];
+    for (k, p) in q.iter().flatten().enumerate() {
+        c[k] = p[axis];
+    }
     Bern2 {
-        m,
-        n,
-        c: q.iter().flatten().map(|p| p[axis]).collect(),
+        m: M - 1,
+        n: N - 1,
+        c,
     }
 }
 
 /// The Bernstein coefficients of `g = (S − E)·(S_u × S_v)` for the patch with control
 /// points `points[row][col]` (`u` along a row, `v` down the rows).
 pub fn facing_coefficients(points: &[[DVec3; 4]; 4], eye: DVec3) -> Vec<f64> {
+    let g = facing_polynomial(points, eye);
+    g.c[..g.len()].to_vec()
+}
+
+/// [`facing_coefficients`] as a [`Bern2`].
+fn facing_polynomial(points: &[[DVec3; 4]; 4], eye: DVec3) -> Bern2 {
     // q[i][j]: i along u (column), j along v (row)
-    let p: Vec<Vec<DVec3>> = (0..4)
-        .map(|i| (0..4).map(|j| points[j][i] - eye).collect())
-        .collect();
-    let su: Vec<Vec<DVec3>> = (0..3)
-        .map(|i| (0..4).map(|j| 3.0 * (p[i + 1][j] - p[i][j])).collect())
-        .collect();
-    let sv: Vec<Vec<DVec3>> = (0..4)
-        .map(|i| (0..3).map(|j| 3.0 * (p[i][j + 1] - p[i][j])).collect())
-        .collect();
-    let c = |q: &[Vec<DVec3>], a| coordinate(q, a);
-    let (ux, uy, uz) = (c(&su, 0), c(&su, 1), c(&su, 2));
-    let (vx, vy, vz) = (c(&sv, 0), c(&sv, 1), c(&sv, 2));
+    let p: [[DVec3; 4]; 4] = std::array::from_fn(|i| std::array::from_fn(|j| points[j][i] - eye));
+    let su: [[DVec3; 4]; 3] =
+        std::array::from_fn(|i| std::array::from_fn(|j| 3.0 * (p[i + 1][j] - p[i][j])));
+    let sv: [[DVec3; 3]; 4] =
+        std::array::from_fn(|i| std::array::from_fn(|j| 3.0 * (p[i][j + 1] - p[i][j])));
+    let (ux, uy, uz) = (coordinate(&su, 0), coordinate(&su, 1), coordinate(&su, 2));
+    let (vx, vy, vz) = (coordinate(&sv, 0), coordinate(&sv, 1), coordinate(&sv, 2));
     let nx = uy.mul(&vz).sub(&uz.mul(&vy));
     let ny = uz.mul(&vx).sub(&ux.mul(&vz));
     let nz = ux.mul(&vy).sub(&uy.mul(&vx));
-    let g = c(&p, 0)
+    coordinate(&p, 0)
         .mul(&nx)
-        .add(&c(&p, 1).mul(&ny))
-        .add(&c(&p, 2).mul(&nz));
-    g.c
+        .add(&coordinate(&p, 1).mul(&ny))
+        .add(&coordinate(&p, 2).mul(&nz))
 }
 
 /// How the patch with these control points faces `eye`.
 pub fn facing(points: &[[DVec3; 4]; 4], eye: DVec3) -> Facing {
-    let g = facing_coefficients(points, eye);
+    let g = facing_polynomial(points, eye);
+    let g = &g.c[..g.len()];
     let neg = g.iter().any(|&x| x < 0.0);
     let pos = g.iter().any(|&x| x > 0.0);
     match (neg, pos) {
