@@ -10,13 +10,19 @@
 //! * [`classify`] — front, back or twisted: the sign of `(S − E)·(S_u × S_v)` over a
 //!   subpatch, exactly (Bernstein coefficients of degree 8 × 8).
 //!
+//! * [`segments`] — visibility along one strip between two row lines: the paper's scan
+//!   segments, slab by slab between the pieces' corners, exact (no polygon boolean).
+//! * [`resolve`] — the bands made and resolved strip by strip, on `--threads`.
+//! * [`merged`] — a patch's visible fragments on a pixel row box-filtered on the host and
+//!   sent through the span fitter as one span.
+//!
 //! The pieces of every band — triangles with their surface points and the patch's own
-//! normals at their corners — go through the project's exact visibility (per triangle,
-//! `cwisim_world::visibility::exact_fragments`) and then through van Rij's trapezia and
-//! box filter, Gouraud (the lighting at each piece corner) or Phong (lit per pixel from
-//! the normals interpolated over the piece, through the span fitter). A screen scene has
-//! no patches: it is drawn as `vanrij` draws it; meshes of a world scene that are not
-//! Bézier patches are projected as `vanrij` projects them and share the visibility pass.
+//! normals at their corners — go through the scan segments of their strip and then
+//! through the box filter, Gouraud (the lighting at each piece corner) or Phong (lit per
+//! pixel from the normals interpolated over the piece, through the span fitter). A screen
+//! scene has no patches: it is drawn as `vanrij` draws it; meshes of a world scene that
+//! are not Bézier patches are projected as `vanrij` projects them and share the project's
+//! exact visibility (`cwisim_world::visibility::exact_fragments`) with the pieces.
 //!
 //! `docs/RENDERERS.md` says how it reads the paper; `docs/ERRATA.md` what it corrects.
 
@@ -24,6 +30,7 @@ pub mod band;
 pub mod classify;
 pub mod merged;
 pub mod resolve;
+pub mod segments;
 
 use crate::error::RenderError;
 use crate::prepare::{PhongSurfaces, PolygonScene};
@@ -340,6 +347,10 @@ pub struct Nishita {
     /// when the polygons are drawn as `vanrij` draws them.
     /// With each polygon's pixel row.
     groups: Option<(Vec<u64>, Vec<u32>)>,
+    /// What the scan segments did, when the scene is all patches (visibility strip by
+    /// strip, [`segments`]); `None` when its other meshes share exact visibility with
+    /// the pieces.
+    segments: Option<segments::SegmentStats>,
 }
 
 /// Whether `w` has a Bézier mesh.
@@ -402,6 +413,7 @@ impl Nishita {
                     settings: *settings,
                     visibility_time: Duration::ZERO,
                     groups: None,
+                    segments: None,
                 });
             }
         };
@@ -415,6 +427,7 @@ impl Nishita {
         let channels = w.channels();
         let mut project = None;
         let mut groups = None;
+        let mut segments = None;
         let (made, count, polygons, vis, surfaces, geometry_time, visibility_time) = if others
             .is_empty()
         {
@@ -430,11 +443,12 @@ impl Nishita {
                 PhongSurfaces::new(r.triangles, r.sources, shader())
                     .filtered(settings.texture_filter)
             });
+            segments = Some(r.stats);
             (
                 r.pieces,
                 r.count,
                 r.polygons,
-                Some(r.stats),
+                None,
                 surfaces,
                 total.saturating_sub(r.time),
                 r.time,
@@ -525,6 +539,7 @@ impl Nishita {
             settings: *settings,
             visibility_time,
             groups,
+            segments,
         })
     }
 
@@ -584,6 +599,15 @@ impl Nishita {
             .with("silhouette_points", s.silhouette_points)
             .with("silhouettes_unsplit", s.silhouettes_unsplit)
             .with("piece_triangles", self.triangles);
+        if let Some(g) = &self.segments {
+            out = out
+                .with("visible_fragments", g.fragments)
+                .with("pieces_hidden", g.hidden)
+                .with("segment_slabs", g.slabs)
+                .with("segment_edge_crossings", g.edge_crossings)
+                .with("segment_depth_crossings", g.depth_crossings)
+                .with("segment_slivers", g.slivers);
+        }
         for (name, n) in HISTOGRAM_NAMES.iter().zip(c.histogram) {
             out.add(name, n);
         }
@@ -722,6 +746,15 @@ impl Renderer for Nishita {
                     s.polygons, s.split_polygons, self.triangles, s.silhouette_points, s.silhouettes_unsplit
                 ),
             ));
+            if let Some(g) = &self.segments {
+                rows.push((
+                    "visibility",
+                    format!(
+                        "scan segments, strip by strip: {} visible fragments of {} pieces ({} wholly hidden); {} slabs, {} cut where edges cross, {} where surfaces cross; {} slivers dropped, {:.1e} px² in all",
+                        g.fragments, g.pieces, g.hidden, g.slabs, g.edge_crossings, g.depth_crossings, g.slivers, g.sliver_area
+                    ),
+                ));
+            }
             let total =
                 s.subpatch_ns + s.roots_ns + s.pieces_ns + self.visibility_time.as_nanos() as u64;
             let share = |ns: u64| 100.0 * ns as f64 / total.max(1) as f64;

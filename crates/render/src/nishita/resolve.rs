@@ -2,8 +2,8 @@
 //! different bands can hide nothing of one another (their overlaps have no area), and
 //! the exact visible fragments of the frame are those of each band's pieces resolved
 //! alone — and, within a band, those of each strip between two row lines alone. Each
-//! band's pieces are made, resolved strip by strip with
-//! [`cwisim_world::visibility::exact_fragments`] and dropped before the next: memory
+//! band's pieces are made, resolved strip by strip with the scan segments of
+//! [`super::segments`] and dropped before the next: memory
 //! holds one band's pieces per thread (the paper's active subpatches), not the frame's.
 //!
 //! Bands are taken by `threads` workers, one at a time, and joined in band order: the
@@ -13,12 +13,12 @@
 //! workers resolve them (holding only the bands resolved ahead of their turn). Either way
 //! the joined vectors keep no spare room: the fragments are held until the rows are emitted.
 
+use super::segments::{strip_fragments, SegmentStats};
 use super::{check_budget, PatchScene, Pieces};
 use crate::error::RenderError;
 use crate::settings::Settings;
 use cwisim_scene::Polygon;
 use cwisim_world::face::ScreenTriangle;
-use cwisim_world::visibility::{exact_fragments, VisibilityStats};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Condvar, Mutex};
 use std::time::{Duration, Instant};
@@ -41,7 +41,7 @@ struct Band {
     /// Its pieces' figures (the triangles dropped unless kept).
     pieces: Pieces,
     /// What visibility did.
-    stats: VisibilityStats,
+    stats: SegmentStats,
     /// Host time of its visibility.
     time: Duration,
 }
@@ -63,22 +63,9 @@ pub struct Resolved {
     /// The pieces' figures (without the triangles).
     pub pieces: Pieces,
     /// What visibility did, summed band by band.
-    pub stats: VisibilityStats,
+    pub stats: SegmentStats,
     /// Host time of visibility, summed over the bands (over threads).
     pub time: Duration,
-}
-
-/// Adds `o` to `s`.
-fn merge(s: &mut VisibilityStats, o: &VisibilityStats) {
-    s.triangles += o.triangles;
-    s.occluding_pairs += o.occluding_pairs;
-    s.hidden += o.hidden;
-    s.fragments += o.fragments;
-    s.copies_hidden += o.copies_hidden;
-    s.candidates_skipped += o.candidates_skipped;
-    s.hole_cuts += o.hole_cuts;
-    s.dropped_slivers += o.dropped_slivers;
-    s.dropped_area += o.dropped_area;
 }
 
 /// One band made and resolved. `made` counts the pieces of every band made so far (on
@@ -99,13 +86,15 @@ fn one_band(
     let so_far = made.fetch_add(n, Ordering::Relaxed) + n;
     check_budget(&budget, so_far, top + rows, settings)?;
     let start = Instant::now();
-    // strip by strip, each strip's pieces in the order they were made (a stable sort)
-    let mut keyed: Vec<(u32, ScreenTriangle)> = std::mem::take(&mut pieces.strip)
-        .into_iter()
-        .zip(std::mem::take(&mut pieces.triangles))
-        .collect();
-    keyed.sort_by_key(|(k, _)| *k);
-    let (strips, triangles): (Vec<u32>, Vec<ScreenTriangle>) = keyed.into_iter().unzip();
+    // strip by strip, each strip's pieces in the order they were made (a stable sort of
+    // their indices: the pieces are large, and moved once)
+    let strip_of = std::mem::take(&mut pieces.strip);
+    let mut order: Vec<u32> = (0..strip_of.len() as u32).collect();
+    order.sort_by_key(|&i| strip_of[i as usize]);
+    let made = std::mem::take(&mut pieces.triangles);
+    let strips: Vec<u32> = order.iter().map(|&i| strip_of[i as usize]).collect();
+    let triangles: Vec<ScreenTriangle> = order.iter().map(|&i| made[i as usize]).collect();
+    drop(made);
     let mut band = Band {
         count: triangles.len(),
         ..Band::default()
@@ -113,8 +102,7 @@ fn one_band(
     let mut a = 0;
     while a < triangles.len() {
         let b = a + strips[a..].partition_point(|&k| k == strips[a]);
-        let (fragments, stats) = exact_fragments(&triangles[a..b], scene.channels());
-        merge(&mut band.stats, &stats);
+        let fragments = strip_fragments(&triangles[a..b], scene.channels(), &mut band.stats);
         for f in fragments {
             let t = &triangles[a + f.source];
             band.groups
@@ -171,7 +159,7 @@ pub fn resolve(
             patches: scene.patches(),
             ..Pieces::default()
         },
-        stats: VisibilityStats::default(),
+        stats: SegmentStats::default(),
         time: Duration::ZERO,
     };
     if threads == 1 {
@@ -287,7 +275,7 @@ fn join(out: &mut Resolved, band: Band) {
     out.count += band.count as u64;
     out.pieces.stats.merge(&band.pieces.stats);
     out.pieces.bands += band.pieces.bands;
-    merge(&mut out.stats, &band.stats);
+    out.stats.add(&band.stats);
     out.time += band.time;
 }
 
