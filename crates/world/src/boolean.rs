@@ -79,13 +79,22 @@ pub(crate) fn overlay(grid: &Grid, subject: &Shape, clip: &Shape, rule: OverlayR
     .overlay(rule, FillRule::NonZero)
 }
 
+/// How many cuts deep [`settle`] goes before it drops what holes are left (counted): the
+/// safeguard against an endless recursion, never reached in practice.
+pub(crate) const MAX_CUT_DEPTH: usize = 64;
+
 /// Turns one result shape (outline, then holes) into hole-free contours in `out`:
-/// drops slivers, cuts holes away, tidies the outlines. `max_holes` is what a part of a
-/// cut may still have (the safeguard against endless recursion).
+/// drops slivers, cuts holes away, tidies the outlines. `cuts_left` is how many cuts
+/// deeper it may go ([`MAX_CUT_DEPTH`] at the top).
+///
+/// A part of a cut has fewer of its parent's holes, but may have new ones: an outline
+/// that touches itself at a vertex (a pinched outline, which the overlay can give) comes
+/// out of a cut as an outline and a hole touching it. Those are cut in turn; dropping
+/// them instead left the part covering the hole, a point covered twice.
 pub(crate) fn settle(
     grid: &Grid,
     shape: Shape,
-    max_holes: usize,
+    cuts_left: usize,
     out: &mut Vec<Contour>,
     losses: &mut Losses,
 ) {
@@ -107,8 +116,8 @@ pub(crate) fn settle(
             holes.push(h);
         }
     }
-    if holes.len() > max_holes {
-        // never observed: the cut did not remove a hole
+    if cuts_left == 0 {
+        // never reached: the cuts did not remove the holes
         for h in holes.drain(..) {
             losses.drop(area(&h));
         }
@@ -131,12 +140,11 @@ pub(crate) fn settle(
         });
     let cut = lo + 0.5 * (hi - lo);
     let m = grid_extent(grid);
-    let left = holes.len() - 1;
     let whole: Shape = std::iter::once(outline).chain(holes).collect();
     for (top, bottom) in [(-m, cut), (cut, m)] {
         let half = vec![vec![[-m, top], [m, top], [m, bottom], [-m, bottom]]];
         for part in overlay(grid, &whole, &half, OverlayRule::Intersect) {
-            settle(grid, part, left, out, losses);
+            settle(grid, part, cuts_left - 1, out, losses);
         }
     }
 }

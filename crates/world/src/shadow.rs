@@ -39,7 +39,9 @@
 //! then shadowed, light by light). Deterministic at any thread count (the light's view
 //! runs on threads as [`crate::visibility::exact_fragments_on`] does).
 
-use crate::boolean::{grid_for, overlay, positive, settle, Contour, Losses, Pt, Shape};
+use crate::boolean::{
+    grid_for, overlay, positive, settle, Contour, Losses, Pt, Shape, MAX_CUT_DEPTH,
+};
 use crate::camera::Camera;
 use crate::face::{ScreenTriangle, Surface};
 use crate::lighting::Lighting;
@@ -710,7 +712,7 @@ pub fn shadowed(
                             stats.booleans += 1;
                             let mut contours = Vec::new();
                             for shape in overlay(&grid, &subject, lit, rule) {
-                                settle(&grid, shape, usize::MAX, &mut contours, &mut losses);
+                                settle(&grid, shape, MAX_CUT_DEPTH, &mut contours, &mut losses);
                             }
                             next.extend(contours.into_iter().map(|c| (c, set)));
                         }
