@@ -1302,11 +1302,23 @@ fn prepare(doc: &str, text: &str, work: &Path) {
     }
 }
 
+/// A block tagged `lang` of these lines, numbered from 1.
+fn block_of(lang: &str, lines: &[&str]) -> Block {
+    Block {
+        lang: lang.into(),
+        lines: lines
+            .iter()
+            .enumerate()
+            .map(|(i, l)| (i + 1, (*l).to_owned()))
+            .collect(),
+    }
+}
+
 #[test]
 fn console_blocks_and_tables_give_the_output_to_check() {
-    let block = Block {
-        lang: "console".into(),
-        lines: [
+    let block = block_of(
+        "console",
+        &[
             "$ cwisim render fig25 -o f.png \\",
             "    --threads 1   # exits 0",
             "...",
@@ -1315,12 +1327,8 @@ fn console_blocks_and_tables_give_the_output_to_check() {
             "$ cwisim scenes pot > pot.json",
             "$ cwisim tradeoff fig25",
             "vanrij [..] 95 [..]",
-        ]
-        .iter()
-        .enumerate()
-        .map(|(i, l)| (i + 1, (*l).to_owned()))
-        .collect(),
-    };
+        ],
+    );
     let units = units(&block, 0);
     assert_eq!(units.len(), 3);
     assert_eq!(
@@ -1359,9 +1367,9 @@ fn console_blocks_and_tables_give_the_output_to_check() {
 
 #[test]
 fn the_parser_reads_shell_as_the_documents_write_it() {
-    let block = Block {
-        lang: "sh".into(),
-        lines: [
+    let block = block_of(
+        "sh",
+        &[
             "# a comment line",
             "cwisim run a.cwt \\",
             "  --stats   # exits 2: a note",
@@ -1375,12 +1383,8 @@ fn the_parser_reads_shell_as_the_documents_write_it() {
             "N=3",
             "{ echo \"cwisim-trace x\"",
             "  yes 'a # b' | head -n $((3 * N)); } > long.cwt",
-        ]
-        .iter()
-        .enumerate()
-        .map(|(i, l)| (i + 1, (*l).to_owned()))
-        .collect(),
-    };
+        ],
+    );
     let units = units(&block, 0);
     let lines: Vec<usize> = units.iter().map(|u| u.line).collect();
     assert_eq!(lines, [2, 4, 7, 11, 12]);

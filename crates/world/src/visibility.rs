@@ -137,6 +137,35 @@ pub struct Fragment {
     pub polygon: Polygon,
 }
 
+impl Fragment {
+    /// The part `vertices` of triangle `tri` (index `source`), with the triangle's affine
+    /// intensity (its first `channels` entries) at each vertex.
+    ///
+    /// # Panics
+    ///
+    /// If `tri` has no area (no barycentric coordinates): a visible part has some.
+    pub fn of_triangle(
+        source: usize,
+        tri: &ScreenTriangle,
+        vertices: Vec<[f64; 2]>,
+        channels: usize,
+    ) -> Fragment {
+        let intensity = vertices
+            .iter()
+            .map(|&p| {
+                let v = tri
+                    .intensity_at(p, channels)
+                    .expect("a visible part's triangle has area");
+                v[..channels].to_vec()
+            })
+            .collect();
+        Fragment {
+            source,
+            polygon: Polygon::new(vertices, intensity),
+        }
+    }
+}
+
 /// What the visibility pass did (for the CLI summary).
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct VisibilityStats {
@@ -388,19 +417,9 @@ impl Shared<'_> {
                     settle(grid, shape, MAX_CUT_DEPTH, &mut contours, &mut tally.losses);
                 }
                 for c in contours.drain(..) {
-                    let intensity = c
-                        .iter()
-                        .map(|&p| {
-                            let v = tri
-                                .intensity_at(p, channels)
-                                .expect("a drawable triangle has nonzero area");
-                            v[..channels].to_vec()
-                        })
-                        .collect();
-                    tally.fragments.push(Fragment {
-                        source: k,
-                        polygon: Polygon::new(c, intensity),
-                    });
+                    tally
+                        .fragments
+                        .push(Fragment::of_triangle(k, tri, c, channels));
                 }
             }
             if tally.fragments.len() == before {

@@ -7,27 +7,29 @@
 //!
 //! 1. **Slabs.** The `x` of every piece corner cuts the strip into slabs. No corner lies
 //!    inside a slab, so each piece crosses it between two of its edges, each a straight
-//!    line across the slab ([`Line`]).
-//! 2. **Edge crossings.** Where two lines cross inside a slab, the slab is cut there too.
-//!    Then the slab's lines do not cross: they are ordered from top to bottom, the same at
-//!    both ends, and cut the slab into cells (trapezoids) between consecutive lines. Each
-//!    piece covers a run of cells.
-//! 3. **Depth.** Each cell goes to the nearest piece covering it, compared at the cell's
+//!    line across the slab.
+//! 2. **Cells.** The slab's lines are ordered at its middle, and each cell between two
+//!    consecutive lines goes to the nearest piece covering it, compared at the cell's
 //!    centre (`1/depth` is affine on a piece, and larger is nearer; equal: the lower
-//!    index). Where another covering piece is nearer at a corner of the cell, the two
-//!    surfaces cross inside it: the line where their `1/depth` are equal is added to the
-//!    slab as one more line (or the slab cut where it is upright), and the slab done
-//!    again. So the cells a piece wins are exactly where it is nearest.
-//! 4. **Fragments.** A piece's cells, joined up and down within a slab and from slab to
-//!    slab while they keep the same two lines, are trapezoids: the fragments, with the
-//!    piece's affine intensity at their corners.
+//!    index). Consecutive cells of one piece make a run.
+//! 3. **Checks.** The middle's order holds all across the slab only where lines do not
+//!    cross, and only the crossings that change what is seen matter. So the slab is cut
+//!    where two lines that bound a run (or a winner's own edges) cross; cut wherever any
+//!    two lines cross if a piece reaches into a gap; and, where another piece is nearer
+//!    than a run's winner somewhere in what they share (checked at that region's
+//!    corners: the surfaces cross), done again with the line where their `1/depth` are
+//!    equal as one more line (or a cut, where it is upright). Nesting is bounded: what is
+//!    left at the bound is rounding. So the runs a piece wins are exactly where it is
+//!    nearest.
+//! 4. **Fragments.** A piece's runs, joined from slab to slab where they meet side for
+//!    side, are its fragments (x-monotone polygons), with the piece's affine intensity at
+//!    their corners.
 //!
 //! Only the pieces crossing a slab are looked at in it (the paper's active subpatches):
 //! time grows with the pieces times the slabs each crosses, not with the pairs of
 //! overlapping pieces, and no polygon boolean is needed. The areas are exact up to
 //! rounding: coverage, depth order and intersections are all lines.
 
-use cwisim_scene::Polygon;
 use cwisim_world::face::ScreenTriangle;
 use cwisim_world::visibility::Fragment;
 
@@ -382,21 +384,13 @@ pub fn strip_fragments(
             stats.sliver_area += area;
             continue;
         }
-        let t = &tris[c.source];
-        let intensity = vertices
-            .iter()
-            .map(|&p| {
-                let v = t
-                    .intensity_at(p, channels)
-                    .expect("a piece with area has barycentric coordinates");
-                v[..channels].to_vec()
-            })
-            .collect();
         visible[c.source] = true;
-        out.push(Fragment {
-            source: c.source,
-            polygon: Polygon::new(vertices, intensity),
-        });
+        out.push(Fragment::of_triangle(
+            c.source,
+            &tris[c.source],
+            vertices,
+            channels,
+        ));
     }
     stats.fragments += out.len() as u64;
     stats.hidden += visible.iter().filter(|v| !**v).count() as u64;
@@ -771,6 +765,12 @@ mod tests {
         (ours, exact)
     }
 
+    /// `1/depth` of `t` at `p` (interpolated; outside `t` too).
+    fn inv_depth_at(t: &ScreenTriangle, p: [f64; 2]) -> f64 {
+        let w = t.barycentric(p).expect("a piece with area");
+        w[0] * t.inv_depth[0] + w[1] * t.inv_depth[1] + w[2] * t.inv_depth[2]
+    }
+
     /// The nearest piece at `p` (the largest `1/depth` among those holding it): a ray
     /// cast.
     fn nearest(tris: &[ScreenTriangle], p: [f64; 2]) -> Option<usize> {
@@ -778,13 +778,47 @@ mod tests {
         for (k, t) in tris.iter().enumerate() {
             let Some(w) = t.barycentric(p) else { continue };
             if w.iter().all(|&x| x > 1e-9) {
-                let z = w[0] * t.inv_depth[0] + w[1] * t.inv_depth[1] + w[2] * t.inv_depth[2];
+                let z = inv_depth_at(t, p);
                 if best.is_none_or(|(_, b)| z > b) {
                     best = Some((k, z));
                 }
             }
         }
         best.map(|b| b.0)
+    }
+
+    /// Whether `p` is in exactly one fragment when a piece holds it (none otherwise), the
+    /// nearest piece's (or one as near, within rounding), by a ray cast.
+    fn shows_the_nearest(
+        tris: &[ScreenTriangle],
+        fragments: &[Fragment],
+        p: [f64; 2],
+    ) -> Result<(), TestCaseError> {
+        let shown: Vec<usize> = fragments
+            .iter()
+            .filter(|f| inside(&f.polygon.vertices, p))
+            .map(|f| f.source)
+            .collect();
+        let want = nearest(tris, p);
+        prop_assert_eq!(
+            shown.len(),
+            usize::from(want.is_some()),
+            "{:?}: {:?} shown, {:?} nearest",
+            p,
+            shown,
+            want
+        );
+        if let (Some(&s), Some(w)) = (shown.first(), want) {
+            let (zs, zw) = (inv_depth_at(&tris[s], p), inv_depth_at(&tris[w], p));
+            prop_assert!(
+                s == w || (zs - zw).abs() < 1e-9,
+                "{:?}: {} shown, {} nearest",
+                p,
+                s,
+                w
+            );
+        }
+        Ok(())
     }
 
     /// Whether `p` is inside the simple polygon `v` (its winding number is not 0).
@@ -844,20 +878,7 @@ mod tests {
                 (0..12).map(move |j| [f64::from(i) / 24.0 + 0.00123, f64::from(j) / 12.0 + 0.00071])
             });
             for p in points {
-                let shown: Vec<usize> = fragments
-                    .iter()
-                    .filter(|f| inside(&f.polygon.vertices, p))
-                    .map(|f| f.source)
-                    .collect();
-                let want = nearest(&tris, p);
-                prop_assert_eq!(shown.len(), usize::from(want.is_some()), "{:?}: {:?} shown, {:?} nearest", p, shown, want);
-                if let (Some(&s), Some(w)) = (shown.first(), want) {
-                    let z = |t: &ScreenTriangle| {
-                        let b = t.barycentric(p).unwrap();
-                        b[0] * t.inv_depth[0] + b[1] * t.inv_depth[1] + b[2] * t.inv_depth[2]
-                    };
-                    prop_assert!(s == w || (z(&tris[s]) - z(&tris[w])).abs() < 1e-9, "{:?}: {} shown, {} nearest", p, s, w);
-                }
+                shows_the_nearest(&tris, &fragments, p)?;
             }
         }
 
@@ -874,23 +895,7 @@ mod tests {
             let mut stats = SegmentStats::default();
             let fragments = strip_fragments(&tris, 1, &mut stats);
             for (x, y) in xs {
-                let p = [x, y];
-                let shown: Vec<usize> = fragments
-                    .iter()
-                    .filter(|f| inside(&f.polygon.vertices, p))
-                    .map(|f| f.source)
-                    .collect();
-                let want = nearest(&tris, p);
-                prop_assert_eq!(shown.len(), usize::from(want.is_some()), "{:?}: {:?} shown, {:?} nearest", p, shown, want);
-                if let (Some(&s), Some(w)) = (shown.first(), want) {
-                    // equal depth within rounding at p is either
-                    let (ts, tw) = (&tris[s], &tris[w]);
-                    let z = |t: &ScreenTriangle| {
-                        let b = t.barycentric(p).unwrap();
-                        b[0] * t.inv_depth[0] + b[1] * t.inv_depth[1] + b[2] * t.inv_depth[2]
-                    };
-                    prop_assert!(s == w || (z(ts) - z(tw)).abs() < 1e-9, "{p:?}: {s} shown, {w} nearest");
-                }
+                shows_the_nearest(&tris, &fragments, [x, y])?;
             }
         }
     }
