@@ -29,7 +29,7 @@ use cwisim_world::bezier::Patch;
 use cwisim_world::camera::Camera;
 use cwisim_world::clip::{self, ClipStats};
 use glam::DVec3;
-use std::collections::HashMap;
+use rustc_hash::FxHashMap as HashMap;
 use std::sync::Mutex;
 
 /// The deepest quadtree level (4^7 cells per patch).
@@ -472,7 +472,7 @@ pub fn band_pieces(
     // roots: one record per distinct edge
     let start = std::time::Instant::now();
     let width = (-(level as f64)).exp2();
-    let mut records: HashMap<[u64; 12], EdgeRecord> = HashMap::new();
+    let mut records: HashMap<[u64; 12], EdgeRecord> = HashMap::default();
     let mut cell_edges: Vec<[([u64; 12], bool); 4]> = Vec::with_capacity(cells.len());
     for (c, f) in cells.iter().zip(&facings) {
         if *f == Facing::Back && !two_sided {
@@ -497,6 +497,7 @@ pub fn band_pieces(
     // pieces
     let start = std::time::Instant::now();
     let mut poly: Vec<PolyVertex> = Vec::new();
+    let mut corners = Vec::new();
     for ((c, f), keys) in cells.iter().zip(&facings).zip(&cell_edges) {
         if *f == Facing::Back && !two_sided {
             stats.back_culled += 1;
@@ -550,11 +551,15 @@ pub fn band_pieces(
             } else {
                 None
             };
-            let parts = match split {
-                Some((a, b)) => vec![a, b],
-                None => vec![std::mem::take(&mut poly)],
+            let halves;
+            let parts: [&[PolyVertex]; 2] = match split {
+                Some(two) => {
+                    halves = two;
+                    [&halves.0, &halves.1]
+                }
+                None => [&poly, &[]],
             };
-            for part in &parts {
+            for part in parts {
                 if part.len() < 3 {
                     continue;
                 }
@@ -564,6 +569,7 @@ pub fn band_pieces(
                     patch,
                     *f,
                     (top + k / params.subscan, k),
+                    &mut corners,
                     out,
                     stats,
                 );
@@ -574,35 +580,36 @@ pub fn band_pieces(
 }
 
 /// The triangles of one straight-sided polygon of a cell.
+#[allow(clippy::too_many_arguments)]
 fn emit_part(
     poly: &[PolyVertex],
     c: &Cell,
     patch: &Patch,
     facing: Facing,
     (row, strip): (u32, u32),
+    corners: &mut Vec<((f64, f64), Option<DVec3>)>,
     out: &mut Vec<Piece>,
     stats: &mut BandStats,
 ) {
-    {
-        {
-            let tris = triangulate(poly, &mut stats.fans);
-            for [a, b, cc] in tris {
-                let vs = [poly[a], poly[b], poly[cc]];
-                let uv = vs.map(|v| c.patch_uv(v.uv.0, v.uv.1));
-                let normals = uv.map(|(u, w)| patch.normal(u, w));
-                out.push(Piece {
-                    screen: vs.map(|v| v.screen),
-                    world: vs.map(|v| v.world),
-                    normals,
-                    uv,
-                    patch: c.patch,
-                    facing,
-                    row,
-                    strip,
-                });
-                stats.triangles += 1;
-            }
-        }
+    let tris = triangulate(poly, &mut stats.fans);
+    // each corner's patch parameters and normal once, however many triangles share it
+    corners.clear();
+    corners.extend(poly.iter().map(|v| {
+        let (u, w) = c.patch_uv(v.uv.0, v.uv.1);
+        ((u, w), patch.normal(u, w))
+    }));
+    for t in tris {
+        out.push(Piece {
+            screen: t.map(|k| poly[k].screen),
+            world: t.map(|k| poly[k].world),
+            normals: t.map(|k| corners[k].1),
+            uv: t.map(|k| corners[k].0),
+            patch: c.patch,
+            facing,
+            row,
+            strip,
+        });
+        stats.triangles += 1;
     }
 }
 

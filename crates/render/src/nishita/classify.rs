@@ -12,6 +12,12 @@
 //! its projected control points are not the control points of its derivative): a cell
 //! called front or back is one, whatever the view. Zero coefficients (at a pole, where
 //! `S_u` vanishes) do not count against either side.
+//!
+//! The products are taken in the *scaled* Bernstein form (coefficient `c[i][j]` times
+//! `C(m, i)·C(n, j)`), in which a product is a plain two-dimensional convolution; the
+//! scale factors are positive, so the signs that classify are read off the scaled form
+//! directly, and [`facing_coefficients`] divides them out only for those who want the
+//! coefficients themselves.
 
 use glam::DVec3;
 
@@ -24,17 +30,6 @@ pub enum Facing {
     Back,
     /// Both signs among the coefficients: may hold a silhouette.
     Twisted,
-}
-
-/// A bivariate polynomial in Bernstein form: degree `(m, n)`, at most `(8, 8)`,
-/// coefficients `c[i][j]` (`i` along `u`, `j` along `v`) stored row-major with `n + 1` per
-/// row. Fixed-size: a subpatch's facing takes six products of these, and a band classifies
-/// thousands of subpatches.
-#[derive(Clone, Copy, Debug)]
-struct Bern2 {
-    m: usize,
-    n: usize,
-    c: [f64; 81],
 }
 
 /// `C(n, k)` for `n ≤ 8` (exact: small integers).
@@ -53,113 +48,101 @@ const BINOMIAL: [[f64; 9]; 9] = {
     t
 };
 
-impl Bern2 {
-    /// The coefficients' count.
-    fn len(&self) -> usize {
-        (self.m + 1) * (self.n + 1)
-    }
+/// A bivariate polynomial of degree `(M − 1, N − 1)` in scaled Bernstein form:
+/// `s[i][j] = c[i][j]·C(M − 1, i)·C(N − 1, j)`, `i` along `u`, `j` along `v`.
+type Scaled<const M: usize, const N: usize> = [[f64; N]; M];
 
-    /// The coefficients times `C(m, i)·C(n, j)`: the scaled form, in which a product is
-    /// a plain convolution.
-    fn scaled(&self) -> [f64; 81] {
-        let mut s = self.c;
-        for i in 0..=self.m {
-            for j in 0..=self.n {
-                s[i * (self.n + 1) + j] *= BINOMIAL[self.m][i] * BINOMIAL[self.n][j];
-            }
-        }
-        s
-    }
+/// One coordinate of control points `q[i][j]` (`i` along `u`) in scaled form.
+fn scaled<const M: usize, const N: usize>(q: &[[DVec3; N]; M], axis: usize) -> Scaled<M, N> {
+    std::array::from_fn(|i| {
+        std::array::from_fn(|j| q[i][j][axis] * BINOMIAL[M - 1][i] * BINOMIAL[N - 1][j])
+    })
+}
 
-    /// The product, in Bernstein form of the summed degrees.
-    fn mul(&self, o: &Bern2) -> Bern2 {
-        let (m, n) = (self.m + o.m, self.n + o.n);
-        let (sa, sb) = (self.scaled(), o.scaled());
-        let mut c = [0.0; 81];
-        for i1 in 0..=self.m {
-            for j1 in 0..=self.n {
-                let a = sa[i1 * (self.n + 1) + j1];
-                if a == 0.0 {
-                    continue;
+/// The product of two scaled polynomials: their convolution (`P = A + C − 1`,
+/// `Q = B + D − 1`).
+fn product<
+    const A: usize,
+    const B: usize,
+    const C: usize,
+    const D: usize,
+    const P: usize,
+    const Q: usize,
+>(
+    a: &Scaled<A, B>,
+    b: &Scaled<C, D>,
+) -> Scaled<P, Q> {
+    debug_assert!(P == A + C - 1 && Q == B + D - 1);
+    let mut out = [[0.0; Q]; P];
+    for i1 in 0..A {
+        for j1 in 0..B {
+            let x = a[i1][j1];
+            for i2 in 0..C {
+                let row = &mut out[i1 + i2][j1..j1 + D];
+                for (o, y) in row.iter_mut().zip(&b[i2]) {
+                    *o += x * y;
                 }
-                for i2 in 0..=o.m {
-                    let row = (i1 + i2) * (n + 1) + j1;
-                    for j2 in 0..=o.n {
-                        c[row + j2] += a * sb[i2 * (o.n + 1) + j2];
-                    }
-                }
             }
         }
-        for i in 0..=m {
-            for j in 0..=n {
-                c[i * (n + 1) + j] /= BINOMIAL[m][i] * BINOMIAL[n][j];
-            }
-        }
-        Bern2 { m, n, c }
     }
-
-    fn sub(mut self, o: &Bern2) -> Bern2 {
-        let k = self.len();
-        for (a, b) in self.c[..k].iter_mut().zip(&o.c[..k]) {
-            *a -= b;
-        }
-        self
-    }
-
-    fn add(mut self, o: &Bern2) -> Bern2 {
-        let k = self.len();
-        for (a, b) in self.c[..k].iter_mut().zip(&o.c[..k]) {
-            *a += b;
-        }
-        self
-    }
+    out
 }
 
-/// One coordinate of control points `q[i][j]` (`i` along `u`) as a [`Bern2`].
-fn coordinate<const M: usize, const N: usize>(q: &[[DVec3; N]; M], axis: usize) -> Bern2 {
-    let mut c = [0.0; 81];
-    for (k, p) in q.iter().flatten().enumerate() {
-        c[k] = p[axis];
+/// `a·b − c·d`, element by element.
+fn cross_term<const M: usize, const N: usize>(ab: Scaled<M, N>, cd: &Scaled<M, N>) -> Scaled<M, N> {
+    let mut out = ab;
+    for (row, sub) in out.iter_mut().zip(cd) {
+        for (o, s) in row.iter_mut().zip(sub) {
+            *o -= s;
+        }
     }
-    Bern2 {
-        m: M - 1,
-        n: N - 1,
-        c,
-    }
+    out
 }
 
-/// The Bernstein coefficients of `g = (S − E)·(S_u × S_v)` for the patch with control
-/// points `points[row][col]` (`u` along a row, `v` down the rows).
-pub fn facing_coefficients(points: &[[DVec3; 4]; 4], eye: DVec3) -> Vec<f64> {
-    let g = facing_polynomial(points, eye);
-    g.c[..g.len()].to_vec()
-}
-
-/// [`facing_coefficients`] as a [`Bern2`].
-fn facing_polynomial(points: &[[DVec3; 4]; 4], eye: DVec3) -> Bern2 {
+/// `g` in scaled form, degree (8, 8), for the patch with control points
+/// `points[row][col]` (`u` along a row, `v` down the rows).
+fn scaled_facing(points: &[[DVec3; 4]; 4], eye: DVec3) -> Scaled<9, 9> {
     // q[i][j]: i along u (column), j along v (row)
     let p: [[DVec3; 4]; 4] = std::array::from_fn(|i| std::array::from_fn(|j| points[j][i] - eye));
     let su: [[DVec3; 4]; 3] =
         std::array::from_fn(|i| std::array::from_fn(|j| 3.0 * (p[i + 1][j] - p[i][j])));
     let sv: [[DVec3; 3]; 4] =
         std::array::from_fn(|i| std::array::from_fn(|j| 3.0 * (p[i][j + 1] - p[i][j])));
-    let (ux, uy, uz) = (coordinate(&su, 0), coordinate(&su, 1), coordinate(&su, 2));
-    let (vx, vy, vz) = (coordinate(&sv, 0), coordinate(&sv, 1), coordinate(&sv, 2));
-    let nx = uy.mul(&vz).sub(&uz.mul(&vy));
-    let ny = uz.mul(&vx).sub(&ux.mul(&vz));
-    let nz = ux.mul(&vy).sub(&uy.mul(&vx));
-    coordinate(&p, 0)
-        .mul(&nx)
-        .add(&coordinate(&p, 1).mul(&ny))
-        .add(&coordinate(&p, 2).mul(&nz))
+    let [ux, uy, uz] = [0, 1, 2].map(|a| scaled(&su, a));
+    let [vx, vy, vz] = [0, 1, 2].map(|a| scaled(&sv, a));
+    let n: [Scaled<6, 6>; 3] = [
+        cross_term(product(&uy, &vz), &product(&uz, &vy)),
+        cross_term(product(&uz, &vx), &product(&ux, &vz)),
+        cross_term(product(&ux, &vy), &product(&uy, &vx)),
+    ];
+    let mut g: Scaled<9, 9> = product(&scaled(&p, 0), &n[0]);
+    for (axis, n) in n.iter().enumerate().skip(1) {
+        let term: Scaled<9, 9> = product(&scaled(&p, axis), n);
+        for (row, add) in g.iter_mut().zip(&term) {
+            for (o, s) in row.iter_mut().zip(add) {
+                *o += s;
+            }
+        }
+    }
+    g
+}
+
+/// The Bernstein coefficients of `g = (S − E)·(S_u × S_v)` for the patch with control
+/// points `points[row][col]` (`u` along a row, `v` down the rows): 81 of them, `i`
+/// (along `u`) major.
+pub fn facing_coefficients(points: &[[DVec3; 4]; 4], eye: DVec3) -> Vec<f64> {
+    let g = scaled_facing(points, eye);
+    (0..9)
+        .flat_map(|i| (0..9).map(move |j| (i, j)))
+        .map(|(i, j)| g[i][j] / (BINOMIAL[8][i] * BINOMIAL[8][j]))
+        .collect()
 }
 
 /// How the patch with these control points faces `eye`.
 pub fn facing(points: &[[DVec3; 4]; 4], eye: DVec3) -> Facing {
-    let g = facing_polynomial(points, eye);
-    let g = &g.c[..g.len()];
-    let neg = g.iter().any(|&x| x < 0.0);
-    let pos = g.iter().any(|&x| x > 0.0);
+    let g = scaled_facing(points, eye);
+    let neg = g.iter().flatten().any(|&x| x < 0.0);
+    let pos = g.iter().flatten().any(|&x| x > 0.0);
     match (neg, pos) {
         (true, false) => Facing::Front,
         (false, true) => Facing::Back,

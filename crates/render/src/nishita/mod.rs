@@ -227,6 +227,10 @@ impl<'w> PatchScene<'w> {
                 &mut raw,
                 &mut out.stats,
             );
+            out.triangles.reserve(raw.len());
+            out.facing.reserve(raw.len());
+            out.origin.reserve(raw.len());
+            out.strip.reserve(raw.len());
             for p in &raw {
                 if let Some(t) = triangle(p, *k as u32, m, &self.camera, &self.lighting) {
                     for i in &t.intensity {
