@@ -345,6 +345,7 @@ pub fn strip_fragments(
     let mut sweep = Sweep {
         prepared: &prepared,
         stats,
+        chains: Vec::new(),
         open: Vec::new(),
         next: Vec::new(),
         closed: Vec::new(),
@@ -367,8 +368,10 @@ pub fn strip_fragments(
         sweep.slab(&active, xa, xb, &[], 0, false);
     }
     sweep.close_all();
-    let mut chains = std::mem::take(&mut sweep.closed);
-    chains.sort_by(|a, b| {
+    let chains = std::mem::take(&mut sweep.chains);
+    let mut closed = std::mem::take(&mut sweep.closed);
+    closed.sort_by(|&a, &b| {
+        let (a, b) = (&chains[a], &chains[b]);
         a.source
             .cmp(&b.source)
             .then(a.lower[0][0].total_cmp(&b.lower[0][0]))
@@ -376,7 +379,7 @@ pub fn strip_fragments(
     let stats = sweep.stats;
     let mut visible = vec![false; tris.len()];
     let mut out = Vec::with_capacity(chains.len());
-    for c in chains {
+    for c in closed.into_iter().map(|k| &chains[k]) {
         let vertices = c.outline();
         if vertices.len() < 3 {
             continue;
@@ -413,9 +416,11 @@ pub fn strip_fragments(
 struct Sweep<'a> {
     prepared: &'a [Option<Prepared>],
     stats: &'a mut SegmentStats,
-    open: Vec<Chain>,
-    next: Vec<Chain>,
-    closed: Vec<Chain>,
+    /// Every chain, open or closed; the sweep's lists hold their indices.
+    chains: Vec<Chain>,
+    open: Vec<usize>,
+    next: Vec<usize>,
+    closed: Vec<usize>,
     pool: Vec<Scratch>,
     /// Slabs within slabs now.
     nesting: u32,
@@ -681,7 +686,9 @@ impl Sweep<'_> {
             let source = sc.bounds[w].0;
             let (lower, upper) = (sc.by_rank[lo], sc.by_rank[hi]);
             let (ya_lower, ya_upper) = (order[lo].0, order[hi].0);
-            let continued = self.open.iter().position(|c| {
+            let chains = &self.chains;
+            let continued = self.open.iter().position(|&k| {
+                let c = &chains[k];
                 c.source == source
                     && c.x1 == xa
                     && c.lower_line.at(xa) == ya_lower
@@ -690,7 +697,8 @@ impl Sweep<'_> {
             });
             match continued {
                 Some(i) => {
-                    let mut c = self.open.swap_remove(i);
+                    let k = self.open.swap_remove(i);
+                    let c = &mut self.chains[k];
                     if !c.lower_line.same(&lower) {
                         c.lower.push([xa, ya_lower]);
                         c.lower_line = lower;
@@ -700,16 +708,19 @@ impl Sweep<'_> {
                         c.upper_line = upper;
                     }
                     c.x1 = xb;
-                    self.next.push(c);
+                    self.next.push(k);
                 }
-                None => self.next.push(Chain {
-                    source,
-                    lower: vec![[xa, ya_lower]],
-                    upper: vec![[xa, ya_upper]],
-                    lower_line: lower,
-                    upper_line: upper,
-                    x1: xb,
-                }),
+                None => {
+                    self.next.push(self.chains.len());
+                    self.chains.push(Chain {
+                        source,
+                        lower: vec![[xa, ya_lower]],
+                        upper: vec![[xa, ya_upper]],
+                        lower_line: lower,
+                        upper_line: upper,
+                        x1: xb,
+                    });
+                }
             }
         }
         // what this slab did not continue is closed
