@@ -442,6 +442,9 @@ fn piece_hiding(
 ) -> Option<Contour> {
     let (i, j) = (front.min(back), front.max(back));
     let (ti, tj) = (&tris[i], &tris[j]);
+    if apart(ti, tj) || apart(tj, ti) {
+        return None;
+    }
     let (mut overlap, mut spare) = (Small::new(), Small::new());
     inside_triangle(&tj.points, ti, &mut overlap, &mut spare);
     if area(&overlap) <= PIECE_AREA {
@@ -664,6 +667,17 @@ fn clip_into(poly: &[Pt], f: impl Fn(Pt) -> f64, out: &mut Small) {
             out.push(b);
         }
     }
+}
+
+/// Whether an edge of triangle `t` has all three corners of `o` on its outside or on it:
+/// the two share no area. The common candidate pair of a mesh — two neighbours whose
+/// boxes overlap — ends here, without clipping.
+fn apart(t: &ScreenTriangle, o: &ScreenTriangle) -> bool {
+    let s = t.doubled_area().signum();
+    (0..3).any(|k| {
+        let (a, b) = (t.points[k], t.points[(k + 1) % 3]);
+        o.points.iter().all(|&p| s * cross(a, b, p) <= 0.0)
+    })
 }
 
 /// The convex polygon `poly` clipped to the triangle `t` (either orientation), into
