@@ -108,15 +108,41 @@ pub fn header(scene: &ScreenScene) -> TraceHeader {
 /// The trapezia of a scene's polygons after clipping to the image, numbered 1, 2, … in
 /// polygon order (the report's Identifier).
 pub fn scene_trapezia(scene: &ScreenScene) -> Vec<trapezoid::Trapezium> {
-    let channels = usize::from(scene.channels);
-    let (w, h) = (f64::from(scene.width), f64::from(scene.height));
+    polygon_trapezia(
+        &scene.polygons,
+        scene.width,
+        scene.height,
+        usize::from(scene.channels),
+    )
+}
+
+/// [`scene_trapezia`] of some of a scene's polygons (`polygons`, of an image
+/// `width × height` with `channels` channels), numbered from 1 among them.
+pub fn polygon_trapezia(
+    polygons: &[cwisim_scene::Polygon],
+    width: u32,
+    height: u32,
+    channels: usize,
+) -> Vec<trapezoid::Trapezium> {
+    let (w, h) = (f64::from(width), f64::from(height));
     let mut out = Vec::new();
-    for (k, p) in scene.polygons.iter().enumerate() {
+    for (k, p) in polygons.iter().enumerate() {
+        let first = out.len() as u32 + 1;
+        // a polygon inside the image is its own clip (no copy)
+        let inside = p
+            .vertices
+            .iter()
+            .all(|v| (0.0..=w).contains(&v[0]) && (0.0..=h).contains(&v[1]));
+        if inside && p.intensity.len() == p.vertices.len() {
+            if p.vertices.len() >= 3 {
+                out.extend(trapezoid::trapezia(p, k as u32, channels, first));
+            }
+            continue;
+        }
         let clipped = clip::clip_to_rect(p, 0.0, 0.0, w, h);
         if clipped.vertices.len() < 3 {
             continue;
         }
-        let first = out.len() as u32 + 1;
         out.extend(trapezoid::trapezia(&clipped, k as u32, channels, first));
     }
     out

@@ -28,7 +28,7 @@ use cwisim_isa::{Instruction, Opcode, TraceWrite};
 use cwisim_scene::ScreenScene;
 use cwisim_ypipe::dofill::{box_slice_to, BoxValue, Procedure, RowOut, Shade};
 use cwisim_ypipe::scan::{edge_list, scan_slices_of, SliceVisit};
-use cwisim_ypipe::scene_trapezia;
+use cwisim_ypipe::polygon_trapezia;
 use cwisim_ypipe::Claim;
 use std::io;
 use std::ops::Range;
@@ -209,14 +209,12 @@ impl MergedFrame<'_> {
             None => 0..self.screen.polygons.len(),
         };
         let base = polygons.start;
-        let band = ScreenScene {
-            width: self.screen.width,
-            height: self.screen.height,
-            channels: self.screen.channels,
-            polygons: self.screen.polygons[polygons].to_vec(),
-        };
-        let trapezia = scene_trapezia(&band);
-        drop(band);
+        let trapezia = polygon_trapezia(
+            &self.screen.polygons[polygons],
+            self.screen.width,
+            self.screen.height,
+            channels,
+        );
         let edges = edge_list(&trapezia, channels);
         // each trapezium counted once, in the chunk of its fragment's own row
         tally.trapezia += match &self.rows {
