@@ -28,6 +28,7 @@
 //! ```
 
 use cwisim_scene::Polygon;
+use std::borrow::Cow;
 
 /// The part of `p` inside the rectangle `[x0, x1] × [y0, y1]`, with intensities
 /// interpolated along the cut edges.
@@ -44,15 +45,30 @@ use cwisim_scene::Polygon;
 ///
 /// If `p.intensity.len() != p.vertices.len()`.
 pub fn clip_to_rect(p: &Polygon, x0: f64, y0: f64, x1: f64, y1: f64) -> Polygon {
+    clip_to_rect_cow(p, x0, y0, x1, y1).into_owned()
+}
+
+/// [`clip_to_rect`] without a copy where nothing is cut: `p` itself, borrowed, when every
+/// vertex lies in the rectangle (the common case of a polygon inside the image); the
+/// clipped polygon otherwise.
+///
+/// # Panics
+///
+/// If `p.intensity.len() != p.vertices.len()`.
+pub fn clip_to_rect_cow(p: &Polygon, x0: f64, y0: f64, x1: f64, y1: f64) -> Cow<'_, Polygon> {
     assert_eq!(
         p.intensity.len(),
         p.vertices.len(),
         "clip_to_rect: one intensity vector per vertex"
     );
+    let inside = |v: &[f64; 2]| v[0] >= x0 && v[0] <= x1 && v[1] >= y0 && v[1] <= y1;
+    if p.vertices.iter().all(inside) {
+        return Cow::Borrowed(p);
+    }
     let mut q = clip_half(p, 1, y0, true);
     q = clip_half(&q, 1, y1, false);
     q = clip_half(&q, 0, x0, true);
-    clip_half(&q, 0, x1, false)
+    Cow::Owned(clip_half(&q, 0, x1, false))
 }
 
 /// One Sutherland–Hodgman pass: keeps `v[axis] ≥ bound` (`keep_ge`) or `v[axis] ≤ bound`.
@@ -156,6 +172,28 @@ mod tests {
         let n = v.len();
         let i = (0..n).map(|k| vec![k as f64]).collect();
         Polygon::new(v, i)
+    }
+
+    #[test]
+    fn a_polygon_inside_is_borrowed_and_a_cut_one_is_the_clip() {
+        let inside = grey(vec![[0.0, 0.0], [4.0, 0.0], [4.0, 3.0]]);
+        assert!(
+            matches!(clip_to_rect_cow(&inside, 0.0, 0.0, 4.0, 3.0), Cow::Borrowed(q) if std::ptr::eq(q, &inside))
+        );
+        // one vertex out on each side in turn: cut, and the same polygon clip_to_rect gives
+        for out in [
+            [-1.0, 1.0],
+            [5.0, 1.0],
+            [2.0, -1.0],
+            [2.0, 4.0],
+            [f64::NAN, 1.0],
+        ] {
+            let p = grey(vec![[1.0, 1.0], [3.0, 1.0], out]);
+            let c = clip_to_rect_cow(&p, 0.0, 0.0, 4.0, 3.0);
+            assert!(matches!(c, Cow::Owned(_)), "{out:?}");
+            let owned = clip_to_rect(&p, 0.0, 0.0, 4.0, 3.0);
+            assert_eq!(format!("{:?}", c.into_owned()), format!("{owned:?}"));
+        }
     }
 
     #[test]

@@ -29,7 +29,7 @@
 //!
 //! [`ScreenScene::validate`]: cwisim_scene::ScreenScene::validate
 
-use crate::clip::clip_to_rect;
+use crate::clip::clip_to_rect_cow;
 use cwisim_scene::{Polygon, ScreenScene};
 
 /// The exact area of a polygon: the absolute value of its shoelace sum (taken relative to
@@ -377,7 +377,7 @@ pub fn box_filtered_subdivided(
     {
         return out;
     }
-    let q = clip_to_rect(p, 0.0, 0.0, wf, hf);
+    let q = clip_to_rect_cow(p, 0.0, 0.0, wf, hf);
     if q.vertices.len() < 3 {
         return out;
     }

@@ -127,22 +127,11 @@ pub fn polygon_trapezia(
     let (w, h) = (f64::from(width), f64::from(height));
     let mut out = Vec::new();
     for (k, p) in polygons.iter().enumerate() {
-        let first = out.len() as u32 + 1;
-        // a polygon inside the image is its own clip (no copy)
-        let inside = p
-            .vertices
-            .iter()
-            .all(|v| (0.0..=w).contains(&v[0]) && (0.0..=h).contains(&v[1]));
-        if inside && p.intensity.len() == p.vertices.len() {
-            if p.vertices.len() >= 3 {
-                out.extend(trapezoid::trapezia(p, k as u32, channels, first));
-            }
-            continue;
-        }
-        let clipped = clip::clip_to_rect(p, 0.0, 0.0, w, h);
+        let clipped = clip::clip_to_rect_cow(p, 0.0, 0.0, w, h);
         if clipped.vertices.len() < 3 {
             continue;
         }
+        let first = out.len() as u32 + 1;
         out.extend(trapezoid::trapezia(&clipped, k as u32, channels, first));
     }
     out
