@@ -462,9 +462,9 @@ fn visibility_is_not_read() {
     }
 }
 
-/// The frame's fragments, joined band by band, are held without spare room (each band
-/// joined as soon as it is resolved on one thread, the joined vectors made at their final
-/// size on several), and are the same at any thread count, Gouraud and Phong.
+/// The frame's fragments, joined band by band, are held packed without spare room (each
+/// band's store made to its size as it is joined, on one thread or several), and are the
+/// same at any thread count, Gouraud and Phong.
 #[test]
 fn resolved_fragments_are_held_without_spare_room() {
     use cwisim_render::nishita::resolve::resolve;
@@ -479,11 +479,12 @@ fn resolved_fragments_are_held_without_spare_room() {
             };
             let scene = PatchScene::new(&w, &settings).unwrap();
             let r = resolve(&scene, &settings, keep).unwrap();
-            assert!(r.polygons.len() > 100, "{} fragments", r.polygons.len());
+            let n = r.fragments.len();
+            assert!(n > 100, "{n} fragments");
+            assert_eq!(r.fragments.groups.len(), n);
+            assert_eq!(r.fragments.rows.len(), n);
             let room = [
-                ("polygons", r.polygons.capacity() - r.polygons.len()),
-                ("groups", r.groups.capacity() - r.groups.len()),
-                ("rows", r.rows.capacity() - r.rows.len()),
+                ("fragments", r.fragments.spare_bytes()),
                 ("sources", r.sources.capacity() - r.sources.len()),
                 ("triangles", r.triangles.capacity() - r.triangles.len()),
             ];
@@ -491,8 +492,8 @@ fn resolved_fragments_are_held_without_spare_room() {
                 room.iter().all(|(_, n)| *n == 0),
                 "threads {threads}, keep {keep}: spare room {room:?}"
             );
-            assert_eq!(r.sources.len(), if keep { r.polygons.len() } else { 0 });
-            polygons.push((r.polygons, r.groups, r.rows, r.sources));
+            assert_eq!(r.sources.len(), if keep { n } else { 0 });
+            polygons.push((r.fragments, r.sources));
         }
         assert!(
             polygons[0] == polygons[1],

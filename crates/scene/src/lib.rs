@@ -10,6 +10,7 @@
 //!   [`read_kind`], [`locate_error`] and [`json_error`] are what every reader of a scene
 //!   kind builds on (world scenes in `cwisim-world` too), so that all errors look alike.
 //! * [`locate`] — a JSON path located in the text.
+//! * [`packed`] — [`PackedPolygons`]: many polygons held flat, a few heap blocks for all.
 //! * [`predicates`] — exact orientation, segment intersection, polygon simplicity.
 //! * [`settings`] — [`Shading`] and [`Antialias`], the drawing settings every renderer
 //!   and command names the same way.
@@ -42,11 +43,13 @@ pub mod budget;
 pub mod error;
 pub mod grid;
 pub mod locate;
+pub mod packed;
 pub mod predicates;
 pub mod screen;
 pub mod settings;
 
 pub use error::{describe_json, json_error, locate_error, read_kind, SceneError, SceneErrorKind};
+pub use packed::PackedPolygons;
 pub use screen::{
     check_intensity, load_scene, parse_scene, read_scene_text, Polygon, Scene, ScreenScene,
 };

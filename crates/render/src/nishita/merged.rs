@@ -25,7 +25,7 @@ use crate::prepare::PhongSurfaces;
 use crate::renderer::{Counters, FramePlan};
 use crate::span::{fit_span, SpanStats};
 use cwisim_isa::{Instruction, Opcode, TraceWrite};
-use cwisim_scene::ScreenScene;
+use cwisim_scene::{PackedPolygons, Polygon, ScreenScene};
 use cwisim_ypipe::dofill::{box_slice_to, BoxValue, Procedure, RowOut, Shade};
 use cwisim_ypipe::polygon_trapezia;
 use cwisim_ypipe::scan::{edge_list, scan_slices_of, SliceVisit};
@@ -33,10 +33,97 @@ use cwisim_ypipe::Claim;
 use std::io;
 use std::ops::Range;
 
-/// One frame: the fragments, their patches and the rows each reaches; each band of
-/// rows builds the trapezia of its own polygons.
+/// A frame's visible fragments, held until their rows are emitted: packed band by band
+/// (each band's store made to its size: no store of the frame's size grows and is
+/// copied), unpacked a few rows at a time; with each one's patch and pixel row.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Fragments {
+    /// The fragments, band by band (no band empty).
+    bands: Vec<PackedPolygons>,
+    /// `ends[b]`: the fragments in bands `..= b`.
+    ends: Vec<usize>,
+    /// For each fragment: its patch (`mesh << 32 | patch`).
+    pub groups: Vec<u64>,
+    /// For each fragment: its pixel row (non-decreasing along the fragments when they
+    /// come band by band and strip by strip; a fragment may reach one row either side,
+    /// by rounding).
+    pub rows: Vec<u32>,
+}
+
+impl Fragments {
+    /// Fragments held.
+    pub fn len(&self) -> usize {
+        self.ends.last().copied().unwrap_or(0)
+    }
+
+    /// Whether it holds none.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Appends a band's fragments (their patches and rows are pushed to `groups` and
+    /// `rows`).
+    pub fn push_band(&mut self, mut band: PackedPolygons) {
+        if band.is_empty() {
+            return;
+        }
+        band.shrink_to_fit();
+        self.ends.push(self.len() + band.len());
+        self.bands.push(band);
+    }
+
+    /// Fragments `range`, unpacked (the part past the end left out).
+    pub fn unpack(&self, range: Range<usize>) -> Vec<Polygon> {
+        let mut out = Vec::new();
+        self.unpack_into(range, &mut out);
+        out
+    }
+
+    /// Fragments `range` unpacked into `out` (the part past the end left out), reusing
+    /// the vectors of the polygons `out` holds ([`PackedPolygons::unpack_into`]).
+    pub fn unpack_into(&self, range: Range<usize>, out: &mut Vec<Polygon>) {
+        let mut filled = 0;
+        let mut b = self.ends.partition_point(|&e| e <= range.start);
+        while b < self.bands.len() {
+            let first = if b == 0 { 0 } else { self.ends[b - 1] };
+            if first >= range.end {
+                break;
+            }
+            let local = range.start.max(first) - first..range.end.min(self.ends[b]) - first;
+            filled += self.bands[b].unpack_into(local, out, filled);
+            b += 1;
+        }
+        out.truncate(filled);
+    }
+
+    /// The bytes its vectors hold and do not use.
+    pub fn spare_bytes(&self) -> usize {
+        use std::mem::size_of;
+        self.bands
+            .iter()
+            .map(PackedPolygons::spare_bytes)
+            .sum::<usize>()
+            + (self.bands.capacity() - self.bands.len()) * size_of::<PackedPolygons>()
+            + (self.ends.capacity() - self.ends.len()) * size_of::<usize>()
+            + (self.groups.capacity() - self.groups.len()) * size_of::<u64>()
+            + (self.rows.capacity() - self.rows.len()) * size_of::<u32>()
+    }
+
+    /// Drops the spare capacity of its vectors.
+    pub fn shrink_to_fit(&mut self) {
+        self.bands.shrink_to_fit();
+        self.ends.shrink_to_fit();
+        self.groups.shrink_to_fit();
+        self.rows.shrink_to_fit();
+    }
+}
+
+/// One frame: the fragments, their patches and the rows each reaches; each few rows
+/// unpack their own polygons and build their trapezia.
 pub struct MergedFrame<'a> {
+    /// The image's size and channels (its polygons are not read: `fragments` are).
     screen: &'a ScreenScene,
+    fragments: &'a Fragments,
     /// For each polygon: its patch (`mesh << 32 | patch`).
     groups: &'a [u64],
     value: BoxValue,
@@ -51,20 +138,21 @@ pub struct MergedFrame<'a> {
 }
 
 impl<'a> MergedFrame<'a> {
-    /// The plan of `screen`, whose polygon `k` is part of patch `groups[k]` and lies in
-    /// pixel row `rows[k]` (within rounding); Gouraud, or Phong lit from `phong`.
+    /// The plan of `fragments` in an image of `screen`'s size and channels; Gouraud, or
+    /// Phong lit from `phong`.
     pub fn new(
         screen: &'a ScreenScene,
-        groups: &'a [u64],
-        rows: &'a [u32],
+        fragments: &'a Fragments,
         value: BoxValue,
         tolerance: f64,
         phong: Option<&'a PhongSurfaces>,
     ) -> MergedFrame<'a> {
-        let ordered = rows.windows(2).all(|w| w[0] <= w[1]) && rows.len() == screen.polygons.len();
+        let rows = &fragments.rows[..];
+        let ordered = rows.windows(2).all(|w| w[0] <= w[1]) && rows.len() == fragments.len();
         MergedFrame {
             screen,
-            groups,
+            fragments,
+            groups: &fragments.groups,
             value,
             tolerance,
             phong,
@@ -157,13 +245,15 @@ fn counters(t: &Tally) -> Counters {
 
 impl FramePlan for MergedFrame<'_> {
     fn counters(&self) -> Counters {
-        Counters::default().with("polygons", self.screen.polygons.len() as u64)
+        Counters::default().with("polygons", self.fragments.len() as u64)
     }
 
     fn emit_rows(&self, rows: Range<u32>, sink: &mut dyn TraceWrite) -> io::Result<Counters> {
         let mut tally = Tally::default();
         // the row's slots, reused from row to row
         let mut slots: Vec<Slot> = Vec::new();
+        // the chunk's fragments unpacked, their vectors reused from chunk to chunk
+        let mut unpacked: Vec<Polygon> = Vec::new();
         // a few rows at a time (each row's stream does not depend on the split)
         let step = match self.rows {
             Some(_) => CHUNK_ROWS,
@@ -172,7 +262,7 @@ impl FramePlan for MergedFrame<'_> {
         let mut start = rows.start;
         while start < rows.end {
             let end = start.saturating_add(step).min(rows.end);
-            self.emit_chunk(start..end, sink, &mut slots, &mut tally)?;
+            self.emit_chunk(start..end, sink, &mut slots, &mut unpacked, &mut tally)?;
             start = end;
         }
         Ok(counters(&tally))
@@ -180,7 +270,7 @@ impl FramePlan for MergedFrame<'_> {
 }
 
 /// Rows emitted at a time: their fragments' trapezia are built for them alone.
-const CHUNK_ROWS: u32 = 8;
+const CHUNK_ROWS: u32 = 4;
 
 impl MergedFrame<'_> {
     fn emit_chunk(
@@ -188,6 +278,7 @@ impl MergedFrame<'_> {
         rows: Range<u32>,
         sink: &mut dyn TraceWrite,
         slots: &mut Vec<Slot>,
+        unpacked: &mut Vec<Polygon>,
         tally: &mut Tally,
     ) -> io::Result<()> {
         let channels = self.screen.channel_count();
@@ -206,15 +297,11 @@ impl MergedFrame<'_> {
                 let last = r.partition_point(|&row| i64::from(row) - 1 < end);
                 first..last.max(first)
             }
-            None => 0..self.screen.polygons.len(),
+            None => 0..self.fragments.len(),
         };
         let base = polygons.start;
-        let trapezia = polygon_trapezia(
-            &self.screen.polygons[polygons],
-            self.screen.width,
-            self.screen.height,
-            channels,
-        );
+        self.fragments.unpack_into(polygons, unpacked);
+        let trapezia = polygon_trapezia(unpacked, self.screen.width, self.screen.height, channels);
         let edges = edge_list(&trapezia, channels);
         // each trapezium counted once, in the chunk of its fragment's own row
         tally.trapezia += match &self.rows {
@@ -338,5 +425,52 @@ impl MergedFrame<'_> {
             }
         });
         result
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A grey square of side 1 at `(x, 0)`.
+    fn square(x: f64) -> Polygon {
+        Polygon::uniform(
+            vec![[x, 0.0], [x + 1.0, 0.0], [x + 1.0, 1.0], [x, 1.0]],
+            &[x / 100.0],
+        )
+    }
+
+    #[test]
+    fn any_range_across_bands_unpacks_the_fragments_in_order() {
+        let all: Vec<Polygon> = (0..10).map(|k| square(k as f64)).collect();
+        // bands of 3, 0 (an empty band is not kept), 1, 4 and 2 fragments
+        let mut fragments = Fragments::default();
+        let mut next = 0;
+        for n in [3, 0, 1, 4, 2] {
+            let mut band = PackedPolygons::new(1);
+            for p in &all[next..next + n] {
+                band.push(p).unwrap();
+            }
+            next += n;
+            fragments.push_band(band);
+        }
+        assert_eq!(fragments.len(), 10);
+        assert_eq!(fragments.bands.len(), 4);
+        for start in 0..=10 {
+            for end in start..=12 {
+                assert_eq!(
+                    fragments.unpack(start..end),
+                    all[start..end.min(10)].to_vec(),
+                    "{start}..{end}"
+                );
+            }
+        }
+        assert!(Fragments::default().unpack(0..3).is_empty());
+        // into a buffer, again and again: each time the range alone
+        let mut buffer = Vec::new();
+        for (start, end) in [(2, 9), (0, 3), (4, 12), (9, 10), (5, 5), (0, 10)] {
+            fragments.unpack_into(start..end, &mut buffer);
+            assert_eq!(buffer, all[start..end.min(10)].to_vec(), "{start}..{end}");
+        }
     }
 }

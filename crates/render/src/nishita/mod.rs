@@ -346,11 +346,11 @@ pub struct Nishita {
     settings: Settings,
     /// Host time of the visibility pass.
     visibility_time: Duration,
-    /// Each polygon's patch (`mesh << 32 | patch`) when a patch's row goes through the
-    /// span fitter as one span ([`merged`]: box filter, band by band); `None`
-    /// when the polygons are drawn as `vanrij` draws them.
-    /// With each polygon's pixel row.
-    groups: Option<(Vec<u64>, Vec<u32>)>,
+    /// The visible fragments, packed, with each one's patch and pixel row, when a
+    /// patch's row goes through the span fitter as one span ([`merged`]: box filter, a
+    /// few rows at a time; `inner`'s scene then has no polygons of its own); `None` when
+    /// the polygons are drawn as `vanrij` draws them (`inner`'s).
+    merged: Option<merged::Fragments>,
     /// What the scan segments did, when the scene is all patches (visibility strip by
     /// strip, [`segments`]); `None` when its other meshes share exact visibility with
     /// the pieces.
@@ -416,7 +416,7 @@ impl Nishita {
                     triangles: 0,
                     settings: *settings,
                     visibility_time: Duration::ZERO,
-                    groups: None,
+                    merged: None,
                     segments: None,
                 });
             }
@@ -430,7 +430,7 @@ impl Nishita {
             .collect();
         let channels = w.channels();
         let mut project = None;
-        let mut groups = None;
+        let mut merged = None;
         let mut segments = None;
         let (made, count, polygons, vis, surfaces, geometry_time, visibility_time) = if others
             .is_empty()
@@ -440,9 +440,12 @@ impl Nishita {
             let scene = PatchScene::new(&w, settings)?;
             let r = resolve::resolve(&scene, settings, phong)?;
             let total = start.elapsed();
-            if settings.aa.is_box() {
-                groups = Some((r.groups, r.rows));
-            }
+            let polygons = if settings.aa.is_box() {
+                merged = Some(r.fragments);
+                Vec::new()
+            } else {
+                r.fragments.unpack(0..r.fragments.len())
+            };
             let surfaces = phong.then(|| {
                 PhongSurfaces::new(r.triangles, r.sources, shader())
                     .filtered(settings.texture_filter)
@@ -451,7 +454,7 @@ impl Nishita {
             (
                 r.pieces,
                 r.count,
-                r.polygons,
+                polygons,
                 None,
                 surfaces,
                 total.saturating_sub(r.time),
@@ -542,7 +545,7 @@ impl Nishita {
             triangles: count,
             settings: *settings,
             visibility_time,
-            groups,
+            merged,
             segments,
         })
     }
@@ -572,9 +575,17 @@ impl Nishita {
         &self.stats
     }
 
-    /// The polygons it draws (the visible fragments of its pieces).
+    /// The scene it draws: its polygons are the visible fragments of its pieces, but
+    /// for the box filter, where they are held packed ([`Nishita::fragments`]) and the
+    /// scene has none of its own.
     pub fn polygons(&self) -> &PolygonScene {
         self.inner.polygons()
+    }
+
+    /// The visible fragments, packed, with each one's patch and pixel row, when a patch's
+    /// row is sent as one span (the box filter on Bézier patches); `None` otherwise.
+    pub fn fragments(&self) -> Option<&merged::Fragments> {
+        self.merged.as_ref()
     }
 
     /// Its own counters (the frame's, besides the Y-processor's).
@@ -650,11 +661,10 @@ impl Renderer for Nishita {
         index: u32,
         previous: Option<&'a Image>,
     ) -> Result<Box<dyn FramePlan + 'a>, RenderError> {
-        let inner: Box<dyn FramePlan + 'a> = match &self.groups {
-            Some((groups, rows)) => Box::new(merged::MergedFrame::new(
+        let inner: Box<dyn FramePlan + 'a> = match &self.merged {
+            Some(fragments) => Box::new(merged::MergedFrame::new(
                 &self.inner.polygons().screen,
-                groups,
-                rows,
+                fragments,
                 if self.settings.aa == cwisim_scene::Antialias::BoxCentre {
                     cwisim_ypipe::dofill::BoxValue::Centre
                 } else {
@@ -673,7 +683,7 @@ impl Renderer for Nishita {
 
     fn settings_phrase(&self) -> String {
         let s = &self.settings;
-        let merged = match self.groups {
+        let merged = match self.merged {
             Some(_) => format!(
                 ", each patch's row one span (tolerance {})",
                 self.span_tolerance()
@@ -793,6 +803,10 @@ impl Renderer for Nishita {
     fn scene_json(&self) -> serde_json::Value {
         let mut v = self.inner.scene_json();
         if let Some(o) = v.as_object_mut() {
+            if let Some(f) = &self.merged {
+                // held packed, not in the scene
+                o.insert("polygons".into(), f.len().into());
+            }
             o.insert(
                 "nishita".into(),
                 serde_json::to_value(self.counters()).unwrap_or_default(),

@@ -11,13 +11,15 @@
 //! thread each band is joined to the frame's fragments as soon as it is resolved (not all
 //! bands held, then joined); on several, this thread joins them in band order as the
 //! workers resolve them (holding only the bands resolved ahead of their turn). Either way
-//! the joined vectors keep no spare room: the fragments are held until the rows are emitted.
+//! the joined vectors keep no spare room: the fragments are held, packed band by band
+//! ([`super::merged::Fragments`]), until the rows are emitted.
 
+use super::merged::Fragments;
 use super::segments::{strip_fragments, SegmentStats};
 use super::{check_budget, PatchScene, Pieces};
 use crate::error::RenderError;
 use crate::settings::Settings;
-use cwisim_scene::Polygon;
+use cwisim_scene::PackedPolygons;
 use cwisim_world::face::ScreenTriangle;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Condvar, Mutex};
@@ -26,8 +28,8 @@ use std::time::{Duration, Instant};
 /// What resolving one band made.
 #[derive(Default)]
 struct Band {
-    /// Its visible fragments, in order.
-    polygons: Vec<Polygon>,
+    /// Its visible fragments, in order, packed.
+    polygons: PackedPolygons,
     /// Each fragment's source, an index into `triangles` (kept for Phong only).
     sources: Vec<usize>,
     /// Each fragment's patch: `mesh << 32 | patch`.
@@ -48,14 +50,12 @@ struct Band {
 
 /// The frame, resolved band by band.
 pub struct Resolved {
-    /// The visible fragments, band by band.
-    pub polygons: Vec<Polygon>,
+    /// The visible fragments, band by band, packed (held until their rows are emitted),
+    /// with each one's patch and pixel row (its strip's: it lies in that row, within
+    /// rounding).
+    pub fragments: Fragments,
     /// Phong: each fragment's source in `triangles`.
     pub sources: Vec<usize>,
-    /// Each fragment's patch: `mesh << 32 | patch`.
-    pub groups: Vec<u64>,
-    /// Each fragment's pixel row (its strip's): it lies in that row, within rounding.
-    pub rows: Vec<u32>,
     /// Phong: every band's triangles that some fragment is part of, in order.
     pub triangles: Vec<ScreenTriangle>,
     /// All triangles.
@@ -96,6 +96,7 @@ fn one_band(
     let triangles: Vec<ScreenTriangle> = order.iter().map(|&i| made[i as usize]).collect();
     drop(made);
     let mut band = Band {
+        polygons: PackedPolygons::new(scene.channels()),
         count: triangles.len(),
         ..Band::default()
     };
@@ -111,10 +112,7 @@ fn one_band(
             if keep {
                 band.sources.push(a + f.source);
             }
-            let mut polygon = f.polygon;
-            // held until the band's rows are emitted: without the clipper's spare room
-            polygon.vertices.shrink_to_fit();
-            band.polygons.push(polygon);
+            band.polygons.push(&f.polygon).map_err(packing)?;
         }
         a = b;
     }
@@ -149,10 +147,8 @@ pub fn resolve(
         cwisim_scene::budget::resolve_threads(settings.threads).clamp(1, bands.len().max(1));
     let made = AtomicUsize::new(0);
     let mut out = Resolved {
-        polygons: Vec::new(),
+        fragments: Fragments::default(),
         sources: Vec::new(),
-        groups: Vec::new(),
-        rows: Vec::new(),
         triangles: Vec::new(),
         count: 0,
         pieces: Pieces {
@@ -264,13 +260,23 @@ impl Drop for Running<'_> {
     }
 }
 
+/// A fragment the packed store refuses: more vertices than it indexes (the memory
+/// budget is far below), or a fragment not of the scene's channels — a fault of the
+/// renderer either way.
+fn packing(e: cwisim_scene::packed::PackError) -> RenderError {
+    RenderError::Renderer {
+        renderer: "nishita",
+        source: std::io::Error::other(e),
+    }
+}
+
 /// Appends one band's fragments, counts and statistics to `out` (bands in order).
 fn join(out: &mut Resolved, band: Band) {
     let base = out.triangles.len();
-    out.polygons.extend(band.polygons);
+    out.fragments.push_band(band.polygons);
     out.sources.extend(band.sources.iter().map(|s| s + base));
-    out.groups.extend(band.groups);
-    out.rows.extend(band.rows);
+    out.fragments.groups.extend(band.groups);
+    out.fragments.rows.extend(band.rows);
     out.triangles.extend(band.triangles);
     out.count += band.count as u64;
     out.pieces.stats.merge(&band.pieces.stats);
@@ -281,9 +287,7 @@ fn join(out: &mut Resolved, band: Band) {
 
 /// `out`'s vectors without their spare capacity (grown band by band).
 fn shrink(out: &mut Resolved) {
-    out.polygons.shrink_to_fit();
+    out.fragments.shrink_to_fit();
     out.sources.shrink_to_fit();
-    out.groups.shrink_to_fit();
-    out.rows.shrink_to_fit();
     out.triangles.shrink_to_fit();
 }
