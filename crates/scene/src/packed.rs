@@ -1,5 +1,5 @@
 //! Many polygons held flat: every polygon's vertices in one vector, their intensities in
-//! another and their depths in a third, with where each polygon starts.
+//! another and their depths in a third, with where each polygon ends.
 //!
 //! A [`Polygon`] is 72 bytes of its own and a heap block for its vertices, one for its
 //! list of intensity vectors and one per vertex (and one for its depths): a grey
@@ -16,14 +16,16 @@ use std::ops::Range;
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct PackedPolygons {
     channels: usize,
-    /// Polygon `k`'s vertices are `vertices[starts[k] .. starts[k + 1]]`.
-    starts: Vec<u32>,
+    /// Polygon `k`'s vertices are `vertices[ends[k - 1] .. ends[k]]` (from 0 for the
+    /// first).
+    ends: Vec<u32>,
     vertices: Vec<[f64; 2]>,
     /// `channels` values per vertex.
     intensity: Vec<f64>,
-    /// Polygon `k`'s depths, when `depth_starts[k] < depth_starts[k + 1]`: as many as it
+    /// Polygon `k`'s depths, `depth[depth_ends[k - 1] .. depth_ends[k]]`: none, or as
+    /// many as it has vertices.
     /// has vertices.
-    depth_starts: Vec<u32>,
+    depth_ends: Vec<u32>,
     depth: Vec<f64>,
 }
 
@@ -52,11 +54,7 @@ impl PackedPolygons {
     pub fn new(channels: usize) -> Self {
         PackedPolygons {
             channels,
-            starts: vec![0],
-            vertices: Vec::new(),
-            intensity: Vec::new(),
-            depth_starts: vec![0],
-            depth: Vec::new(),
+            ..PackedPolygons::default()
         }
     }
 
@@ -67,7 +65,7 @@ impl PackedPolygons {
 
     /// Polygons held.
     pub fn len(&self) -> usize {
-        self.starts.len().saturating_sub(1)
+        self.ends.len()
     }
 
     /// Whether it holds none.
@@ -82,7 +80,7 @@ impl PackedPolygons {
         let depths = p.depth.as_ref().map_or(0, Vec::len);
         if p.intensity.len() != n
             || p.intensity.iter().any(|i| i.len() != self.channels)
-            || (depths != 0 && depths != n)
+            || (p.depth.is_some() && depths != n)
         {
             return Err(PackError::Shape {
                 vertices: n,
@@ -93,11 +91,6 @@ impl PackedPolygons {
         }
         let end = u32::try_from(self.vertices.len() + n).map_err(|_| PackError::Full)?;
         let depth_end = u32::try_from(self.depth.len() + depths).map_err(|_| PackError::Full)?;
-        if self.starts.is_empty() {
-            // a store made by `Default`
-            self.starts.push(0);
-            self.depth_starts.push(0);
-        }
         self.vertices.extend_from_slice(&p.vertices);
         for i in &p.intensity {
             self.intensity.extend_from_slice(i);
@@ -105,34 +98,14 @@ impl PackedPolygons {
         if let Some(d) = &p.depth {
             self.depth.extend_from_slice(d);
         }
-        self.starts.push(end);
-        self.depth_starts.push(depth_end);
+        self.ends.push(end);
+        self.depth_ends.push(depth_end);
         Ok(())
     }
 
     /// Polygon `k`, as it was pushed; `None` past the end.
     pub fn get(&self, k: usize) -> Option<Polygon> {
-        let (a, b) = (
-            *self.starts.get(k)? as usize,
-            *self.starts.get(k + 1)? as usize,
-        );
-        let (da, db) = (
-            self.depth_starts[k] as usize,
-            self.depth_starts[k + 1] as usize,
-        );
-        let intensity = if self.channels == 0 {
-            vec![Vec::new(); b - a]
-        } else {
-            self.intensity[a * self.channels..b * self.channels]
-                .chunks_exact(self.channels)
-                .map(<[f64]>::to_vec)
-                .collect()
-        };
-        Some(Polygon {
-            vertices: self.vertices[a..b].to_vec(),
-            intensity,
-            depth: (db > da).then(|| self.depth[da..db].to_vec()),
-        })
+        self.unpack(k..k.saturating_add(1)).pop()
     }
 
     /// Polygons `range`, unpacked (the part of `range` past the end left out).
@@ -152,11 +125,8 @@ impl PackedPolygons {
         let end = range.end.min(self.len());
         let start = range.start.min(end);
         for (slot, k) in (first..).zip(start..end) {
-            let (a, b) = (self.starts[k] as usize, self.starts[k + 1] as usize);
-            let (da, db) = (
-                self.depth_starts[k] as usize,
-                self.depth_starts[k + 1] as usize,
-            );
+            let (a, b) = span(&self.ends, k);
+            let (da, db) = span(&self.depth_ends, k);
             if slot == out.len() {
                 out.push(Polygon::new(Vec::new(), Vec::new()));
             }
@@ -181,32 +151,38 @@ impl PackedPolygons {
 
     /// Drops the spare capacity of its vectors.
     pub fn shrink_to_fit(&mut self) {
-        self.starts.shrink_to_fit();
+        self.ends.shrink_to_fit();
         self.vertices.shrink_to_fit();
         self.intensity.shrink_to_fit();
-        self.depth_starts.shrink_to_fit();
+        self.depth_ends.shrink_to_fit();
         self.depth.shrink_to_fit();
     }
 
     /// The bytes its vectors hold and do not use (their capacity past their length).
     pub fn spare_bytes(&self) -> usize {
         use std::mem::size_of;
-        (self.starts.capacity() - self.starts.len()) * size_of::<u32>()
+        (self.ends.capacity() - self.ends.len()) * size_of::<u32>()
             + (self.vertices.capacity() - self.vertices.len()) * size_of::<[f64; 2]>()
             + (self.intensity.capacity() - self.intensity.len()) * size_of::<f64>()
-            + (self.depth_starts.capacity() - self.depth_starts.len()) * size_of::<u32>()
+            + (self.depth_ends.capacity() - self.depth_ends.len()) * size_of::<u32>()
             + (self.depth.capacity() - self.depth.len()) * size_of::<f64>()
     }
 
     /// The bytes its vectors hold (their capacity).
     pub fn heap_bytes(&self) -> usize {
         use std::mem::size_of;
-        self.starts.capacity() * size_of::<u32>()
+        self.ends.capacity() * size_of::<u32>()
             + self.vertices.capacity() * size_of::<[f64; 2]>()
             + self.intensity.capacity() * size_of::<f64>()
-            + self.depth_starts.capacity() * size_of::<u32>()
+            + self.depth_ends.capacity() * size_of::<u32>()
             + self.depth.capacity() * size_of::<f64>()
     }
+}
+
+/// Where item `k` of a packed vector lies, from the vector of the items' ends.
+fn span(ends: &[u32], k: usize) -> (usize, usize) {
+    let start = if k == 0 { 0 } else { ends[k - 1] as usize };
+    (start, ends[k] as usize)
 }
 
 #[cfg(test)]
@@ -304,6 +280,9 @@ mod tests {
         // two depths for four vertices
         let shallow = good.clone().with_depth(vec![1.0, 2.0]);
         assert!(packed.push(&shallow).is_err());
+        // a depth list with no depths (it would come back without one)
+        let empty = good.clone().with_depth(Vec::new());
+        assert!(packed.push(&empty).is_err());
         assert_eq!(packed, before);
         assert_eq!(packed.get(0), Some(good));
     }
@@ -322,8 +301,8 @@ mod tests {
         packed.shrink_to_fit();
         assert_eq!(packed.len(), 1000);
         assert_eq!(packed.get(999).as_ref(), Some(&quad));
-        // 4 × (16 + 8) bytes of vertex and intensity and 8 of starts per polygon
-        assert_eq!(packed.heap_bytes(), 1001 * 4 * 2 + 4000 * 24);
+        // 4 × (16 + 8) bytes of vertex and intensity and 8 of ends per polygon
+        assert_eq!(packed.heap_bytes(), 1000 * 4 * 2 + 4000 * 24);
         assert_eq!(packed.spare_bytes(), 0);
         packed.push(&quad).unwrap();
         assert!(packed.spare_bytes() > 0);

@@ -124,8 +124,6 @@ pub struct MergedFrame<'a> {
     /// The image's size and channels (its polygons are not read: `fragments` are).
     screen: &'a ScreenScene,
     fragments: &'a Fragments,
-    /// For each polygon: its patch (`mesh << 32 | patch`).
-    groups: &'a [u64],
     value: BoxValue,
     tolerance: f64,
     /// Phong: the triangles, each fragment's source, the lighting.
@@ -152,7 +150,6 @@ impl<'a> MergedFrame<'a> {
         MergedFrame {
             screen,
             fragments,
-            groups: &fragments.groups,
             value,
             tolerance,
             phong,
@@ -320,7 +317,7 @@ impl MergedFrame<'_> {
             }
             match visit {
                 SliceVisit::Fill(slice, t) => {
-                    let group = self.groups[base + t.polygon as usize];
+                    let group = self.fragments.groups[base + t.polygon as usize];
                     let k = match slots[..active].iter().position(|s| s.group == group) {
                         Some(k) => k,
                         None => {
