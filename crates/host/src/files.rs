@@ -2,8 +2,8 @@
 //!
 //! Every output of a command goes through [`write_atomic`]:
 //!
-//! - A **regular file** (or a new path) is written to a hidden sibling (`.NAME.partial`)
-//!   and renamed over the path only when the whole command succeeded: inside
+//! - A **regular file** (or a new path) is written to a hidden sibling of a new, unique
+//!   name (`.NAME.XXXXXX.partial`, created exclusively: see [`PartialFile`]) and renamed over the path only when the whole command succeeded: inside
 //!   [`transaction`] (which `cwisim`'s dispatch wraps around every command) the renames
 //!   wait for the command's end, so the outputs of one command are all written or none is
 //!   (`render -o old.png --npy ro/x.npy` keeps `old.png` when the NumPy file cannot be
@@ -40,42 +40,69 @@ fn unregister_partial(path: &Path) {
     }
 }
 
-/// A hidden file beside an output that holds bytes before they are final (the partial of
-/// [`write_atomic`], the scanline records of `--stats-json`). Registered so that an
-/// interruption removes it; removed when dropped unless [`Self::persist`] renamed it.
+/// A hidden file that holds an output's bytes before they are final (the partial of
+/// [`write_atomic`], the scanline records of `--stats-json`). Its name is new and unique
+/// (`.NAME.XXXXXX.partial`, through the `tempfile` crate), and it is created exclusively
+/// (`O_CREAT | O_EXCL`): a file, link or FIFO already there under any name is never
+/// followed, written or removed, and two processes writing one output each have their own.
+/// Registered so that an interruption removes it; removed when dropped unless
+/// [`Self::persist`] renamed it.
 pub struct PartialFile {
-    path: PathBuf,
-    done: bool,
+    path: Option<tempfile::TempPath>,
+    registered: PathBuf,
 }
 
 impl PartialFile {
-    /// Creates (or truncates) `path`, registered for removal.
-    pub fn create(path: PathBuf) -> io::Result<(PartialFile, File)> {
+    /// Creates a new file in `dir` named `PREFIX` + six random characters + `SUFFIX`,
+    /// exclusively, with the mode a new file gets (0666 less the umask), registered for
+    /// removal.
+    pub fn create_in(
+        dir: &Path,
+        prefix: &std::ffi::OsStr,
+        suffix: &str,
+    ) -> io::Result<(PartialFile, File)> {
+        let named = tempfile::Builder::new()
+            .prefix(prefix)
+            .suffix(suffix)
+            .rand_bytes(6)
+            .make_in(dir, |path| {
+                let mut options = OpenOptions::new();
+                options.write(true).create_new(true);
+                #[cfg(unix)]
+                std::os::unix::fs::OpenOptionsExt::mode(&mut options, 0o666);
+                options.open(path)
+            })?;
+        let (file, path) = named.into_parts();
         register_partial(&path);
-        let partial = PartialFile { path, done: false };
-        let file = File::create(&partial.path)?;
-        Ok((partial, file))
+        let registered = path.to_path_buf();
+        Ok((
+            PartialFile {
+                path: Some(path),
+                registered,
+            },
+            file,
+        ))
     }
 
     /// Its path.
     pub fn path(&self) -> &Path {
-        &self.path
+        &self.registered
     }
 
-    /// Renames it to `target`; on failure it is still removed when dropped.
+    /// Renames it to `target`; on failure it is removed.
     fn persist(mut self, target: &Path) -> io::Result<()> {
-        std::fs::rename(&self.path, target)?;
-        self.done = true;
-        unregister_partial(&self.path);
-        Ok(())
+        let path = self.path.take().expect("persisted once");
+        let result = path.persist(target).map_err(|e| e.error);
+        unregister_partial(&self.registered);
+        result
     }
 }
 
 impl Drop for PartialFile {
     fn drop(&mut self) {
-        if !self.done {
-            let _ = std::fs::remove_file(&self.path);
-            unregister_partial(&self.path);
+        if let Some(path) = self.path.take() {
+            drop(path); // removes the file
+            unregister_partial(&self.registered);
         }
     }
 }
@@ -193,7 +220,7 @@ pub fn is_special(path: &Path) -> bool {
 
 /// Writes `path` through `fill`, all or nothing (see the module's documentation).
 ///
-/// A regular file's bytes go to a hidden sibling (`.NAME.partial`), flushed and synced,
+/// A regular file's bytes go to a hidden sibling (a [`PartialFile`]), flushed and synced,
 /// then renamed over the path: at once outside a [`transaction`], at its successful end
 /// inside one. On any error the partial is removed and the old file is untouched. A
 /// symbolic link is followed; a device or FIFO is written in place.
@@ -211,8 +238,9 @@ where
         return out.flush().map_err(|e| CliError::write(path, e));
     }
     let target = resolve_output(path)?;
+    let (dir, prefix) = partial_place(&target, path)?;
     let (partial, file) =
-        PartialFile::create(partial_path(&target, path)?).map_err(|e| CliError::write(path, e))?;
+        PartialFile::create_in(&dir, &prefix, ".partial").map_err(|e| CliError::write(path, e))?;
     let mut out = BufWriter::new(file);
     fill(&mut out)?;
     let file = out
@@ -235,19 +263,24 @@ where
     }
 }
 
-/// The temporary sibling `write_atomic` fills before renaming it to `target` (`shown` is
-/// the path as the user gave it, for messages).
-fn partial_path(target: &Path, shown: &Path) -> Result<PathBuf, CliError> {
+/// Where `write_atomic` makes the partial file it renames to `target`: `target`'s
+/// directory, and the name's prefix `.NAME.` (`shown` is the path as the user gave it,
+/// for messages).
+fn partial_place(target: &Path, shown: &Path) -> Result<(PathBuf, std::ffi::OsString), CliError> {
     let name = target.file_name().ok_or_else(|| {
         CliError::write(
             shown,
             io::Error::new(io::ErrorKind::InvalidInput, "the output path names no file"),
         )
     })?;
-    let mut tmp = std::ffi::OsString::from(".");
-    tmp.push(name);
-    tmp.push(".partial");
-    Ok(target.with_file_name(tmp))
+    let mut prefix = std::ffi::OsString::from(".");
+    prefix.push(name);
+    prefix.push(".");
+    let dir = match target.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    Ok((dir, prefix))
 }
 
 /// Checks, before any work, that `path` can be written: its directory exists and takes a
@@ -258,11 +291,9 @@ pub fn check_writable(path: &Path) -> Result<(), CliError> {
         return Ok(());
     }
     let target = resolve_output(path)?;
-    let probe = partial_path(&target, path)?;
-    let mut name = probe.file_name().unwrap_or_default().to_os_string();
-    name.push(format!(".probe-{}", std::process::id()));
-    let probe = probe.with_file_name(name);
-    let (partial, file) = PartialFile::create(probe).map_err(|e| CliError::write(path, e))?;
+    let (dir, prefix) = partial_place(&target, path)?;
+    let (partial, file) =
+        PartialFile::create_in(&dir, &prefix, ".probe").map_err(|e| CliError::write(path, e))?;
     drop(file);
     drop(partial);
     Ok(())
@@ -289,40 +320,90 @@ fn resolve(p: &Path) -> PathBuf {
     }
 }
 
-/// Refuses outputs that would overwrite the input or one another, and outputs that cannot
-/// be written at all ([`check_writable`]), before any work is done. `input` is what is read
-/// and what to call it in the message (`"trace being read"`, `"scene"`); `outputs` pairs
-/// each option (`-o`, `--npy`, …) with the path it was given, if any.
-pub fn check_outputs(
-    input: Option<(&str, &Path)>,
-    outputs: &[(&str, Option<&Path>)],
-) -> Result<(), CliError> {
-    let given: Vec<(&str, &Path)> = outputs
-        .iter()
-        .filter_map(|(f, p)| p.map(|p| (*f, p)))
-        .collect();
-    for (i, (flag, path)) in given.iter().enumerate() {
-        if let Some((noun, input)) = input {
-            if same_file(path, input) {
-                return Err(CliError::Usage(format!(
-                    "{flag} {} would overwrite the {noun}",
-                    path.display()
-                )));
+/// What a command reads and writes, checked once before any work by [`Io::check`]: no
+/// output may be an input (a trace, a scene, the files a scene names, a machine file, a
+/// part to merge), no two outputs one file, and every output writable. Every command
+/// builds one; the checks are this one function's, not each command's.
+#[derive(Default)]
+pub struct Io<'a> {
+    inputs: Vec<(String, PathBuf)>,
+    outputs: Vec<(&'a str, &'a Path)>,
+}
+
+impl<'a> Io<'a> {
+    /// Nothing read or written yet.
+    pub fn new() -> Io<'a> {
+        Io::default()
+    }
+
+    /// An input file, called `noun` in the message (`"trace being read"`), if given.
+    pub fn input(mut self, noun: &str, path: Option<&Path>) -> Self {
+        if let Some(p) = path {
+            self.inputs.push((noun.to_string(), p.to_path_buf()));
+        }
+        self
+    }
+
+    /// A trace or scene argument (a file, or an embedded scene's name): the file, when it
+    /// exists, and when it is a scene file every file it names (OBJ meshes, texture
+    /// images: [`cwisim_world::referenced_files`]).
+    pub fn source(mut self, noun: &str, arg: Option<&Path>) -> Self {
+        let Some(path) = arg.filter(|p| p.exists()) else {
+            return self;
+        };
+        self.inputs.push((noun.to_string(), path.to_path_buf()));
+        if !path.is_file() || cwisim_isa::Encoding::from_path(path).is_ok() {
+            return self; // a trace, or not a regular file: it names no file
+        }
+        if let Ok(text) = cwisim_scene::read_scene_text(path) {
+            for (field, file) in cwisim_world::referenced_files(&text, path.parent()) {
+                self.inputs
+                    .push((format!("file the {noun} names at {field}"), file));
             }
         }
-        for (other, other_path) in &given[..i] {
-            if same_file(path, other_path) && !is_special(path) {
-                return Err(CliError::Usage(format!(
-                    "{other} and {flag} both name {}; give each output its own file",
-                    path.display()
-                )));
+        self
+    }
+
+    /// The `--machine` file, if given.
+    pub fn machine(self, machine: &crate::commands::MachineArgs) -> Self {
+        self.input("machine file", machine.machine.as_deref())
+    }
+
+    /// An output, by the option that names it (`-o`, `--npy`), if given.
+    pub fn output(mut self, flag: &'a str, path: Option<&'a Path>) -> Self {
+        if let Some(p) = path {
+            self.outputs.push((flag, p));
+        }
+        self
+    }
+
+    /// Refuses (a usage error, exit 2) an output that is an input or another output, and
+    /// an output that cannot be written at all ([`check_writable`]). A device or FIFO may
+    /// be named twice (`/dev/null`).
+    pub fn check(&self) -> Result<(), CliError> {
+        for (i, (flag, path)) in self.outputs.iter().enumerate() {
+            for (noun, input) in &self.inputs {
+                if same_file(path, input) {
+                    return Err(CliError::Usage(format!(
+                        "{flag} {} would overwrite the {noun}",
+                        path.display()
+                    )));
+                }
+            }
+            for (other, other_path) in &self.outputs[..i] {
+                if same_file(path, other_path) && !is_special(path) {
+                    return Err(CliError::Usage(format!(
+                        "{other} and {flag} both name {}; give each output its own file",
+                        path.display()
+                    )));
+                }
             }
         }
+        for (_, path) in &self.outputs {
+            check_writable(path)?;
+        }
+        Ok(())
     }
-    for (_, path) in &given {
-        check_writable(path)?;
-    }
-    Ok(())
 }
 
 #[cfg(test)]

@@ -89,7 +89,7 @@ impl StatsReport<'_> {
 }
 
 /// The per-scanline records of `--stats-json`, written to a hidden file beside the output
-/// (`.NAME.lines.partial`) as each scanline completes, in their final form: pretty JSON
+/// (`.NAME.XXXXXX.lines.partial`, a [`crate::files::PartialFile`]) as each scanline completes, in their final form: pretty JSON
 /// objects indented as the elements of `stats.lines`, separated by `,\n`. Removed when
 /// dropped.
 pub struct LineSpill {
@@ -110,20 +110,22 @@ impl LineSpill {
         let name = output.file_name().ok_or_else(|| {
             io::Error::new(io::ErrorKind::InvalidInput, "the output path names no file")
         })?;
-        let mut hidden = std::ffi::OsString::from(".");
-        hidden.push(name);
-        hidden.push(".lines.partial");
-        let path = if crate::files::is_special(output) {
+        let mut prefix = std::ffi::OsString::from(".");
+        prefix.push(name);
+        prefix.push(".");
+        let dir = if crate::files::is_special(output) {
             // beside a device or FIFO there may be no room for a file: the temporary
             // directory instead
-            hidden.push(format!(".{}", std::process::id()));
-            std::env::temp_dir().join(hidden)
+            std::env::temp_dir()
         } else {
             let target =
                 crate::files::resolve_output(output).map_err(|e| io::Error::other(e.one_line()))?;
-            target.with_file_name(hidden)
+            match target.parent() {
+                Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+                _ => std::path::PathBuf::from("."),
+            }
         };
-        let (file, out) = crate::files::PartialFile::create(path)?;
+        let (file, out) = crate::files::PartialFile::create_in(&dir, &prefix, ".lines.partial")?;
         Ok(LineSpill {
             file,
             out: Some(BufWriter::new(out)),

@@ -257,7 +257,9 @@ fn convert_refuses_to_overwrite_its_input() {
         let (_, stderr) = text(&out);
         assert_eq!(out.status.code(), Some(2));
         assert!(
-            stderr.starts_with("error: IN and OUT are the same file"),
+            stderr.starts_with(&format!(
+                "error: OUT {out_name} would overwrite the trace being read (IN)"
+            )),
             "{stderr}"
         );
     }

@@ -224,3 +224,133 @@ fn a_full_standard_output_is_a_write_failure() {
         );
     }
 }
+
+/// A trace of `lines` scanlines over `width` processors, each line a ramp from `start`: big
+/// enough that writing its `.npy` takes a while (the window in which two writers meet).
+fn ramp_trace(width: u32, lines: u32, start: f64) -> String {
+    let mut t = format!("cwisim-trace version=1 width={width} lines={lines} channels=1\n");
+    for k in 0..lines {
+        t.push_str(&format!(
+            "Eval2 0 {width} {} {}\nRefresh\n",
+            start + f64::from(k) * 1e-4,
+            1.0 / f64::from(width)
+        ));
+    }
+    t
+}
+
+#[test]
+fn a_planted_partial_name_is_never_followed_written_or_removed() {
+    // what an older cwisim wrote to: `.NAME.partial` beside the output. A link there
+    // (symbolic or hard) must not carry the output's bytes into another file, a FIFO there
+    // must not block the run, and none of them is removed: they are not cwisim's.
+    let dir = scratch("outputs-planted-partial");
+    std::fs::write(dir.join("t.cwt"), SMALL_TRACE).unwrap();
+    std::fs::write(dir.join("victim.txt"), b"precious").unwrap();
+    std::fs::write(dir.join("hard-victim.txt"), b"also precious").unwrap();
+    symlink("victim.txt", dir.join(".sym.png.partial")).unwrap();
+    std::fs::hard_link(dir.join("hard-victim.txt"), dir.join(".hard.png.partial")).unwrap();
+    let made = Command::new("mkfifo")
+        .arg(dir.join(".fifo.png.partial"))
+        .status()
+        .expect("mkfifo");
+    assert!(made.success());
+    for out_name in ["sym.png", "hard.png", "fifo.png"] {
+        // a run that blocked on the FIFO would never end: give it a minute
+        let mut child = Command::new(env!("CARGO_BIN_EXE_cwisim"))
+            .args(["run", "t.cwt", "-o", out_name])
+            .current_dir(&dir)
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("spawn");
+        let start = Instant::now();
+        let status = loop {
+            if let Some(status) = child.try_wait().unwrap() {
+                break status;
+            }
+            if start.elapsed() > Duration::from_secs(60) {
+                let _ = child.kill();
+                panic!("`run -o {out_name}` blocked on a planted partial name");
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        };
+        assert!(status.success(), "run -o {out_name}");
+        let meta = std::fs::symlink_metadata(dir.join(out_name)).unwrap();
+        assert!(
+            meta.file_type().is_file(),
+            "{out_name} is not a regular file"
+        );
+        assert!(read(dir.join(out_name)).starts_with(PNG_MAGIC));
+    }
+    assert_eq!(read(dir.join("victim.txt")), b"precious");
+    assert_eq!(read(dir.join("hard-victim.txt")), b"also precious");
+    // an output gets the mode of any new file (0666 less the umask), not a temporary's 0600
+    use std::os::unix::fs::PermissionsExt;
+    let mode = |f: &str| std::fs::metadata(dir.join(f)).unwrap().permissions().mode() & 0o777;
+    assert_eq!(mode("sym.png"), mode("victim.txt"));
+    let planted = std::fs::symlink_metadata(dir.join(".sym.png.partial")).unwrap();
+    assert!(planted.file_type().is_symlink());
+    let fifo = std::fs::symlink_metadata(dir.join(".fifo.png.partial")).unwrap();
+    assert!(fifo.file_type().is_fifo());
+    assert!(dir.join(".hard.png.partial").exists());
+    assert_eq!(
+        names(&dir),
+        [
+            ".fifo.png.partial",
+            ".hard.png.partial",
+            ".sym.png.partial",
+            "fifo.png",
+            "hard-victim.txt",
+            "hard.png",
+            "sym.png",
+            "t.cwt",
+            "victim.txt"
+        ]
+    );
+}
+
+#[test]
+fn two_writers_of_one_output_leave_one_whole_file_of_one_run() {
+    let dir = scratch("outputs-two-writers");
+    std::fs::write(dir.join("a.cwt"), ramp_trace(1024, 192, 0.0)).unwrap();
+    std::fs::write(dir.join("b.cwt"), ramp_trace(1024, 192, 0.5)).unwrap();
+    // each alone, for reference
+    for t in ["a", "b"] {
+        let out = cwisim(
+            &dir,
+            &["run", &format!("{t}.cwt"), "--npy", &format!("{t}.npy")],
+        );
+        assert!(out.status.success(), "{:?}", text(&out));
+    }
+    let (a, b) = (read(dir.join("a.npy")), read(dir.join("b.npy")));
+    assert_ne!(a, b);
+    for round in 0..8 {
+        let children: Vec<_> = ["a.cwt", "b.cwt"]
+            .iter()
+            .map(|t| {
+                Command::new(env!("CARGO_BIN_EXE_cwisim"))
+                    .args(["run", t, "--npy", "out.npy"])
+                    .current_dir(&dir)
+                    .stdout(Stdio::null())
+                    .stderr(Stdio::null())
+                    .spawn()
+                    .expect("spawn")
+            })
+            .collect();
+        for mut c in children {
+            assert!(c.wait().unwrap().success(), "round {round}");
+        }
+        let got = read(dir.join("out.npy"));
+        assert!(
+            got == a || got == b,
+            "round {round}: out.npy is neither run's whole output ({} bytes)",
+            got.len()
+        );
+    }
+    assert_eq!(
+        names(&dir),
+        ["a.cwt", "a.npy", "b.cwt", "b.npy", "out.npy"],
+        "a partial file was left behind"
+    );
+}

@@ -156,6 +156,29 @@ pub fn parse_any(text: &str, base: Option<&Path>) -> Result<AnyScene, SceneError
     }
 }
 
+/// The files a scene's text names besides itself — its meshes' OBJ files
+/// (`meshes[K].obj`) and its textures' images (`meshes[K].material.texture.image`) — each
+/// with the JSON path that names it, as the loader reads them (relative to `base`). A
+/// command checks its outputs against these before any work (an output may not be an
+/// input). A text that is not a world scene, or not a readable one, names none: reading
+/// it says why.
+pub fn referenced_files(text: &str, base: Option<&Path>) -> Vec<(String, std::path::PathBuf)> {
+    let Ok(spec) = serde_json::from_str::<scene::WorldSpec>(text) else {
+        return Vec::new();
+    };
+    let at = |name: &str| base.map_or_else(|| Path::new(name).to_path_buf(), |b| b.join(name));
+    let mut files = Vec::new();
+    for (k, m) in spec.meshes.iter().enumerate() {
+        if let Some(obj) = &m.obj {
+            files.push((format!("meshes[{k}].obj"), at(obj)));
+        }
+        if let Some(image) = m.material.texture.as_ref().and_then(|t| t.image.as_ref()) {
+            files.push((format!("meshes[{k}].material.texture.image"), at(image)));
+        }
+    }
+    files
+}
+
 /// Reads a scene file of any kind; errors name the file.
 pub fn load_any(path: &Path) -> Result<AnyScene, SceneError> {
     let text = cwisim_scene::read_scene_text(path)?;
@@ -270,4 +293,36 @@ pub fn to_screen(
         project,
         visibility,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn referenced_files_lists_objs_and_texture_images_relative_to_base() {
+        let text = r#"{ "kind": "world", "width": 8, "height": 8, "channels": 1,
+            "camera": { "eye": [0, 0, 5], "target": [0, 0, 0], "up": [0, 1, 0], "fov_y": 30 },
+            "ambient": 0.2, "lights": [],
+            "meshes": [
+              { "material": { "k_a": 1, "k_d": 0, "k_s": 0, "n": 1,
+                              "texture": { "image": "t.png" } }, "obj": "a.obj" },
+              { "material": { "k_a": 1, "k_d": 0, "k_s": 0, "n": 1,
+                              "texture": { "checker": { "squares": [2, 2] } } },
+                "obj": "b.obj" }
+            ] }"#;
+        let files = referenced_files(text, Some(Path::new("dir")));
+        let expect = [
+            ("meshes[0].obj", "dir/a.obj"),
+            ("meshes[0].material.texture.image", "dir/t.png"),
+            ("meshes[1].obj", "dir/b.obj"),
+        ];
+        assert_eq!(files.len(), expect.len(), "{files:?}");
+        for ((field, path), (f, p)) in files.iter().zip(expect) {
+            assert_eq!((field.as_str(), path.as_path()), (f, Path::new(p)));
+        }
+        // not a world scene, or not one at all: none
+        assert!(referenced_files("{\"kind\": \"screen\"}", None).is_empty());
+        assert!(referenced_files("not json", None).is_empty());
+    }
 }

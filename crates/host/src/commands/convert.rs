@@ -1,7 +1,7 @@
 //! `cwisim convert`: re-encode a trace, streaming, one instruction at a time.
 
 use crate::error::CliError;
-use crate::files::{same_file, write_atomic};
+use crate::files::{write_atomic, Io};
 use clap::Args;
 use cwisim_isa::{Encoding, FileReader, TraceRead};
 use std::path::{Path, PathBuf};
@@ -52,12 +52,10 @@ pub fn run(args: &ConvertArgs) -> Result<u64, CliError> {
 pub fn convert(input: &Path, output: &Path) -> Result<u64, CliError> {
     Encoding::from_path(input)?;
     let out_encoding = Encoding::from_path(output)?;
-    if same_file(input, output) {
-        return Err(CliError::Usage(format!(
-            "IN and OUT are the same file ({}); convert into a new file",
-            output.display()
-        )));
-    }
+    Io::new()
+        .input("trace being read (IN)", Some(input))
+        .output("OUT", Some(output))
+        .check()?;
     let mut reader = FileReader::open(input)?;
     let header = *reader.header();
     let mut count = 0;

@@ -79,6 +79,11 @@ pub fn run(args: &DiffArgs, stdout: &mut dyn Write) -> Result<bool, CliError> {
     if let Some(p) = &args.image {
         crate::cost_args::check_extension("--image", p, "png")?;
     }
+    crate::files::Io::new()
+        .source("side A", Some(&args.a))
+        .source("side B", Some(&args.b))
+        .output("--image", args.image.as_deref())
+        .check()?;
     if outputs {
         let a = load_output(&args.a, args)?;
         let b = load_output(&args.b, args)?;

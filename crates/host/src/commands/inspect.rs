@@ -8,7 +8,7 @@ use super::MachineArgs;
 use crate::cost_args::{check_extension, display_name};
 use crate::draw::DrawArgs;
 use crate::error::CliError;
-use crate::files::{check_outputs, write_atomic};
+use crate::files::{write_atomic, Io};
 use crate::input::InputKind;
 use crate::progress::Stage;
 use crate::range::{parse_range, Range};
@@ -494,19 +494,13 @@ pub fn run(args: &InspectArgs, stdout: &mut dyn Write, progress: bool) -> Result
         InputKind::of(&b.input)?;
         crate::input::drawing_applies(&b.draw, &[Some(&b.input)])?;
     }
-    let output = [("-o", Some(args.output.as_path()))];
-    check_outputs(
-        args.input
-            .exists()
-            .then_some(("the input", args.input.as_path())),
-        &output,
-    )?;
+    let mut io = Io::new()
+        .source("input", Some(&args.input))
+        .machine(&args.machine);
     if let Some(b) = &against {
-        check_outputs(
-            b.input.exists().then_some(("input B", b.input.as_path())),
-            &output,
-        )?;
+        io = io.source("input B", Some(&b.input)).machine(&b.machine);
     }
+    io.output("-o", Some(&args.output)).check()?;
 
     let stage = Stage::new(progress, "inspect: preparing the input");
     let threads = cwisim_scene::budget::check_threads(args.threads).map_err(CliError::Usage)?;

@@ -6,7 +6,7 @@ use super::MachineArgs;
 use crate::cost_args::check_extension;
 use crate::draw::ShadowsArg;
 use crate::error::CliError;
-use crate::files::{check_outputs, write_atomic};
+use crate::files::{write_atomic, Io};
 use crate::output::{write_png, write_rgb_png};
 use crate::progress::Progress;
 use clap::Args;
@@ -133,15 +133,14 @@ fn default_plot(args: &RefineArgs) -> Result<Option<PathBuf>, CliError> {
 /// Runs `cwisim refine`.
 pub fn run(args: &RefineArgs, stdout: &mut dyn Write, progress: bool) -> Result<(), CliError> {
     let plot = default_plot(args)?;
-    check_outputs(
-        None,
-        &[
-            ("--trace", args.trace.as_deref()),
-            ("--csv", args.csv.as_deref()),
-            ("--plot", plot.as_deref()),
-            ("--ids", args.ids.as_deref()),
-        ],
-    )?;
+    Io::new()
+        .source("scene", args.scene.as_deref())
+        .machine(&args.machine)
+        .output("--trace", args.trace.as_deref())
+        .output("--csv", args.csv.as_deref())
+        .output("--plot", plot.as_deref())
+        .output("--ids", args.ids.as_deref())
+        .check()?;
     let ids_npy = match &args.ids {
         Some(p) if p.extension().is_some_and(|e| e.eq_ignore_ascii_case("npy")) => Some(true),
         Some(p) => check_extension("--ids", p, "png").map(|()| Some(false))?,

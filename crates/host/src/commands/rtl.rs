@@ -163,6 +163,12 @@ fn work_dir(given: Option<&Path>, what: &str) -> Result<(PathBuf, bool), CliErro
 /// Runs `cwisim rtl`.
 pub fn run(args: &RtlArgs, stdout: &mut dyn Write, progress: bool) -> Result<(), CliError> {
     crate::input::drawing_applies(&args.draw, &[args.for_input.as_deref()])?;
+    crate::files::Io::new()
+        .source("--for input", args.for_input.as_deref())
+        .machine(&args.machine)
+        .output("-o", Some(&args.output))
+        .output("--testbench", args.testbench.as_deref())
+        .check()?;
     let machine = args.machine.load()?;
     let out = stdout;
     let say = |out: &mut dyn Write, label: &str, value: String| {

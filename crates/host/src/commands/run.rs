@@ -4,7 +4,7 @@ use super::{ImageArgs, MachineArgs};
 use crate::cost_args::{display_name, CostArgs};
 use crate::demo;
 use crate::error::CliError;
-use crate::files::{check_outputs, write_atomic};
+use crate::files::{write_atomic, Io};
 use crate::progress::Progress;
 use crate::range::Range;
 use crate::report::{timing_name, unrefreshed_warning, write_summary, LineSpill, StatsReport};
@@ -359,14 +359,13 @@ impl KeptRecords {
 /// Refuses outputs that would overwrite the trace or each other.
 fn check_paths(args: &RunArgs) -> Result<(), CliError> {
     let [cost_image, cost_npy] = args.cost.outputs();
-    check_outputs(
-        args.trace.as_deref().map(|t| ("trace being read", t)),
-        &[
-            ("-o", args.image.output.as_deref()),
-            ("--npy", args.image.npy.as_deref()),
-            ("--stats-json", args.stats_json.as_deref()),
-            (cost_image.0, cost_image.1.map(PathBuf::as_path)),
-            (cost_npy.0, cost_npy.1.map(PathBuf::as_path)),
-        ],
-    )
+    Io::new()
+        .input("trace being read", args.trace.as_deref())
+        .machine(&args.machine)
+        .output("-o", args.image.output.as_deref())
+        .output("--npy", args.image.npy.as_deref())
+        .output("--stats-json", args.stats_json.as_deref())
+        .output(cost_image.0, cost_image.1.map(PathBuf::as_path))
+        .output(cost_npy.0, cost_npy.1.map(PathBuf::as_path))
+        .check()
 }

@@ -5,9 +5,9 @@
 use super::{ImageArgs, MachineArgs};
 use crate::commands::run::TimingArg;
 use crate::cost_args::{display_name, CostArgs};
-use crate::draw::{DrawArgs, Drawn};
+use crate::draw::DrawArgs;
 use crate::error::CliError;
-use crate::files::{check_outputs, same_file, write_atomic};
+use crate::files::{write_atomic, Io};
 use crate::progress::{Progress, Stage};
 use crate::report::{timing_name, write_summary, StatsReport};
 use crate::summary::{write_render_summary, StageTimes};
@@ -100,11 +100,10 @@ fn encode(renderer: &dyn Renderer, path: &Path) -> Result<Vec<u8>, CliError> {
 
 /// Runs `cwisim emit`.
 pub fn run_emit(args: &EmitArgs) -> Result<(), CliError> {
-    if same_file(&args.scene, &args.output) {
-        return Err(CliError::Usage(
-            "the output would overwrite the scene".into(),
-        ));
-    }
+    Io::new()
+        .source("scene", Some(&args.scene))
+        .output("-o", Some(&args.output))
+        .check()?;
     let drawn = args.draw.draw(Some(&args.scene))?;
     let bytes = encode(&*drawn.renderer, &args.output)?;
     write_atomic(&args.output, |w| {
@@ -114,12 +113,16 @@ pub fn run_emit(args: &EmitArgs) -> Result<(), CliError> {
 }
 
 /// The PNG path `render` writes when given no output at all.
-fn default_png(args: &RenderArgs, drawn: &Drawn) -> Option<PathBuf> {
+fn default_png(args: &RenderArgs) -> Result<Option<PathBuf>, CliError> {
     let any = args.image.wanted()
         || args.trace.is_some()
         || args.cost.wanted()
         || args.stats_json.is_some();
-    (!any).then(|| PathBuf::from(format!("{}.png", drawn.source.name())))
+    if any {
+        return Ok(None);
+    }
+    let name = cwisim_render::Source::resolve(args.scene.as_deref())?.name();
+    Ok(Some(PathBuf::from(format!("{name}.png"))))
 }
 
 /// Runs `cwisim render`.
@@ -129,22 +132,20 @@ pub fn run_render(
     progress: bool,
 ) -> Result<(), CliError> {
     let [cost_image, cost_npy] = args.cost.outputs();
-    let scene_file = args
-        .scene
-        .as_deref()
-        .filter(|p| p.exists())
-        .map(|p| ("scene", p));
-    check_outputs(
-        scene_file,
-        &[
-            ("-o", args.image.output.as_deref()),
-            ("--npy", args.image.npy.as_deref()),
-            ("--trace", args.trace.as_deref()),
-            ("--stats-json", args.stats_json.as_deref()),
-            (cost_image.0, cost_image.1.map(PathBuf::as_path)),
-            (cost_npy.0, cost_npy.1.map(PathBuf::as_path)),
-        ],
-    )?;
+    let default_png = default_png(args)?;
+    Io::new()
+        .source("scene", args.scene.as_deref())
+        .machine(&args.machine)
+        .output(
+            "-o",
+            args.image.output.as_deref().or(default_png.as_deref()),
+        )
+        .output("--npy", args.image.npy.as_deref())
+        .output("--trace", args.trace.as_deref())
+        .output("--stats-json", args.stats_json.as_deref())
+        .output(cost_image.0, cost_image.1.map(PathBuf::as_path))
+        .output(cost_npy.0, cost_npy.1.map(PathBuf::as_path))
+        .check()?;
     args.cost.check()?;
     cwisim_scene::budget::check_threads(args.threads).map_err(CliError::Usage)?;
     // loading, projecting, lighting and exact visibility come before the first scanline
@@ -155,7 +156,7 @@ pub fn run_render(
     let drawn = args.draw.draw_on(args.scene.as_deref(), args.threads)?;
     drop(stage);
     let mut image_args = args.image.clone();
-    if let Some(png) = default_png(args, &drawn) {
+    if let Some(png) = default_png {
         image_args.output = Some(png);
     }
     let renderer = &*drawn.renderer;

@@ -288,14 +288,13 @@ fn check_outputs(args: &StatsArgs) -> Result<(), CliError> {
     if let Some(p) = &args.plot {
         check_extension("--plot", p, "png")?;
     }
-    files::check_outputs(
-        Some(("input", args.input.as_path())),
-        &[
-            ("--plot", args.plot.as_deref()),
-            ("--csv", args.csv.as_deref()),
-            ("--stats-json", args.stats_json.as_deref()),
-        ],
-    )
+    files::Io::new()
+        .source("input", Some(&args.input))
+        .machine(&args.machine)
+        .output("--plot", args.plot.as_deref())
+        .output("--csv", args.csv.as_deref())
+        .output("--stats-json", args.stats_json.as_deref())
+        .check()
 }
 
 /// The CSV header: the table's columns with every opcode.

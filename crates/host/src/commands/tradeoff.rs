@@ -7,7 +7,7 @@
 use super::MachineArgs;
 use crate::draw::ShadowsArg;
 use crate::error::CliError;
-use crate::files::{check_outputs, write_atomic};
+use crate::files::{write_atomic, Io};
 use crate::output::write_rgb_png;
 use crate::progress::Progress;
 use clap::Args;
@@ -84,13 +84,15 @@ pub struct TradeoffArgs {
 
 /// Runs `cwisim tradeoff`.
 pub fn run(args: &TradeoffArgs, stdout: &mut dyn Write, progress: bool) -> Result<(), CliError> {
-    check_outputs(
-        None,
-        &[
-            ("--csv", args.csv.as_deref()),
-            ("--plot", args.plot.as_deref()),
-        ],
-    )?;
+    let mut io = Io::new()
+        .source("scene", args.scene.as_deref())
+        .machine(&args.machine);
+    for part in &args.merge {
+        io = io.input("part being merged", Some(part));
+    }
+    io.output("--csv", args.csv.as_deref())
+        .output("--plot", args.plot.as_deref())
+        .check()?;
     if let Some(p) = &args.plot {
         crate::cost_args::check_extension("--plot", p, "png")?;
     }

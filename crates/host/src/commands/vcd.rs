@@ -11,7 +11,7 @@
 
 use super::MachineArgs;
 use crate::error::CliError;
-use crate::files::{same_file, write_atomic};
+use crate::files::{write_atomic, Io};
 use crate::progress::Progress;
 use crate::range::{parse_range, Range};
 use clap::Args;
@@ -71,12 +71,11 @@ pub struct VcdArgs {
 /// Runs `cwisim vcd`.
 pub fn run(args: &VcdArgs, progress: bool) -> Result<(), CliError> {
     crate::input::drawing_applies(&args.draw, &[Some(&args.trace)])?;
-    if same_file(&args.output, &args.trace) {
-        return Err(CliError::Usage(format!(
-            "-o {} would overwrite the trace being read",
-            args.output.display()
-        )));
-    }
+    Io::new()
+        .source("trace being read", Some(&args.trace))
+        .machine(&args.machine)
+        .output("-o", Some(&args.output))
+        .check()?;
     let machine = args.machine.load()?;
     let (mut file, size) = crate::input::open_sized(&args.trace, &args.draw, false)?;
     let header = *file.header();
