@@ -26,6 +26,72 @@ use std::sync::Mutex;
 /// Every partial file alive in the process, on any thread: what an interruption removes.
 static LIVE_PARTIALS: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 
+/// Every temporary work directory alive in the process (`rtl`'s tools' files): what an
+/// interruption removes, with what is in it.
+static LIVE_DIRS: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// A directory for a tool's files: one the user named (`--work-dir`, made new and kept),
+/// or a temporary one of a new, unique name (`cwisim-rtl-WHAT-XXXXXX` in the temporary
+/// directory), removed when dropped — on an error, a missing tool and an interruption
+/// too — unless [`WorkDir::keep`] kept it (a co-simulation that differs, for a look).
+pub struct WorkDir {
+    path: PathBuf,
+    temporary: Option<tempfile::TempDir>,
+}
+
+impl WorkDir {
+    /// `given` (made new), or a temporary directory for `what`.
+    pub fn new(given: Option<&Path>, what: &str) -> Result<WorkDir, CliError> {
+        if let Some(d) = given {
+            std::fs::create_dir(d).map_err(|e| CliError::write(d, e))?;
+            return Ok(WorkDir {
+                path: d.to_path_buf(),
+                temporary: None,
+            });
+        }
+        let tmp = std::env::temp_dir();
+        let dir = tempfile::Builder::new()
+            .prefix(&format!("cwisim-rtl-{what}-"))
+            .tempdir_in(&tmp)
+            .map_err(|e| CliError::write(&tmp, e))?;
+        let path = dir.path().to_path_buf();
+        if let Ok(mut live) = LIVE_DIRS.lock() {
+            live.push(path.clone());
+        }
+        Ok(WorkDir {
+            path,
+            temporary: Some(dir),
+        })
+    }
+
+    /// Its path.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Keeps a temporary directory after all (its path is said in a message).
+    pub fn keep(mut self) -> PathBuf {
+        if let Some(dir) = self.temporary.take() {
+            let path = dir.keep();
+            if let Ok(mut live) = LIVE_DIRS.lock() {
+                live.retain(|p| p != &path);
+            }
+        }
+        self.path.clone()
+    }
+}
+
+impl Drop for WorkDir {
+    fn drop(&mut self) {
+        if let Some(dir) = self.temporary.take() {
+            drop(dir); // removes it and what it holds
+            if let Ok(mut live) = LIVE_DIRS.lock() {
+                live.retain(|p| p != &self.path);
+            }
+        }
+    }
+}
+
 fn register_partial(path: &Path) {
     if let Ok(mut live) = LIVE_PARTIALS.lock() {
         live.push(path.to_path_buf());
@@ -107,14 +173,23 @@ impl Drop for PartialFile {
     }
 }
 
-/// Removes every partial file on SIGINT or SIGTERM (SIGHUP too), then exits with
+/// Stops every HDL tool the command runs (`rtl`'s simulators and Yosys, with what they
+/// started), removes every partial file and temporary work directory on SIGINT or SIGTERM
+/// (SIGHUP too), then exits with
 /// [`crate::error::EXIT_INTERRUPTED`]: an interrupted command leaves nothing behind and
 /// replaces nothing. Installed once by `cwisim`'s `main`; a second call does nothing.
 pub fn install_interrupt_cleanup() {
     let _ = ctrlc::set_handler(|| {
+        // the HDL tools first, so that none writes into what is removed next
+        cwisim_rtl::tools::stop_children();
         if let Ok(live) = LIVE_PARTIALS.lock() {
             for p in live.iter() {
                 let _ = std::fs::remove_file(p);
+            }
+        }
+        if let Ok(live) = LIVE_DIRS.lock() {
+            for d in live.iter() {
+                let _ = std::fs::remove_dir_all(d);
             }
         }
         let _ = writeln!(io::stderr(), "error: interrupted; no output was written");
@@ -216,6 +291,17 @@ fn output_kind(path: &Path) -> Result<OutputKind, CliError> {
 /// written in place, whose name need not carry the format's extension.
 pub fn is_special(path: &Path) -> bool {
     matches!(output_kind(path), Ok(OutputKind::InPlace))
+}
+
+/// The encoding a trace written to `path` gets: the one its extension names; for a device
+/// or FIFO whose name has no extension (`/dev/stdout`, a named pipe), the annotated text
+/// (`.cwt`), as LIMITS.md says ("its name need not carry the format's extension").
+pub fn trace_output_encoding(path: &Path) -> Result<cwisim_isa::Encoding, CliError> {
+    match cwisim_isa::Encoding::from_path(path) {
+        Ok(e) => Ok(e),
+        Err(_) if path.extension().is_none() && is_special(path) => Ok(cwisim_isa::Encoding::Text),
+        Err(e) => Err(e.into()),
+    }
 }
 
 /// Writes `path` through `fill`, all or nothing (see the module's documentation).

@@ -406,7 +406,7 @@ fn a_trace_without_refresh_is_refused_naming_the_file() {
         assert_eq!(
             stderr,
             "error: t.cwt: the trace ends before its first scanline (no Refresh; the header \
-announces 2 lines per frame): it is incomplete (cut short?)\n"
+announces 2 lines per frame): it is incomplete (cut short?); the file ends at byte 64\n"
         );
     }
     assert!(!dir.join("t.png").exists() && !dir.join("t.npy").exists());

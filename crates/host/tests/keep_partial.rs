@@ -153,7 +153,7 @@ fn a_trace_cut_between_records_is_refused_unless_kept() {
         assert!(
             stderr.ends_with(
                 "error: short.cwt: the trace ends after 2 scanlines, inside frame 0 (2 of its \
-4 lines): it is incomplete (cut short?)\n"
+4 lines): it is incomplete (cut short?); the file ends at byte 106\n"
             ),
             "{args:?}: {stderr}"
         );

@@ -702,7 +702,7 @@ fn bad_inputs_exit_2_with_one_error_line_and_no_file() {
     assert_eq!(
         stderr,
         "error: t.cwt: the trace ends before its first scanline (no Refresh; the header \
-announces 1 line per frame): it is incomplete (cut short?)\n"
+announces 1 line per frame): it is incomplete (cut short?); the file ends at byte 64\n"
     );
     assert!(!empty.join("x.vcd").exists());
     // Usage errors of the parser itself.

@@ -205,8 +205,14 @@ impl FileReader {
         self.completeness
     }
 
+    /// The refusal of an incomplete trace, saying where the file ends (its byte count).
     fn refusal(&self, incomplete: &Incomplete) -> TraceError {
-        incomplete.error().in_file(&self.path)
+        let mut e = incomplete.error().in_file(&self.path);
+        e.message.push_str(&format!(
+            "; the file ends at byte {}",
+            self.inner.bytes_read()
+        ));
+        e
     }
 
     /// The inner reader has reached the end: judges the trace the first time.
@@ -393,7 +399,11 @@ mod tests {
             (6, "the trace ends after 6 scanlines, inside frame 1 (2 of its 4 lines)"),
         ] {
             for path in &files(&format!("short-{scanlines}"), &trace(4, scanlines)).0 {
-                let want = format!("{}: {said}: it is incomplete (cut short?)", path.display());
+                let size = std::fs::metadata(path).unwrap().len();
+                let want = format!(
+                    "{}: {said}: it is incomplete (cut short?); the file ends at byte {size}",
+                    path.display()
+                );
                 for batched in [true, false] {
                     let mut r = FileReader::open(path).unwrap();
                     let e = if batched {

@@ -89,8 +89,9 @@ fn the_issues_file_cut_mid_number_after_a_refresh_is_refused() {
     assert_eq!(
         e.to_string(),
         format!(
-            "{}: the trace ends after 65 scanlines, inside frame 0 (65 of its 400 lines): it is incomplete (cut short?)",
-            path.display()
+            "{}: the trace ends after 65 scanlines, inside frame 0 (65 of its 400 lines): it is incomplete (cut short?); the file ends at byte {}",
+            path.display(),
+            value + 4
         )
     );
     // cut at a line's end

@@ -55,6 +55,16 @@ pub fn draw(
         .check_given(given, settings)
         .map_err(RenderError::Usage)?;
     settings.check().map_err(RenderError::Usage)?;
+    let scene_text = |source: &Source| -> Option<String> {
+        match (scene, source) {
+            (SceneInput::Text { text, .. }, _) => Some((*text).to_string()),
+            (_, Source::File(p)) => cwisim_scene::read_scene_text(p).ok(),
+            (_, Source::Embedded(name)) => {
+                cwisim_world::embedded::embedded(name).map(|e| e.text.to_string())
+            }
+            (_, Source::Built(_)) => None,
+        }
+    };
     let (loaded, name) = match scene {
         SceneInput::Named(path) => (
             Source::resolve(path)?.load_for(settings)?,
@@ -71,7 +81,22 @@ pub fn draw(
     entry
         .check_scene(given, &loaded.scene, &name, settings)
         .map_err(RenderError::Usage)?;
-    build(entry, loaded, settings)
+    let source = loaded.source.clone();
+    build(entry, loaded, settings).map_err(|e| match e {
+        // a refusal of a field found while building (a light that cannot cast shadows):
+        // located in the scene's text, as a reading error is
+        RenderError::Scene(se) if se.line.is_none() && se.field.is_some() => {
+            let Some(text) = scene_text(&source) else {
+                return RenderError::Scene(se);
+            };
+            let located = cwisim_scene::locate_error(&text, se);
+            RenderError::Scene(match source.path() {
+                Some(p) if located.path.is_none() => located.in_file(p),
+                _ => located,
+            })
+        }
+        e => e,
+    })
 }
 
 /// Builds `entry`'s renderer for a loaded scene.

@@ -119,8 +119,10 @@ impl NonFinite {
         e.get_ref()?.downcast_ref()
     }
 
-    /// `e`, its [`NonFinite`] (if it carries one without a row) given the row `row`: for a
-    /// renderer that makes its rows' values in a loop of its own.
+    /// `e` located at the row `row`, for a renderer that makes its rows' values in a loop
+    /// of its own: its [`NonFinite`] (if it carries one without a row) given the row; any
+    /// other error not yet located (a fault of the renderer's, an internal error) said
+    /// to be the row's (`row R: …`), so that its message names the scanline.
     pub fn at_row(e: io::Error, row: u32) -> io::Error {
         match NonFinite::carried_by(&e) {
             Some(nf) if nf.row.is_none() => NonFinite {
@@ -128,9 +130,21 @@ impl NonFinite {
                 ..nf.clone()
             }
             .into_io(),
-            _ => e,
+            Some(_) => e,
+            None if e.get_ref().is_some_and(|s| s.is::<AtRow>()) => e,
+            None => io::Error::new(e.kind(), AtRow { row, source: e }),
         }
     }
+}
+
+/// A renderer's error located at the pixel row it was making.
+#[derive(Debug, thiserror::Error)]
+#[error("row {row}: {source}")]
+pub struct AtRow {
+    /// The pixel row.
+    pub row: u32,
+    /// What went wrong there.
+    pub source: io::Error,
 }
 
 /// `frame F, row R: `, as much of it as is known.
@@ -163,5 +177,27 @@ impl RenderError {
     /// input's.
     pub fn is_internal(&self) -> bool {
         matches!(self, RenderError::Renderer { .. } | RenderError::Array(_))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn at_row_names_the_row_of_any_error_once() {
+        let e = NonFinite::at_row(io::Error::other("target -1e-15 is negative"), 7);
+        assert_eq!(e.to_string(), "row 7: target -1e-15 is negative");
+        // located once: an outer loop does not say it again
+        let e = NonFinite::at_row(e, 9);
+        assert_eq!(e.to_string(), "row 7: target -1e-15 is negative");
+        // a value that is not finite gets the row in its own record
+        let nf = NonFinite {
+            row: None,
+            stage: "per-pixel shading",
+            detail: "pixel 3, channel 0: the shade is inf".into(),
+        };
+        let e = NonFinite::at_row(nf.into_io(), 5);
+        assert_eq!(NonFinite::carried_by(&e).and_then(|nf| nf.row), Some(5));
     }
 }

@@ -27,6 +27,7 @@
 //! its targets, so a pixel that `m` pieces reach (its trapezia, where fragments meet) is
 //! within `m ×` the tolerance of its tolerance-0 value.
 
+use crate::error::NonFinite;
 use crate::prepare::PhongSurfaces;
 use crate::renderer::{Counters, FramePlan};
 use crate::span::{fit_span, SpanStats};
@@ -176,11 +177,12 @@ impl FramePlan for PhongFrame<'_> {
                         targets.extend(shade[..channels].iter().map(|v| c * v.max(0.0)));
                     }
                     filled += 1;
-                    result =
-                        fit_span(first as u32, &targets, channels, self.tolerance, sink).map(|s| {
+                    result = fit_span(first as u32, &targets, channels, self.tolerance, sink)
+                        .map(|s| {
                             instructions += s.pieces();
                             stats.add(&s);
-                        });
+                        })
+                        .map_err(|e| NonFinite::at_row(e, row));
                 }
                 Visit::EndOfRow(_) => {
                     instructions += 1;

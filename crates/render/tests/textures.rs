@@ -245,6 +245,72 @@ fn the_box_filter_comes_closer_than_point_sampling_to_the_true_mean_over_a_pixel
     );
 }
 
+#[test]
+fn point_filtered_pixels_split_by_a_shared_edge_read_the_texel_under_their_centre() {
+    // the square's two triangles share its diagonal; a pixel the diagonal crosses is in
+    // parts, each of its own triangle, and must still show the one texel under its centre
+    // (issue 53: each part read its own, up to 0.31 off), as a ray cast finds it
+    let dir = texture_dir("point-seam");
+    let size = 64u32;
+    let w = square(&dir, size, 3.0, -40.0);
+    let mesh = &w.meshes[0];
+    for shading in [Shading::Flat, Shading::Gouraud] {
+        let image = rendered(&w, &settings(shading, Antialias::Box, TextureFilter::Point));
+        let (mut checked, mut split) = (0, 0);
+        for py in 0..size as usize {
+            for px in 0..size as usize {
+                // wholly on the square: its four corners' rays hit it, clear of its rim
+                let corners: Vec<_> = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
+                    .iter()
+                    .map(|&(dx, dy)| {
+                        let (o, d) = ray(&w, size, size, px as f64 + dx, py as f64 + dy);
+                        hits(&w, o, d).into_iter().next()
+                    })
+                    .collect();
+                if corners.iter().any(|h| h.is_none()) {
+                    continue;
+                }
+                let (o, d) = ray(&w, size, size, px as f64 + 0.5, py as f64 + 0.5);
+                let Some(h) = hits(&w, o, d).into_iter().next() else {
+                    continue;
+                };
+                let face = &mesh.faces[h.face];
+                let uv = [0, 1].map(|a| {
+                    (0..3)
+                        .map(|k| h.bary[k] * face.uv[h.corners[k]][a])
+                        .sum::<f64>()
+                });
+                let (tx, ty) = (uv[0] * TW as f64, uv[1] * TH as f64);
+                let near_edge = |t: f64| (t - t.round()).abs() < 1e-6;
+                if near_edge(tx) || near_edge(ty) || h.margin.abs() < 1e-9 {
+                    continue;
+                }
+                let want = texel(
+                    (tx.floor() as usize).min(TW - 1),
+                    (ty.floor() as usize).min(TH - 1),
+                );
+                let want = (want * 255.0).round() / 255.0;
+                let got = image[py * size as usize + px];
+                assert!(
+                    (got - want).abs() < 1e-9,
+                    "{shading:?} pixel ({px}, {py}): {got} against the ray cast's {want}"
+                );
+                checked += 1;
+                let triangles = corners
+                    .iter()
+                    .flatten()
+                    .map(|h| h.corners)
+                    .collect::<Vec<_>>();
+                if triangles.iter().any(|c| *c != triangles[0]) {
+                    split += 1;
+                }
+            }
+        }
+        assert!(checked > 1000, "{checked} pixels checked");
+        assert!(split > 30, "{split} pixels split by the diagonal checked");
+    }
+}
+
 /// An embedded scene at `size`.
 fn embedded(name: &str, size: (u32, u32)) -> WorldScene {
     common::world(

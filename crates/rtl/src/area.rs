@@ -149,7 +149,11 @@ pub fn script(file: &str, top: &str) -> String {
 pub fn synthesize_module(dir: &Path, file: &str, top: &str) -> Result<Area, RtlError> {
     run("yosys", &["-q", "-p", &script(file, top)], dir)?;
     let stat = dir.join(STAT_FILE);
-    let text = std::fs::read_to_string(&stat).map_err(|e| RtlError::io(&stat, e))?;
+    let text = std::fs::read_to_string(&stat).map_err(|source| RtlError::NoOutput {
+        tool: "yosys".into(),
+        path: stat.clone(),
+        source,
+    })?;
     parse_stat(&text)
 }
 

@@ -33,6 +33,14 @@ impl Simulator {
             Simulator::Verilator => "verilator",
         }
     }
+
+    /// The programs it runs, each of which must be on the PATH.
+    pub fn programs(self) -> &'static [&'static str] {
+        match self {
+            Simulator::Icarus => &["iverilog", "vvp"],
+            Simulator::Verilator => &["verilator"],
+        }
+    }
 }
 
 /// What a co-simulation found, with its times.
@@ -144,13 +152,16 @@ pub fn cosimulate(
     };
     let simulate = started.elapsed();
     let dump_path = dir.join(DUMP_FILE);
-    let size = std::fs::metadata(&dump_path)
-        .map_err(|e| RtlError::io(&dump_path, e))?
-        .len();
+    let no_dump = |source| RtlError::NoOutput {
+        tool: sim.name().into(),
+        path: dump_path.clone(),
+        source,
+    };
+    let size = std::fs::metadata(&dump_path).map_err(no_dump)?.len();
     // the text and what is parsed from it, about as much again
     cwisim_scene::budget::Budget::current()
         .check_memory("the simulator's dump", size.saturating_mul(2))?;
-    let text = std::fs::read_to_string(&dump_path).map_err(|e| RtlError::io(&dump_path, e))?;
+    let text = std::fs::read_to_string(&dump_path).map_err(no_dump)?;
     let observed = dump::parse(&text, &dump_path.display().to_string())?;
     let result = compare(d, trace, &want, &conv, &observed)?;
     Ok(Outcome {

@@ -48,7 +48,18 @@ pub enum RtlError {
         /// The first lines of what it printed.
         output: String,
     },
-    /// A file of the co-simulation could not be written or read.
+    /// A tool ran without an error but left no readable output where it should have
+    /// written it (a simulator that wrote no dump).
+    #[error("{tool} ran but left no readable {}: {source}", path.display())]
+    NoOutput {
+        /// The tool.
+        tool: String,
+        /// The file it should have written.
+        path: PathBuf,
+        /// Why it cannot be read.
+        source: std::io::Error,
+    },
+    /// A file of the co-simulation could not be written (or a file of ours read back).
     #[error("{}: {source}", path.display())]
     Io {
         /// The file.

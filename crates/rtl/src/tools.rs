@@ -3,7 +3,58 @@
 
 use crate::error::RtlError;
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::process::{Command, Output};
+use std::sync::Mutex;
+
+/// The process groups of the tools running now (each tool is started as the leader of a
+/// group of its own, so that what it starts — Verilator's make and compilers — is in it):
+/// what [`stop_children`] kills.
+static RUNNING: Mutex<Vec<u32>> = Mutex::new(Vec::new());
+
+/// Runs `command` to its end, as the leader of a new process group registered in
+/// [`RUNNING`] while it runs; its output.
+fn output_of(command: &mut Command) -> std::io::Result<Output> {
+    #[cfg(unix)]
+    std::os::unix::process::CommandExt::process_group(command, 0);
+    let child = command
+        .stdin(std::process::Stdio::null())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()?;
+    let pid = child.id();
+    if let Ok(mut running) = RUNNING.lock() {
+        running.push(pid);
+    }
+    let out = child.wait_with_output();
+    if let Ok(mut running) = RUNNING.lock() {
+        running.retain(|&p| p != pid);
+    }
+    out
+}
+
+/// Kills every tool running now, with whatever it started (its process group): for a
+/// command interrupted by a signal, so that no simulator or synthesizer outlives it.
+/// Safe to call from a signal handler's thread; does nothing when none runs.
+pub fn stop_children() {
+    let Ok(running) = RUNNING.lock() else {
+        return;
+    };
+    for &pid in running.iter() {
+        #[cfg(unix)]
+        if let Ok(group) = libc::pid_t::try_from(pid) {
+            // SAFETY: kill(2) takes any pid and signal number and touches no memory of
+            // ours; a group already gone gives ESRCH, which is ignored
+            unsafe {
+                libc::kill(-group, libc::SIGKILL);
+            }
+        }
+    }
+}
+
+/// How many tools run now (for tests).
+pub fn running_children() -> usize {
+    RUNNING.lock().map_or(0, |r| r.len())
+}
 
 /// The project's script that installs the tools.
 pub const INSTALL_SCRIPT: &str = "crates/rtl/tools/install-hdl.sh";
@@ -22,8 +73,9 @@ pub fn require(name: &str) -> Result<PathBuf, RtlError> {
     find(name).ok_or_else(|| RtlError::ToolMissing { tool: name.into() })
 }
 
-/// Runs `program args…` in `dir`; its standard output, or [`RtlError::ToolFailed`] with
-/// the first lines of what it printed.
+/// Runs `program args…` in `dir` (its temporary directory too), as the leader of a process
+/// group of its own ([`stop_children`] kills it); its standard output, or
+/// [`RtlError::ToolFailed`] with the first lines of what it printed.
 pub fn run(program: &str, args: &[&str], dir: &Path) -> Result<String, RtlError> {
     let bin = if program.contains('/') {
         PathBuf::from(program)
@@ -31,15 +83,19 @@ pub fn run(program: &str, args: &[&str], dir: &Path) -> Result<String, RtlError>
         require(program)?
     };
     let command = format!("{program} {}", args.join(" "));
-    let out = Command::new(&bin)
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .map_err(|e| RtlError::ToolFailed {
-            command: command.clone(),
-            status: "not started".into(),
-            output: e.to_string(),
-        })?;
+    // the tool's own temporaries (iverilog's) in `dir` too: removed with it, even when
+    // the tool is killed before it could remove them
+    let out = output_of(
+        Command::new(&bin)
+            .args(args)
+            .current_dir(dir)
+            .env("TMPDIR", dir),
+    )
+    .map_err(|e| RtlError::ToolFailed {
+        command: command.clone(),
+        status: "not started".into(),
+        output: e.to_string(),
+    })?;
     let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
     let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
     if !out.status.success() {
@@ -62,11 +118,12 @@ pub fn lint(design: &Path, top: &str) -> Result<Vec<String>, RtlError> {
         .and_then(|f| f.to_str())
         .unwrap_or("design.v");
     let bin = require("verilator")?;
-    let out = Command::new(&bin)
-        .args(["--lint-only", "-Wall", "--top-module", top, file])
-        .current_dir(dir)
-        .output()
-        .map_err(|e| RtlError::io(bin.clone(), e))?;
+    let out = output_of(
+        Command::new(&bin)
+            .args(["--lint-only", "-Wall", "--top-module", top, file])
+            .current_dir(dir),
+    )
+    .map_err(|e| RtlError::io(bin.clone(), e))?;
     let text = String::from_utf8_lossy(&out.stderr).into_owned();
     let warnings: Vec<String> = text
         .lines()

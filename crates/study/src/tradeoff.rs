@@ -639,10 +639,22 @@ impl Plan {
             textured: probe.is_textured(),
         };
         let settings = grid(&entries, &axes, formats);
+        let skipped = skipped_renderers(&entries, &axes);
+        if settings.is_empty() {
+            // every renderer asked for left out: a sweep of nothing is not a sweep
+            let why: Vec<String> = skipped
+                .iter()
+                .map(|(name, why)| format!("{name}: {why}"))
+                .collect();
+            return Err(StudyError::Usage(format!(
+                "no setting to measure: every renderer asked for is left out ({})",
+                why.join("; ")
+            )));
+        }
         Ok(Plan {
             scene: scene.map(Path::to_path_buf),
             groups: streams(&settings),
-            skipped: skipped_renderers(&entries, &axes),
+            skipped,
             settings,
             axes,
             references: References::default(),
@@ -670,6 +682,7 @@ impl Plan {
         repeat: u32,
         cancel: Option<&std::sync::atomic::AtomicBool>,
     ) -> Result<Vec<Row>, StudyError> {
+        check_repeat(repeat)?;
         let scene = self.scene.as_deref();
         let group = &self.settings[self.groups[g].clone()];
         let measured = measure_stream_until(scene, group, machine, repeat, cancel)?;
@@ -683,6 +696,16 @@ impl Plan {
                 Ok(row_of(setting, &measured, &times, &reference, &self.axes))
             })
             .collect()
+    }
+}
+
+/// Refuses a sweep that would time each setting no times at all.
+fn check_repeat(repeat: u32) -> Result<(), StudyError> {
+    match repeat {
+        0 => Err(StudyError::Usage(
+            "repeat must be at least 1: each setting is timed that many times and the median reported".into(),
+        )),
+        _ => Ok(()),
     }
 }
 
@@ -731,6 +754,7 @@ pub fn measure_groups(
     threads: usize,
     progress: &mut dyn FnMut(Step<'_>),
 ) -> Result<Vec<Row>, StudyError> {
+    check_repeat(repeat)?;
     let settings = &plan.settings;
     let first = groups.start;
     let ranges = &plan.groups[groups];
@@ -929,7 +953,7 @@ fn measure_stream_until(
         }
     };
     let mut out: Vec<(Measured, Vec<Duration>)> = Vec::with_capacity(group.len());
-    for time in 0..repeat.max(1) {
+    for time in 0..repeat {
         stop()?;
         let start = Instant::now();
         let loaded = Source::resolve(scene)?.load_for(&first.settings)?;

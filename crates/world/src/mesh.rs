@@ -102,20 +102,30 @@ pub(crate) struct Raw {
     pub normals: Option<Vec<Vec<DVec3>>>,
     /// Texture coordinates per face corner, when the source gives them.
     pub uv: Option<Vec<Vec<[f64; 2]>>>,
+    /// An OBJ file's: each face's `f` line (1-based), to locate a face's fault there.
+    pub face_lines: Option<Vec<u64>>,
 }
 
 /// Builds mesh `k` of a scene.
 pub fn build(spec: &MeshSpec, k: usize, base: Option<&Path>) -> Result<Mesh, BuildError> {
     let name = spec.name.clone().unwrap_or_else(|| format!("mesh {k}"));
-    let (raw, face_field): (Raw, Box<dyn Fn(usize) -> String>) = if let Some(b) = &spec.bezier {
+    type FaceError = Box<dyn Fn(usize, String) -> BuildError>;
+    let at_field = |field: Box<dyn Fn(usize) -> String>| -> FaceError {
+        Box::new(move |f, message| geometry(field(f), message))
+    };
+    let (raw, face_error): (Raw, FaceError) = if let Some(b) = &spec.bezier {
         (
             bezier(b, k)?,
-            Box::new(move |f| format!("meshes[{k}].bezier (triangle {f})")),
+            at_field(Box::new(move |f| {
+                format!("meshes[{k}].bezier (triangle {f})")
+            })),
         )
     } else if let Some(r) = &spec.revolution {
         (
             revolution(r, k)?,
-            Box::new(move |f| format!("meshes[{k}].revolution (face {f})")),
+            at_field(Box::new(move |f| {
+                format!("meshes[{k}].revolution (face {f})")
+            })),
         )
     } else if let Some(file) = &spec.obj {
         let path = match base {
@@ -123,15 +133,25 @@ pub fn build(spec: &MeshSpec, k: usize, base: Option<&Path>) -> Result<Mesh, Bui
             None => Path::new(file).to_path_buf(),
         };
         let raw = obj::read(&path).map_err(BuildError::File)?;
+        // a face's fault is the OBJ file's, at its `f` line; where the faces could not
+        // be matched to their lines, the scene's, at the mesh's `obj`
+        let lines = raw.face_lines.clone();
         let shown = file.clone();
-        (
-            raw,
-            Box::new(move |f| format!("meshes[{k}].obj (face {f} of {shown})")),
-        )
+        let located: FaceError =
+            Box::new(
+                move |f, message| match lines.as_ref().and_then(|l| l.get(f).copied()) {
+                    Some(line) => BuildError::File(SceneError {
+                        kind: SceneErrorKind::Geometry,
+                        ..obj::error(&path, Some(line), format!("face {f}: {message}"))
+                    }),
+                    None => geometry(format!("meshes[{k}].obj (face {f} of {shown})"), message),
+                },
+            );
+        (raw, located)
     } else {
         (
             inline(spec, k)?,
-            Box::new(move |f| format!("meshes[{k}].faces[{f}]")),
+            at_field(Box::new(move |f| format!("meshes[{k}].faces[{f}]"))),
         )
     };
     if raw.faces.is_empty() {
@@ -162,8 +182,8 @@ pub fn build(spec: &MeshSpec, k: usize, base: Option<&Path>) -> Result<Mesh, Bui
     let mut areas = Vec::with_capacity(raw.faces.len());
     for (f, corners) in raw.faces.iter().enumerate() {
         if corners.len() < 3 {
-            return Err(geometry(
-                face_field(f),
+            return Err(face_error(
+                f,
                 format!("a face needs at least 3 corners, found {}", corners.len()),
             ));
         }
@@ -173,8 +193,8 @@ pub fn build(spec: &MeshSpec, k: usize, base: Option<&Path>) -> Result<Mesh, Bui
             .map(|&c| (positions[c as usize] - positions[corners[0] as usize]).length_squared())
             .fold(0.0, f64::max);
         if n.length() <= 1e-12 * scale || scale == 0.0 {
-            return Err(geometry(
-                face_field(f),
+            return Err(face_error(
+                f,
                 "degenerate face: its corners are collinear or coincide (zero area)".into(),
             ));
         }
@@ -184,8 +204,8 @@ pub fn build(spec: &MeshSpec, k: usize, base: Option<&Path>) -> Result<Mesh, Bui
                 let t = (positions[corners[c] as usize] - o)
                     .cross(positions[corners[c + 1] as usize] - o);
                 if t.dot(n) < -1e-12 * scale {
-                    return Err(geometry(
-                        face_field(f),
+                    return Err(face_error(
+                        f,
                         format!(
                             "non-convex face ({} corners): the fan of triangles from its first corner would fold over; split it into triangles or convex faces",
                             corners.len()
@@ -224,10 +244,7 @@ pub fn build(spec: &MeshSpec, k: usize, base: Option<&Path>) -> Result<Mesh, Bui
             .iter()
             .any(|n| *n == DVec3::ZERO || !n.is_finite())
         {
-            return Err(geometry(
-                face_field(f),
-                "a given normal is zero or not finite".into(),
-            ));
+            return Err(face_error(f, "a given normal is zero or not finite".into()));
         }
     }
     Ok(Mesh {
@@ -415,6 +432,7 @@ fn inline(spec: &MeshSpec, k: usize) -> Result<Raw, BuildError> {
         faces: out_faces,
         normals,
         uv,
+        face_lines: None,
     })
 }
 
@@ -442,6 +460,7 @@ fn bezier(b: &BezierSource, k: usize) -> Result<Raw, BuildError> {
         faces: Vec::new(),
         normals: Some(Vec::new()),
         uv: Some(Vec::new()),
+        face_lines: None,
     };
     let normals = raw.normals.as_mut().expect("set above");
     let uv = raw.uv.as_mut().expect("set above");
@@ -575,6 +594,7 @@ pub(crate) fn revolution(r: &Revolution, k: usize) -> Result<Raw, BuildError> {
         faces,
         normals: None,
         uv: Some(uvs),
+        face_lines: None,
     })
 }
 

@@ -62,7 +62,8 @@ impl<R: BufRead> BufRead for Counting<R> {
     }
 }
 
-fn error(path: &Path, line: Option<u64>, message: String) -> SceneError {
+/// A fault of the OBJ file at `path`, on its line `line` when known.
+pub(crate) fn error(path: &Path, line: Option<u64>, message: String) -> SceneError {
     SceneError {
         path: Some(path.to_path_buf()),
         line,
@@ -109,6 +110,19 @@ pub(crate) fn read(path: &Path) -> Result<Raw, SceneError> {
         kind: SceneErrorKind::Io,
         ..error(path, None, format!("cannot read the OBJ file: {e}"))
     };
+    // what is not a regular file is refused before a byte is read: a FIFO would block
+    // forever, a device such as /dev/zero read up to the size limit
+    let meta = std::fs::metadata(path).map_err(io)?;
+    if !meta.is_file() {
+        return Err(SceneError {
+            kind: SceneErrorKind::Io,
+            ..error(
+                path,
+                None,
+                "not a regular file (an OBJ file is expected)".into(),
+            )
+        });
+    }
     let file = std::fs::File::open(path).map_err(io)?;
     let mut bytes = Vec::new();
     file.take(MAX_OBJ_BYTES + 1)
@@ -253,6 +267,21 @@ pub(crate) fn read(path: &Path) -> Result<Raw, SceneError> {
                     )
                 });
             }
+            // the bound inline `uv` has: beyond it a texel index loses its meaning
+            let bound = crate::scene::MAX_WORLD_COORDINATE;
+            if let Some(bad) = m.texcoords.iter().position(|x| x.abs() > bound) {
+                return Err(SceneError {
+                    kind: SceneErrorKind::Limit,
+                    ..error(
+                        path,
+                        statement_line("vt", vt_seen + bad / 2),
+                        format!(
+                            "expected texture coordinates within ±1e9, found {:e}",
+                            m.texcoords[bad]
+                        ),
+                    )
+                });
+            }
         }
         vt_seen += m.texcoords.len() / 2;
         let mut at = 0usize;
@@ -281,7 +310,20 @@ pub(crate) fn read(path: &Path) -> Result<Raw, SceneError> {
             at += arity as usize;
         }
     }
+    // each face's `f` line (tobj ignores one of fewer than 3 corners: a point or a
+    // line), when every such line made one face as tobj read them
+    let f_lines: Vec<u64> = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| {
+            let mut words = l.split_whitespace();
+            words.next() == Some("f") && words.count() >= 3
+        })
+        .map(|(n, _)| n as u64 + 1)
+        .collect();
+    let face_lines = (f_lines.len() == faces.len()).then_some(f_lines);
     Ok(Raw {
+        face_lines,
         positions,
         faces,
         normals: (all_have_normals && !normals.is_empty()).then_some(normals),
@@ -299,6 +341,29 @@ mod tests {
         let p = dir.join(name);
         std::fs::write(&p, text).unwrap();
         p
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn what_is_not_a_regular_file_is_refused_before_it_is_read() {
+        // a FIFO with no writer would block a read forever; /dev/zero would be read to
+        // the size limit
+        let dir = std::env::temp_dir().join(format!("cwisim-obj-fifo-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let fifo = dir.join("mesh.obj");
+        let _ = std::fs::remove_file(&fifo);
+        let made = std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap();
+        assert!(made.success());
+        for path in [fifo.as_path(), Path::new("/dev/zero")] {
+            let e = read(path).unwrap_err();
+            assert_eq!(e.kind, SceneErrorKind::Io, "{e}");
+            assert!(e.message.contains("not a regular file"), "{e}");
+            assert_eq!(e.path.as_deref(), Some(path));
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

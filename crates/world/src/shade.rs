@@ -108,10 +108,11 @@ impl PhongShader {
         Some([0, 1].map(|a| (w[0] * uv[0][a] + w[1] * uv[1][a] + w[2] * uv[2][a]) / sum))
     }
 
-    /// The texture's factor for `t` at screen point `p`, per channel (all 1 for an
-    /// untextured mesh), read as `filter` says: at `p` itself, or averaged over the
-    /// footprint of the pixel whose centre is `centre` (at `p` where the footprint leaves
-    /// the triangle's visible plane).
+    /// The texture's factor for `t` at screen point `p` of the pixel whose centre is
+    /// `centre`, per channel (all 1 for an untextured mesh), read as `filter` says: the
+    /// texel under `centre` on the triangle's plane, or the texture averaged over the
+    /// pixel's footprint on that plane (either at `p` where the plane is at or behind the
+    /// eye there).
     pub fn texture_factor(
         &self,
         t: &ScreenTriangle,
@@ -124,7 +125,13 @@ impl PhongShader {
         };
         let at_p = || self.uv_at(t, p).map_or([1.0; 4], |uv| texture.point(uv));
         match filter {
-            TextureFilter::Point => at_p(),
+            // the texel under the pixel centre, on the triangle's plane extended to it
+            // (the centre may lie outside the triangle, in a neighbour's part of the
+            // pixel): every part of a pixel of one planar, uniformly mapped surface reads
+            // the same texel, so no seam shows along the triangles' shared edges
+            TextureFilter::Point => self
+                .uv_at(t, centre)
+                .map_or_else(at_p, |uv| texture.point(uv)),
             TextureFilter::Box => {
                 let mut lo = [f64::INFINITY; 2];
                 let mut hi = [f64::NEG_INFINITY; 2];

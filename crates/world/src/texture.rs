@@ -420,7 +420,15 @@ impl ImageFile<'_> {
                 ),
             ));
         }
-        let file = std::fs::File::open(&self.path).map_err(|e| self.io(e))?;
+        let mut file = std::fs::File::open(&self.path).map_err(|e| self.io(e))?;
+        // the size the header claims, against the limit before the decoder sees it (a
+        // width of 2^31, beyond PNG's own range, is over the limit, not a decoder's error)
+        let mut head = [0u8; 24];
+        let got = std::io::Read::read(&mut file, &mut head).map_err(|e| self.io(e))?;
+        if let Some((w, h)) = png_header_size(&head[..got]) {
+            self.within_limit(w, h)?;
+        }
+        std::io::Seek::rewind(&mut file).map_err(|e| self.io(e))?;
         let reader =
             image::ImageReader::with_format(std::io::BufReader::new(file), image::ImageFormat::Png);
         let (width, height) = reader.into_dimensions().map_err(|e| self.not_png(e))?;
@@ -430,6 +438,12 @@ impl ImageFile<'_> {
                 format!("the image is empty ({width}×{height})"),
             ));
         }
+        self.within_limit(width, height)?;
+        Ok((width, height))
+    }
+
+    /// Refuses a size over [`MAX_TEXELS`].
+    fn within_limit(&self, width: u32, height: u32) -> Result<(), SceneError> {
         let texels = u64::from(width) * u64::from(height);
         if texels > MAX_TEXELS {
             return Err(self.fail(
@@ -439,8 +453,19 @@ impl ImageFile<'_> {
                 ),
             ));
         }
-        Ok((width, height))
+        Ok(())
     }
+}
+
+/// The width and height a PNG's first 24 bytes claim (the signature, then the IHDR chunk's
+/// length, type, width and height, big-endian), if they are a PNG's.
+fn png_header_size(head: &[u8]) -> Option<(u32, u32)> {
+    const SIGNATURE: &[u8; 8] = b"\x89PNG\r\n\x1a\n";
+    if head.len() < 24 || &head[..8] != SIGNATURE || &head[12..16] != b"IHDR" {
+        return None;
+    }
+    let word = |at: usize| u32::from_be_bytes([head[at], head[at + 1], head[at + 2], head[at + 3]]);
+    Some((word(16), word(20)))
 }
 
 /// The size in texels, `(width, height)`, of the texture a (validated) spec makes: a
@@ -606,6 +631,36 @@ mod tests {
         assert!((m - t.point([0.5, 0.5])[0]).abs() < 1e-6);
         // unused channels are 1
         assert_eq!(t.point([0.5, 0.5])[3], 1.0);
+    }
+
+    #[test]
+    fn a_header_claiming_2_to_the_31_texels_wide_is_the_limit_s_refusal() {
+        // a valid PNG of 1×1, its IHDR width rewritten to 2^31 (beyond PNG's own range,
+        // which the decoder would refuse with a message of its own)
+        let mut png = Vec::new();
+        image::GrayImage::from_raw(1, 1, vec![7])
+            .unwrap()
+            .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+            .unwrap();
+        png[16..20].copy_from_slice(&(1u32 << 31).to_be_bytes());
+        let dir = std::env::temp_dir().join(format!("cwisim-tex-huge-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("huge.png"), &png).unwrap();
+        let spec = TextureSpec {
+            image: Some("huge.png".into()),
+            checker: None,
+            repeat: [1.0, 1.0],
+        };
+        let e = extent(&spec, "meshes[0].material.texture", Some(&dir)).unwrap_err();
+        assert_eq!(e.kind, SceneErrorKind::Limit, "{e}");
+        assert!(
+            e.message
+                .contains("2147483648×1 = 2147483648 texels; the limit is"),
+            "{e}"
+        );
+        assert_eq!(png_header_size(&png[..23]), None);
+        assert_eq!(png_header_size(b"GIF89a..................."), None);
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

@@ -116,9 +116,13 @@ impl Slice {
     }
 
     /// The exact covered area of pixel column `i` in this row.
+    ///
+    /// The area is never negative: where the two edges (nearly) meet, the difference of
+    /// their fractions can round to −1e-16 or so, which is taken as the 0 it is (a
+    /// negative coverage made a per-pixel renderer's target negative: issue 53).
     pub fn coverage(&self, i: i64) -> f64 {
         let x = i as f64;
-        self.height() * (self.left.right_of(x) - self.right.right_of(x))
+        (self.height() * (self.left.right_of(x) - self.right.right_of(x))).max(0.0)
     }
 
     /// The pixels the left and right edge cut through: `(L0, L1, R0, R1)`.

@@ -51,7 +51,7 @@ pub fn run(args: &ConvertArgs) -> Result<u64, CliError> {
 /// not.
 pub fn convert(input: &Path, output: &Path) -> Result<u64, CliError> {
     Encoding::from_path(input)?;
-    let out_encoding = Encoding::from_path(output)?;
+    let out_encoding = crate::files::trace_output_encoding(output)?;
     Io::new()
         .input("trace being read (IN)", Some(input))
         .output("OUT", Some(output))

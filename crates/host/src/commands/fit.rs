@@ -82,6 +82,10 @@ pub(crate) fn parse_error_budget(s: &str) -> Result<f64, String> {
 /// Runs `cwisim fit`.
 pub fn run(args: &FitArgs, stdout: &mut dyn Write, progress: bool) -> Result<(), CliError> {
     cwisim_scene::budget::check_threads(args.threads).map_err(CliError::Usage)?;
+    if args.area {
+        // Yosys, before the search
+        super::rtl::require_tools(&["yosys"])?;
+    }
     let machine = args.machine.load()?;
     let stage = crate::progress::Stage::new(progress, "fit: drawing the scene");
     let drawn = args.draw.draw_on(args.scene.as_deref(), args.threads)?;

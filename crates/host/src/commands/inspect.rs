@@ -525,14 +525,16 @@ pub fn run(args: &InspectArgs, stdout: &mut dyn Write, progress: bool) -> Result
         cwisim_study::inspect::check_same_dimensions((&a.name, &a.header), (&b.name, &b.header))?;
     }
     let (width, lines) = (u64::from(a.header.width), u64::from(a.header.lines));
+    let beyond = |f: u64| CliError::Usage(format!("--frames: frame {f} is beyond any trace"));
     let frames = match args.frames {
         None => (0, 1),
         Some(r) => match r.last {
-            Some(l) => (r.first, l.saturating_add(1)),
+            Some(l) => (r.first, l.checked_add(1).ok_or_else(|| beyond(l))?),
             None => {
                 stage.message("inspect: counting the frames of the input");
                 let whole = a.whole_frames(&args.input, &args.draw)?;
-                (r.first, whole.max(r.first + 1))
+                let next = r.first.checked_add(1).ok_or_else(|| beyond(r.first))?;
+                (r.first, whole.max(next))
             }
         },
     };

@@ -10,7 +10,6 @@ use crate::files::{write_atomic, Io};
 use crate::output::{write_png, write_rgb_png};
 use crate::progress::Progress;
 use clap::Args;
-use cwisim_isa::encoding::Encoding;
 use cwisim_isa::{Instruction, TraceWrite};
 use cwisim_render::refine::{parse_phases, Phase};
 use cwisim_render::settings::{
@@ -152,7 +151,11 @@ pub fn run(args: &RefineArgs, stdout: &mut dyn Write, progress: bool) -> Result<
     if let Some(p) = &args.csv {
         check_extension("--csv", p, "csv")?;
     }
-    let encoding = args.trace.as_deref().map(Encoding::from_path).transpose()?;
+    let encoding = args
+        .trace
+        .as_deref()
+        .map(crate::files::trace_output_encoding)
+        .transpose()?;
     if args.sweep.is_some() {
         for (flag, given) in [
             ("--trace", args.trace.is_some()),

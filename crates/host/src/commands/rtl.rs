@@ -8,7 +8,7 @@
 use super::fit::OverflowArg;
 use super::MachineArgs;
 use crate::error::CliError;
-use crate::files::write_atomic;
+use crate::files::{write_atomic, WorkDir};
 use clap::Args;
 use cwisim_isa::{io::read_all, TraceHeader};
 use cwisim_rtl::verilog::{self, Watch};
@@ -19,7 +19,7 @@ use cwisim_study::fit::fit_scene;
 use cwisim_xproc::numeric::Overflow;
 use cwisim_xproc::Numeric;
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// The arguments of `cwisim rtl`.
 #[derive(Args, Clone, Debug, PartialEq)]
@@ -103,6 +103,14 @@ pub enum SimArg {
     Verilator,
 }
 
+/// The simulator `--cosim` names.
+fn sim_of(sim: SimArg) -> Simulator {
+    match sim {
+        SimArg::Icarus => Simulator::Icarus,
+        SimArg::Verilator => Simulator::Verilator,
+    }
+}
+
 /// A `cwisim_rtl` error as the command's.
 fn rtl_error(e: RtlError) -> CliError {
     match e {
@@ -113,7 +121,7 @@ fn rtl_error(e: RtlError) -> CliError {
         | RtlError::Numeric(_)
         | RtlError::Trace { .. }
         | RtlError::ToolMissing { .. }) => CliError::Usage(e.to_string()),
-        e @ (RtlError::ToolFailed { .. } | RtlError::Parse { .. }) => {
+        e @ (RtlError::ToolFailed { .. } | RtlError::NoOutput { .. } | RtlError::Parse { .. }) => {
             CliError::Internal(e.to_string())
         }
     }
@@ -138,31 +146,34 @@ pub(crate) fn scene_area(
         timing,
     )
     .map_err(rtl_error)?;
-    let (dir, _) = work_dir(None, "area")?;
-    let a = area::synthesize(&design, &dir).map_err(rtl_error);
-    let _ = std::fs::remove_dir_all(&dir);
-    a
+    let dir = WorkDir::new(None, "area")?;
+    area::synthesize(&design, dir.path()).map_err(rtl_error)
 }
 
-/// A fresh directory for the tools' files.
-fn work_dir(given: Option<&Path>, what: &str) -> Result<(PathBuf, bool), CliError> {
-    match given {
-        Some(d) => {
-            std::fs::create_dir(d).map_err(|e| CliError::write(d, e))?;
-            Ok((d.to_path_buf(), true))
-        }
-        None => {
-            let d = std::env::temp_dir().join(format!("cwisim-rtl-{what}-{}", std::process::id()));
-            let _ = std::fs::remove_dir_all(&d);
-            std::fs::create_dir_all(&d).map_err(|e| CliError::write(&d, e))?;
-            Ok((d, false))
-        }
+/// Refuses, before any work, a run whose tools are not installed: `programs`, each on the
+/// PATH.
+pub(crate) fn require_tools(programs: &[&str]) -> Result<(), CliError> {
+    for p in programs {
+        cwisim_rtl::tools::require(p).map_err(rtl_error)?;
     }
+    Ok(())
 }
 
 /// Runs `cwisim rtl`.
 pub fn run(args: &RtlArgs, stdout: &mut dyn Write, progress: bool) -> Result<(), CliError> {
     crate::input::drawing_applies(&args.draw, &[args.for_input.as_deref()])?;
+    // the tools, before anything is written or drawn
+    if let Some(sim) = args.cosim {
+        require_tools(sim_of(sim).programs())?;
+    }
+    if args.area {
+        require_tools(&["yosys"])?;
+    }
+    if args.watch.is_some() && args.cosim.is_none() && args.testbench.is_none() {
+        return Err(CliError::Usage(
+            "--watch chooses the processors whose token arrivals --cosim compares and --testbench writes: give one of them".into(),
+        ));
+    }
     crate::files::Io::new()
         .source("--for input", args.for_input.as_deref())
         .machine(&args.machine)
@@ -267,12 +278,9 @@ pub fn run(args: &RtlArgs, stdout: &mut dyn Write, progress: bool) -> Result<(),
     }
     say(out, "wrote", args.output.display().to_string())?;
     if args.area {
-        let (dir, keep) = work_dir(None, "area")?;
-        let a = area::synthesize(&design, &dir).map_err(rtl_error);
-        if !keep {
-            let _ = std::fs::remove_dir_all(&dir);
-        }
-        let a = a?;
+        let dir = WorkDir::new(None, "area")?;
+        let a = area::synthesize(&design, dir.path()).map_err(rtl_error)?;
+        drop(dir);
         say(
             out,
             "area",
@@ -283,20 +291,15 @@ pub fn run(args: &RtlArgs, stdout: &mut dyn Write, progress: bool) -> Result<(),
         )?;
     }
     if let (Some(sim), Some(trace)) = (args.cosim, &trace) {
-        let sim = match sim {
-            SimArg::Icarus => Simulator::Icarus,
-            SimArg::Verilator => Simulator::Verilator,
-        };
-        let (dir, keep) = work_dir(args.work_dir.as_deref(), "cosim")?;
+        let sim = sim_of(sim);
+        let dir = WorkDir::new(args.work_dir.as_deref(), "cosim")?;
         let stage = crate::progress::Stage::new(progress, "rtl: co-simulating");
-        let outcome =
-            cosimulate(&design, &header, trace, &machine, &watch, sim, &dir).map_err(rtl_error)?;
+        let outcome = cosimulate(&design, &header, trace, &machine, &watch, sim, dir.path())
+            .map_err(rtl_error)?;
         drop(stage);
         match outcome.result {
             Ok(a) => {
-                if !keep {
-                    let _ = std::fs::remove_dir_all(&dir);
-                }
+                drop(dir);
                 say(
                     out,
                     "co-sim",
@@ -324,11 +327,13 @@ pub fn run(args: &RtlArgs, stdout: &mut dyn Write, progress: bool) -> Result<(),
                 )?;
             }
             Err(m) => {
+                // kept, for a look
+                let dir = dir.keep();
                 return Err(CliError::Internal(format!(
                     "the {} co-simulation differs from the stepped engine: {m} (files in {})",
                     sim.name(),
                     dir.display()
-                )))
+                )));
             }
         }
     }

@@ -12,7 +12,7 @@ use crate::progress::{Progress, Stage};
 use crate::report::{timing_name, write_summary, StatsReport};
 use crate::summary::{write_render_summary, StageTimes};
 use clap::Args;
-use cwisim_isa::{Encoding, TraceWrite};
+use cwisim_isa::TraceWrite;
 use cwisim_render::{render, ArrayConfig, Renderer, Taps};
 use cwisim_study::cost::CostMap;
 use cwisim_xproc::{Numeric, Timing};
@@ -87,7 +87,7 @@ pub struct RenderArgs {
 
 /// The renderer's whole stream in one encoding, in memory (written only once complete).
 fn encode(renderer: &dyn Renderer, path: &Path) -> Result<Vec<u8>, CliError> {
-    let encoding = Encoding::from_path(path)?;
+    let encoding = crate::files::trace_output_encoding(path)?;
     let mut bytes = Vec::new();
     {
         let mut w = encoding

@@ -388,7 +388,7 @@ impl MergedFrame<'_> {
                     }
                     tally.rows_filled += 1;
                 }
-                SliceVisit::EndOfRow(_) => {
+                SliceVisit::EndOfRow(row) => {
                     slots[..active].sort_by_key(|s| s.group);
                     for s in &mut slots[..active] {
                         if s.lo > s.hi {
@@ -407,7 +407,8 @@ impl MergedFrame<'_> {
                                     tally.instructions += f.pieces();
                                     tally.fit.add(&f);
                                     tally.spans += 1;
-                                });
+                                })
+                                .map_err(|e| crate::error::NonFinite::at_row(e, row));
                             p = q;
                         }
                         s.values[s.lo * channels..(s.hi + 1) * channels].fill(0.0);
