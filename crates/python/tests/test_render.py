@@ -278,6 +278,10 @@ def test_a_scene_of_another_type_says_what_is_taken(scene):
         cwisim.render(scene)
     with pytest.raises(TypeError, match=r"a dict"):
         cwisim.emit(scene)
+    # the calls that read a scene file themselves (a dict is a UsageError there)
+    for call in [cwisim.fit, cwisim.refine]:
+        with pytest.raises(TypeError, match=r": expected an embedded scene's name or a scene file's path, not"):
+            call(scene)
 
 
 def test_a_value_of_the_wrong_form_says_what_is_expected():
