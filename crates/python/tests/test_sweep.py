@@ -72,8 +72,10 @@ def test_a_dask_cluster_of_two_workers_gives_the_local_rows(local):
 
 
 def test_a_bad_sweep_is_refused_before_any_task():
-    with pytest.raises(cwisim.UsageError, match="draws several frames"):
+    with pytest.raises(cwisim.UsageError, match="draws several frames") as refused:
         cwisim.tradeoff("pot", renderers=["refine"])
+    # a command it quotes is the command line's, as written
+    assert "`cwisim render --renderer refine` prints its phases" in str(refused.value)
     with pytest.raises(cwisim.UsageError, match="^numeric: "):
         cwisim.tradeoff("pot", numeric="f16")
     with pytest.raises(cwisim.UsageError, match="tradeoff takes a scene file"):

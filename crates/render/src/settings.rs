@@ -648,8 +648,26 @@ const KEYWORD_FLAGS: &[&str] = &[
 /// a value the flag takes right after it is written as Python would pass it:
 /// `--shading phong` → `shading="phong"`, `--size 640x480` → `size=(640, 480)`,
 /// `--shadows on` → `shadows=True`, `--samples 2` → `samples=2`. Other flags (the
-/// command line's own, `--csv`) stay as they are.
+/// command line's own, `--csv`) stay as they are, and so does a command quoted whole
+/// (`` `cwisim render --renderer refine` ``).
 pub fn keyword_spelling(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for (k, part) in text.split('`').enumerate() {
+        if k > 0 {
+            out.push('`');
+        }
+        let quoted_command = k % 2 == 1 && part.starts_with("cwisim ");
+        if quoted_command {
+            out.push_str(part);
+        } else {
+            out.push_str(&flags_as_keywords(part));
+        }
+    }
+    out
+}
+
+/// [`keyword_spelling`] of text that quotes no command.
+fn flags_as_keywords(text: &str) -> String {
     let mut out = String::with_capacity(text.len());
     let mut rest = text;
     while let Some(at) = rest.find("--") {
@@ -756,6 +774,11 @@ mod tests {
             "use renderer=\"vanrij\"; shadows=False; --csv out.csv, a-- b"
         );
         assert_eq!(keyword_spelling("nothing to change"), "nothing to change");
+        // a command quoted whole is the command line's, as written
+        assert_eq!(
+            keyword_spelling("use `--samples 4`; `cwisim render --renderer refine` prints it"),
+            "use `samples=4`; `cwisim render --renderer refine` prints it"
+        );
     }
 
     #[test]
