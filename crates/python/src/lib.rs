@@ -12,7 +12,11 @@
 //! Errors are Python exceptions carrying the command line's located message:
 //! `SceneError` (a scene that cannot be read: file, line or JSON path, what was
 //! expected), `UsageError` (unknown names, settings that do not go together or exceed a
-//! limit), both `CwisimError`s; a fault of cwisim's own is a plain `CwisimError`. The
+//! limit), both `CwisimError`s; a fault of cwisim's own is a plain `CwisimError`. They
+//! are the `cwisim` module's (`cwisim.UsageError`, found there by pickle), and a
+//! `UsageError` names the command line's flags as keyword arguments (`samples=`,
+//! [`keyword_spelling`]). `Render.summary` is the library's
+//! [`cwisim_render::summary::render_rows`], the rows `cwisim render` prints. The
 //! render runs without the GIL, and stops after the scanline during which Ctrl-C came
 //! (`KeyboardInterrupt`).
 
@@ -22,7 +26,7 @@ use cwisim_isa::{
 };
 use cwisim_render::draw::{draw, SceneInput};
 use cwisim_render::refine::parse_phases;
-use cwisim_render::settings::Setting;
+use cwisim_render::settings::{keyword_spelling, Setting};
 use cwisim_render::{
     registry, render as render_frames, ArrayConfig, RenderError, Rendered, Settings, Taps,
 };
@@ -45,23 +49,36 @@ use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 create_exception!(
-    _native,
+    cwisim,
     CwisimError,
     PyException,
     "Anything cwisim refuses or fails at; the message says what and where."
 );
 create_exception!(
-    _native,
+    cwisim,
     SceneError,
     CwisimError,
     "A scene that cannot be read: the message locates it (the file, the line or JSON path) and says what was expected."
 );
 create_exception!(
-    _native,
+    cwisim,
     UsageError,
     CwisimError,
     "An unknown name, settings that do not go together, or a size over a limit: the command line's exit 2."
 );
+
+/// A `UsageError` of `message`, its command-line flags spoken as keyword arguments
+/// (`--samples` → `samples=`, [`keyword_spelling`]).
+fn usage_error(message: impl AsRef<str>) -> PyErr {
+    UsageError::new_err(keyword_spelling(message.as_ref()))
+}
+
+/// A message of the command line's with its flags spoken as keyword arguments, as every
+/// `UsageError` says them (`--samples` → `samples=`).
+#[pyfunction(name = "keyword_spelling")]
+fn keyword_spelling_py(message: &str) -> String {
+    keyword_spelling(message)
+}
 
 /// The Python exception for a render error: the same message as the command line's.
 fn to_py(e: RenderError) -> PyErr {
@@ -72,7 +89,7 @@ fn to_py(e: RenderError) -> PyErr {
         | RenderError::UnknownRenderer { .. }
         | RenderError::Machine(_)
         | RenderError::ImageLimit(_)
-        | RenderError::Overflow { .. } => UsageError::new_err(message),
+        | RenderError::Overflow { .. } => usage_error(message),
         RenderError::Cancelled { .. } => PyKeyboardInterrupt::new_err(message),
         RenderError::Renderer { .. } | RenderError::Array(_) => CwisimError::new_err(message),
     }
@@ -125,7 +142,7 @@ fn scene_text(name: &str) -> PyResult<&'static str> {
                 .iter()
                 .map(|e| e.name)
                 .collect();
-            UsageError::new_err(format!(
+            usage_error(format!(
                 "no embedded scene `{name}` (embedded: {})",
                 names.join(", ")
             ))
@@ -165,14 +182,14 @@ fn settings_of(given: &[(String, String)], threads: usize) -> PyResult<(Settings
     let mut named = Vec::new();
     for (name, value) in given {
         let setting = Setting::of_name(name).ok_or_else(|| {
-            UsageError::new_err(format!(
+            usage_error(format!(
                 "unknown setting `{name}`; known: {}",
                 setting_names().join(", ")
             ))
         })?;
         setting
             .set(&mut settings, value)
-            .map_err(|e| UsageError::new_err(format!("{name}: {e}")))?;
+            .map_err(|e| usage_error(format!("{name}: {e}")))?;
         named.push(setting);
     }
     Ok((settings, named))
@@ -240,12 +257,12 @@ fn run_dict<'py>(
 fn array_config(numeric: &str, timing: &str, machine: Option<&str>) -> PyResult<ArrayConfig> {
     let numeric: Numeric = numeric
         .parse()
-        .map_err(|e| UsageError::new_err(format!("numeric: {e}")))?;
+        .map_err(|e| usage_error(format!("numeric: {e}")))?;
     let timing = match timing {
         "fast" => Timing::Fast,
         "stepped" => Timing::Stepped,
         other => {
-            return Err(UsageError::new_err(format!(
+            return Err(usage_error(format!(
                 "timing: unknown timing `{other}`; expected fast or stepped"
             )))
         }
@@ -338,7 +355,7 @@ fn emit_stream<'py>(
     settings: Vec<(String, String)>,
     threads: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
-    cwisim_scene::budget::check_threads(threads).map_err(UsageError::new_err)?;
+    cwisim_scene::budget::check_threads(threads).map_err(usage_error)?;
     let (settings, given) = settings_of(&settings, threads)?;
     let input = match (scene, scene_json) {
         (_, Some(text)) => SceneInput::Text { name, text },
@@ -406,13 +423,13 @@ fn encode_trace<'py>(
     encoding: &str,
 ) -> PyResult<Bound<'py, PyBytes>> {
     let header = TraceHeader::new(width, lines, channels)
-        .map_err(|e| UsageError::new_err(format!("header: {e}")))?;
+        .map_err(|e| usage_error(format!("header: {e}")))?;
     let encoding = Encoding::ALL
         .iter()
         .find(|(_, ext)| *ext == encoding)
         .map(|(e, _)| *e)
         .ok_or_else(|| {
-            UsageError::new_err(format!(
+            usage_error(format!(
                 "unknown trace encoding `{encoding}`; expected cwt, jsonl or cwb"
             ))
         })?;
@@ -426,7 +443,7 @@ fn encode_trace<'py>(
     let ch = usize::from(channels);
     let n = code.len();
     if x.len() != n || dx.len() != n || note.len() != n || values.len() != n * 3 * ch {
-        return Err(UsageError::new_err(format!(
+        return Err(usage_error(format!(
             "the columns disagree: {n} opcodes, {} x, {} dx, {} values (expected {} = {n} × 3 × {ch})",
             x.len(),
             dx.len(),
@@ -437,7 +454,7 @@ fn encode_trace<'py>(
     let mut stream = Vec::with_capacity(n);
     for k in 0..n {
         let op = Opcode::from_code(code[k]).ok_or_else(|| {
-            UsageError::new_err(format!(
+            usage_error(format!(
                 "instruction {k}: no opcode has the code {}",
                 code[k]
             ))
@@ -445,7 +462,7 @@ fn encode_trace<'py>(
         let i =
             Instruction::from_operands(op, x[k], dx[k], dx[k], &values[k * 3 * ch..][..3 * ch], ch);
         i.check(&header).map_err(|e| {
-            UsageError::new_err(format!("instruction {k} ({}): {}", op.name(), e.message()))
+            usage_error(format!("instruction {k} ({}): {}", op.name(), e.message()))
         })?;
         stream.push(i);
     }
@@ -519,7 +536,7 @@ fn replay<'py>(
         })
         .map_err(|e| match e {
             Refused::Input(m) => SceneError::new_err(m),
-            Refused::Usage(m) => UsageError::new_err(m),
+            Refused::Usage(m) => usage_error(m),
         })?;
     let out = run_dict(py, image, &stats, &array, &array.numeric)?;
     out.set_item("height", header.lines)?;
@@ -531,7 +548,7 @@ fn replay<'py>(
 struct Done {
     image: Image,
     rendered: Rendered,
-    summary: Vec<(&'static str, String)>,
+    summary: Vec<(String, String)>,
     renderer: &'static str,
     phrase: String,
     scene: String,
@@ -592,7 +609,7 @@ fn drawn_and_rendered(
     let rendered = render_frames(r, array, settings.threads, &mut sink, taps)?;
     Ok(Done {
         image: sink.finish()?,
-        summary: r.summary_rows(&rendered.counters, &rendered.stats),
+        summary: cwisim_render::summary::render_rows(&drawn, &rendered, &array.numeric),
         rendered,
         renderer: r.name(),
         phrase: r.settings_phrase(),
@@ -626,7 +643,7 @@ fn render<'py>(
     threads: usize,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    cwisim_scene::budget::check_threads(threads).map_err(UsageError::new_err)?;
+    cwisim_scene::budget::check_threads(threads).map_err(usage_error)?;
     let (settings, given) = settings_of(&settings, threads)?;
     let array = array_config(numeric, timing, machine)?;
     let input = match (scene, scene_json) {
@@ -671,7 +688,7 @@ fn study_to_py(e: StudyError) -> PyErr {
         StudyError::Render(e) => to_py(e),
         StudyError::Trace(e) => SceneError::new_err(e.to_string()),
         StudyError::Machine(_) | StudyError::ImageLimit(_) | StudyError::Usage(_) => {
-            UsageError::new_err(e.to_string())
+            usage_error(e.to_string())
         }
         StudyError::Array(_) | StudyError::Plot(_) => CwisimError::new_err(e.to_string()),
         StudyError::Cancelled => PyKeyboardInterrupt::new_err("interrupted"),
@@ -719,12 +736,12 @@ impl TradeoffPlan {
         let size = size
             .map(|s| s.parse::<cwisim_render::Size>())
             .transpose()
-            .map_err(|e| UsageError::new_err(format!("size: {e}")))?;
+            .map_err(|e| usage_error(format!("size: {e}")))?;
         let formats = numeric
             .iter()
             .map(|f| f.parse::<Numeric>())
             .collect::<Result<Vec<_>, _>>()
-            .map_err(|e| UsageError::new_err(format!("numeric: {e}")))?;
+            .map_err(|e| usage_error(format!("numeric: {e}")))?;
         let machine = match machine {
             Some(path) => Machine::from_file(Path::new(path)).map_err(|e| to_py(e.into()))?,
             None => Machine::default(),
@@ -764,7 +781,7 @@ impl TradeoffPlan {
     #[pyo3(signature = (g, repeat=3))]
     fn measure(&self, py: Python<'_>, g: usize, repeat: u32) -> PyResult<String> {
         if g >= self.plan.groups.len() {
-            return Err(UsageError::new_err(format!(
+            return Err(usage_error(format!(
                 "group {g} of a plan of {}",
                 self.plan.groups.len()
             )));
@@ -803,9 +820,9 @@ fn fit<'py>(
     machine: Option<&str>,
     threads: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
-    cwisim_scene::budget::check_threads(threads).map_err(UsageError::new_err)?;
+    cwisim_scene::budget::check_threads(threads).map_err(usage_error)?;
     if !(max_error.is_finite() && max_error > 0.0) {
-        return Err(UsageError::new_err(format!(
+        return Err(usage_error(format!(
             "max_error: the error budget must be finite and > 0, found {max_error}"
         )));
     }
@@ -813,7 +830,7 @@ fn fit<'py>(
         "saturate" => Overflow::Saturate,
         "wrap" => Overflow::Wrap,
         other => {
-            return Err(UsageError::new_err(format!(
+            return Err(usage_error(format!(
                 "overflow: unknown `{other}`; expected saturate or wrap"
             )))
         }
@@ -894,14 +911,14 @@ fn refine<'py>(
     machine: Option<&str>,
     threads: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
-    cwisim_scene::budget::check_threads(threads).map_err(UsageError::new_err)?;
-    let phases = parse_phases(phases).map_err(UsageError::new_err)?;
+    cwisim_scene::budget::check_threads(threads).map_err(usage_error)?;
+    let phases = parse_phases(phases).map_err(usage_error)?;
     let (settings, given) = settings_of(&settings, 1)?;
     registry::find("refine")
         .map_err(to_py)?
         .check_given(&given, &settings)
-        .map_err(UsageError::new_err)?;
-    settings.check().map_err(UsageError::new_err)?;
+        .map_err(usage_error)?;
+    settings.check().map_err(usage_error)?;
     let array = array_config("f64", "fast", machine)?;
     let mut run = interruptible(py, |cancel| {
         let setup = RefineSetup {
@@ -958,7 +975,7 @@ fn refine<'py>(
 
 /// Scanline `line` asked of a trace that outputs only `lines`.
 fn beyond_trace(line: u64, lines: u64) -> PyErr {
-    UsageError::new_err(format!(
+    usage_error(format!(
         "line {line}: the trace outputs {lines} scanline(s), 0..{lines}"
     ))
 }
@@ -1116,6 +1133,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(default_formats, m)?)?;
     m.add_function(wrap_pyfunction!(default_tessellations, m)?)?;
     m.add_function(wrap_pyfunction!(pareto, m)?)?;
+    m.add_function(wrap_pyfunction!(keyword_spelling_py, m)?)?;
     m.add_class::<TradeoffPlan>()?;
     Ok(())
 }

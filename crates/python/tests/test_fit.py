@@ -3,22 +3,15 @@
 from __future__ import annotations
 
 import os
-import subprocess
-from pathlib import Path
 
 import pytest
+from conftest import cli
 
 import cwisim
 
-ROOT = Path(__file__).resolve().parents[3]
-
 
 def test_fit_finds_the_command_line_s_registers(tmp_path):
-    binary = Path(os.environ.get("CWISIM_BIN", ROOT / "target" / "release" / "cwisim"))
-    out = subprocess.run(
-        [str(binary), "fit", "fig25", "--max-error", "1/256", "--threads", "1"],
-        cwd=tmp_path, capture_output=True, text=True, check=False,
-    )
+    out = cli("fit", "fig25", "--max-error", "1/256", "--threads", "1", cwd=tmp_path)
     assert out.returncode == 0, out.stderr
     printed = dict(
         (line[:16].strip(), line[16:].strip()) for line in out.stdout.splitlines() if line[:16].strip()
@@ -42,11 +35,7 @@ def test_a_budget_out_of_reach_is_refused():
 
 
 def test_refine_measures_the_command_line_s_phases(tmp_path):
-    binary = Path(os.environ.get("CWISIM_BIN", ROOT / "target" / "release" / "cwisim"))
-    out = subprocess.run(
-        [str(binary), "refine", "still-life", "--size", "120x80", "--csv", "r.csv"],
-        cwd=tmp_path, capture_output=True, text=True, check=False,
-    )
+    out = cli("refine", "still-life", "--size", "120x80", "--csv", "r.csv", cwd=tmp_path)
     assert out.returncode == 0, out.stderr
     import csv
 

@@ -1,37 +1,23 @@
 """The Python package against the command line it must not drift from: the same images,
 the same refusals with the same messages, the same per-scanline records.
 
-The command line is the release binary (``cargo build --release``), or ``$CWISIM_BIN``.
+The command line is conftest.py's: the binary crates/python/install.sh builds, or
+``$CWISIM_BIN``.
 """
 
 from __future__ import annotations
 
 import json
 import os
-import subprocess
+import pickle
 import threading
-from pathlib import Path
+import traceback
 
 import numpy as np
 import pytest
+from conftest import cli
 
 import cwisim
-
-ROOT = Path(__file__).resolve().parents[3]
-
-
-def cli_binary() -> Path:
-    path = Path(os.environ.get("CWISIM_BIN", ROOT / "target" / "release" / "cwisim"))
-    if not path.exists():
-        pytest.fail(f"{path}: no cwisim binary; build it with `cargo build --release`")
-    return path
-
-
-def cli(*args: str, cwd: Path) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [str(cli_binary()), *args], cwd=cwd, capture_output=True, text=True, check=False
-    )
-
 
 SCENES = list(cwisim.scenes())
 RENDERERS = [r.name for r in cwisim.renderers()]
@@ -57,7 +43,10 @@ def test_every_image_is_the_command_line_s_npy_byte_for_byte(tmp_path, scene, re
         assert out.returncode == 2, out.stderr
         with pytest.raises(cwisim.UsageError) as refused:
             cwisim.render(scene, renderer)
-        assert out.stderr.strip() == f"error: {refused.value}"
+        # the same message, its flags spoken as keyword arguments
+        said = out.stderr.strip().removeprefix("error: ")
+        assert str(refused.value) == cwisim._native.keyword_spelling(said)
+        assert "--" not in str(refused.value), refused.value
         return
     r = cwisim.render(scene, renderer)
     expected = np.load(tmp_path / "a.npy")
@@ -129,7 +118,7 @@ def test_bad_input_raises_the_located_error():
         cwisim.render("no-such-scene")
     with pytest.raises(cwisim.UsageError, match=r"^numeric: "):
         cwisim.render("pot", numeric="f16")
-    with pytest.raises(cwisim.UsageError, match=r"^--size 60000x60000: the image would hold"):
+    with pytest.raises(cwisim.UsageError, match=r"^size=\(60000, 60000\): the image would hold"):
         cwisim.render("pot", size=(60000, 60000))
     assert issubclass(cwisim.SceneError, cwisim.CwisimError)
     assert issubclass(cwisim.UsageError, cwisim.CwisimError)
@@ -201,3 +190,118 @@ def test_progress_is_told_of_every_scanline_and_may_stop_the_render():
 
     with pytest.raises(Enough):
         cwisim.render("pot", size=(64, 48), progress=stop)
+
+
+def printed_rows(text: str):
+    """The rows `cwisim render` prints: `(label, text)`, a text's continuation lines
+    (indented to column 13) kept in it."""
+    rows = []
+    for line in text.splitlines():
+        if line[:13].strip():
+            rows.append([line[:13].strip(), line[13:]])
+        elif line.strip() and rows:
+            rows[-1][1] += "\n" + line
+    return [tuple(r) for r in rows]
+
+
+@pytest.mark.parametrize(
+    "scene,renderer,more",
+    [
+        ("pot", "vanrij", {}),
+        ("still-life", "sbuffer", {}),
+        ("pot", "refine", {"size": (64, 48)}),
+        ("fig25", "vanrij", {"numeric": "f32"}),
+        ("fig25", "vanrij", {"numeric": "fixed:I=4.6,dI=4.6,ddI=1.6"}),
+    ],
+)
+def test_the_summary_is_the_command_line_s(tmp_path, scene, renderer, more):
+    """Row for row, label and text, but for the wall times and the files written."""
+    args = ["render", scene, "--renderer", renderer, "-o", "x.png"]
+    for k, v in more.items():
+        args += [f"--{k}", v if isinstance(v, str) else f"{v[0]}x{v[1]}"]
+    out = cli(*args, cwd=tmp_path)
+    assert out.returncode == 0, out.stderr
+    printed = [r for r in printed_rows(out.stdout) if r[0] not in ("time", "wrote")]
+    r = cwisim.render(scene, renderer, **more)
+    assert r.summary == printed
+    labels = [label for label, _ in r.summary]
+    assert labels[0] == "scene" and {"Y-processor", "instructions", "cycles", "worst line"} <= set(labels)
+    if scene == "pot" and renderer == "vanrij":
+        assert labels[:3] == ["scene", "geometry", "visibility"]
+    if "numeric" in more:
+        assert "overflows" in labels
+
+
+@pytest.mark.parametrize("cls", [cwisim.CwisimError, cwisim.SceneError, cwisim.UsageError])
+def test_the_errors_are_cwisim_s_and_pickle(cls):
+    """They belong to the package (a traceback says `cwisim.UsageError`), and pickle, as a
+    Dask worker sends them home."""
+    assert cls.__module__ == "cwisim" and cls is getattr(cwisim, cls.__name__)
+    e = cls("what went wrong, and where")
+    back = pickle.loads(pickle.dumps(e))
+    assert type(back) is cls and str(back) == str(e) and back.args == e.args
+    said = "".join(traceback.format_exception_only(type(e), e))
+    assert said.startswith(f"cwisim.{cls.__name__}: what went wrong")
+
+
+def test_a_raised_error_pickles():
+    with pytest.raises(cwisim.UsageError) as raised:
+        cwisim.render("pot", "nope")
+    back = pickle.loads(pickle.dumps(raised.value))
+    assert type(back) is cwisim.UsageError and str(back) == str(raised.value)
+    data = cwisim.scene("pot")
+    del data["camera"]
+    with pytest.raises(cwisim.SceneError) as raised:
+        cwisim.render(data)
+    back = pickle.loads(pickle.dumps(raised.value))
+    assert type(back) is cwisim.SceneError and str(back) == str(raised.value)
+
+
+def test_errors_name_keyword_arguments_not_flags():
+    with pytest.raises(cwisim.UsageError) as refused:
+        cwisim.render("pot", samples=4)
+    assert str(refused.value).startswith("samples= is not used by vanrij"), refused.value
+    assert "--" not in str(refused.value)
+    with pytest.raises(cwisim.UsageError) as refused:
+        cwisim.render("pot", aa="box", shading="phong")
+    assert str(refused.value).startswith('aa="box" (exact) is not drawn with shading="phong"')
+    assert 'use aa="box-centre"' in str(refused.value)
+    with pytest.raises(cwisim.UsageError, match=r'^renderer="nishita" draws Bézier patches'):
+        cwisim.render("pot", "nishita")
+    with pytest.raises(cwisim.UsageError, match=r"^eval0_tolerance= is used with visibility="):
+        cwisim.render("pot", eval0_tolerance=0.1)
+
+
+@pytest.mark.parametrize("scene", [42, 1.5, b"pot", ["pot"]])
+def test_a_scene_of_another_type_says_what_is_taken(scene):
+    with pytest.raises(TypeError, match=r"^scene: expected an embedded scene's name, a scene file's path, or a dict"):
+        cwisim.render(scene)
+    with pytest.raises(TypeError, match=r"a dict"):
+        cwisim.emit(scene)
+    # the calls that read a scene file themselves (a dict is a UsageError there)
+    for call in [cwisim.fit, cwisim.refine]:
+        with pytest.raises(TypeError, match=r": expected an embedded scene's name or a scene file's path, not"):
+            call(scene)
+
+
+def test_a_value_of_the_wrong_form_says_what_is_expected():
+    data = cwisim.scene("pot")
+    data["meshes"][0]["material"]["k_d"] = "red"
+    with pytest.raises(cwisim.SceneError) as bad:
+        cwisim.render(data)
+    message = str(bad.value)
+    assert 'invalid type: string "red", expected a number, or a list of numbers (one per channel)' in message
+    assert "variant" not in message
+    # located in the scene as json.dumps(data, indent=2) prints it
+    line = json.dumps(data, indent=2).splitlines()[int(message.split(":")[0]) - 1]
+    assert '"k_d": "red"' in line, (message, line)
+    data["meshes"][0]["material"]["k_d"] = [0.75]
+    assert cwisim.render(data, size=(32, 32)).image.shape == (32, 32, 1)
+
+
+def test_the_records_as_a_data_frame():
+    r = cwisim.render("pot", size=(64, 48))
+    df = r.lines_frame()
+    assert len(df) == 48 and list(df.columns) == list(r.lines.dtype.names)
+    assert df["busy_cycles"].tolist() == r.lines["busy_cycles"].tolist()
+    assert int(df["late"].sum()) == r.totals["late_lines"]

@@ -3,22 +3,13 @@ against the command line's `emit` and `run`."""
 
 from __future__ import annotations
 
-import os
-import subprocess
-from pathlib import Path
-
 import numpy as np
 import pytest
+from conftest import ROOT, cli
 
 import cwisim
 
-ROOT = Path(__file__).resolve().parents[3]
 ENCODINGS = ["cwt", "jsonl", "cwb"]
-
-
-def cli(*args: str, cwd: Path) -> subprocess.CompletedProcess:
-    binary = Path(os.environ.get("CWISIM_BIN", ROOT / "target" / "release" / "cwisim"))
-    return subprocess.run([str(binary), *args], cwd=cwd, capture_output=True, text=True, check=False)
 
 
 def same(a: cwisim.Stream, b: cwisim.Stream, notes: bool = True) -> bool:

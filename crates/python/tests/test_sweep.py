@@ -6,24 +6,15 @@ from __future__ import annotations
 import csv
 import io
 import os
-import subprocess
 import time
-from pathlib import Path
 
 import pytest
+from conftest import cli
 
 import cwisim
 from cwisim import sweep
 
-ROOT = Path(__file__).resolve().parents[3]
 GRID = dict(size=(96, 96), renderers=["vanrij", "woo-chall", "sbuffer"], numeric=["f64", "f32"])
-
-
-def cli_binary() -> Path:
-    path = Path(os.environ.get("CWISIM_BIN", ROOT / "target" / "release" / "cwisim"))
-    if not path.exists():
-        pytest.fail(f"{path}: no cwisim binary; build it with `cargo build --release`")
-    return path
 
 
 @pytest.fixture(scope="module")
@@ -32,11 +23,9 @@ def local():
 
 
 def test_the_rows_are_the_command_line_s(tmp_path, local):
-    out = subprocess.run(
-        [str(cli_binary()), "tradeoff", "still-life", "--size", "96x96",
-         "--renderers", "vanrij,woo-chall,sbuffer", "--numeric", "f64;f32",
-         "--repeat", "1", "--csv", "t.csv"],
-        cwd=tmp_path, capture_output=True, text=True, check=False,
+    out = cli(
+        "tradeoff", "still-life", "--size", "96x96", "--renderers", "vanrij,woo-chall,sbuffer",
+        "--numeric", "f64;f32", "--repeat", "1", "--csv", "t.csv", cwd=tmp_path,
     )
     assert out.returncode == 0, out.stderr
     rows = list(csv.DictReader(io.StringIO((tmp_path / "t.csv").read_text())))
@@ -44,6 +33,10 @@ def test_the_rows_are_the_command_line_s(tmp_path, local):
     for k, (theirs, ours) in enumerate(zip(rows, local)):
         for field, value in theirs.items():
             if field in ("host_ms",):
+                continue
+            if field in cwisim.NOT_APPLICABLE:
+                # the CSV's `-` is None
+                assert value == ("-" if ours[field] is None else ours[field]), (k, field)
                 continue
             if field.startswith("counter_"):
                 mine = ours["counters"].get(field[len("counter_"):])
@@ -79,8 +72,10 @@ def test_a_dask_cluster_of_two_workers_gives_the_local_rows(local):
 
 
 def test_a_bad_sweep_is_refused_before_any_task():
-    with pytest.raises(cwisim.UsageError, match="draws several frames"):
+    with pytest.raises(cwisim.UsageError, match="draws several frames") as refused:
         cwisim.tradeoff("pot", renderers=["refine"])
+    # a command it quotes is the command line's, as written
+    assert "`cwisim render --renderer refine` prints its phases" in str(refused.value)
     with pytest.raises(cwisim.UsageError, match="^numeric: "):
         cwisim.tradeoff("pot", numeric="f16")
     with pytest.raises(cwisim.UsageError, match="tradeoff takes a scene file"):
@@ -103,3 +98,44 @@ def test_settings_times_scenes_here_and_on_dask():
     ) as cluster, distributed.Client(cluster) as client:
         there = cwisim.tradeoff(scenes, client=client, **grid)
     assert sweep.compare(rows, there) == []
+
+
+def test_what_does_not_apply_is_none(local):
+    """`-` nowhere: a field that does not apply to a row is None, in every column."""
+    assert not [(k, f) for k, r in enumerate(local) for f, v in r.items() if v == "-"]
+    woo = [r for r in local if r["renderer"] == "woo-chall"]
+    assert woo and all(r["aa"] is None and r["samples"] >= 1 for r in woo)
+    van = [r for r in local if r["renderer"] == "vanrij"]
+    assert van and all(r["aa"] is not None and r["samples"] is None for r in van)
+    fig = cwisim.tradeoff("fig25", repeat=1, renderers=["vanrij"], numeric="f64")
+    assert all(r["shadows"] is None and r["visibility"] is None for r in fig)
+
+
+def test_a_renderer_left_out_is_a_warning_as_the_command_line_says(tmp_path):
+    grid = dict(size=(32, 32), numeric="f64", repeat=1)
+    with pytest.warns(cwisim.TradeoffWarning) as told:
+        rows = cwisim.tradeoff("pot", **grid)
+    out = cli("tradeoff", "pot", "--size", "32x32", "--numeric", "f64", "--repeat", "1", cwd=tmp_path)
+    assert out.returncode == 0, out.stderr
+    skipped = [line for line in out.stdout.splitlines() if line.startswith("skipped ")]
+    assert skipped and [str(w.message) for w in told] == skipped
+    assert skipped[0].startswith("skipped nishita: the scene has no Bézier patches")
+    assert "nishita" not in {r["renderer"] for r in rows}
+
+
+def test_the_rows_as_a_data_frame(local):
+    df = cwisim.frame(local)
+    assert len(df) == len(local) and "counters" not in df.columns
+    assert df["busy_cycles"].tolist() == [r["busy_cycles"] for r in local]
+    assert df["pareto"].tolist() == [r["pareto"] for r in local]
+
+
+def test_an_error_on_a_dask_worker_comes_home_as_itself():
+    """A worker's cwisim error pickles: the client raises the same class and message."""
+    distributed = pytest.importorskip("dask.distributed")
+    args = cwisim._plan_args("pot", (32, 32), None, None, ["vanrij"], "f64", None)
+    with distributed.LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None
+    ) as cluster, distributed.Client(cluster) as client:
+        with pytest.raises(cwisim.UsageError, match=r"^group 99 of a plan of \d+"):
+            client.submit(sweep.measure_group, args, 99, 1, pure=False).result()

@@ -66,6 +66,7 @@ pub mod settings;
 pub mod source;
 pub mod span;
 pub mod subsample;
+pub mod summary;
 pub mod vanrij;
 pub mod woochall;
 

@@ -628,9 +628,158 @@ impl Settings {
     }
 }
 
+/// The command line's flags that are keyword arguments in Python but not drawing
+/// settings: `--max-error` is `max_error=`.
+const KEYWORD_FLAGS: &[&str] = &[
+    "renderer",
+    "renderers",
+    "numeric",
+    "timing",
+    "machine",
+    "threads",
+    "max-error",
+    "overflow",
+    "phases",
+    "repeat",
+];
+
+/// A message of the command line's, spoken to a caller of keyword arguments (the Python
+/// package): each flag that is a keyword there becomes it, `--samples` → `samples=`, and
+/// a value the flag takes right after it is written as Python would pass it:
+/// `--shading phong` → `shading="phong"`, `--size 640x480` → `size=(640, 480)`,
+/// `--shadows on` → `shadows=True`, `--samples 2` → `samples=2`. Other flags (the
+/// command line's own, `--csv`) stay as they are, and so does a command quoted whole
+/// (`` `cwisim render --renderer refine` ``).
+pub fn keyword_spelling(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for (k, part) in text.split('`').enumerate() {
+        if k > 0 {
+            out.push('`');
+        }
+        let quoted_command = k % 2 == 1 && part.starts_with("cwisim ");
+        if quoted_command {
+            out.push_str(part);
+        } else {
+            out.push_str(&flags_as_keywords(part));
+        }
+    }
+    out
+}
+
+/// [`keyword_spelling`] of text that quotes no command.
+fn flags_as_keywords(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    while let Some(at) = rest.find("--") {
+        let before_ok = rest[..at]
+            .chars()
+            .next_back()
+            .or_else(|| out.chars().next_back())
+            .is_none_or(|c| !(c.is_alphanumeric() || c == '-' || c == '_'));
+        out.push_str(&rest[..at]);
+        rest = &rest[at..];
+        let name_len = rest[2..]
+            .find(|c: char| !(c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-'))
+            .unwrap_or(rest.len() - 2);
+        let name = rest[2..2 + name_len].trim_end_matches('-');
+        let setting = Setting::of_flag(&format!("--{name}"));
+        if !before_ok || name.is_empty() || (setting.is_none() && !KEYWORD_FLAGS.contains(&name)) {
+            out.push_str("--");
+            rest = &rest[2..];
+            continue;
+        }
+        rest = &rest[2 + name.len()..];
+        out.push_str(&name.replace('-', "_"));
+        out.push('=');
+        // the value after it, if it is one the flag takes
+        let Some(after) = rest.strip_prefix(' ') else {
+            continue;
+        };
+        let token_len = after
+            .find(|c: char| c.is_whitespace() || c == ')' || c == '(')
+            .unwrap_or(after.len());
+        let token = after[..token_len].trim_end_matches([',', ';', ':', '.']);
+        if token.is_empty() {
+            continue;
+        }
+        let numeral = token.parse::<f64>().is_ok()
+            || token
+                .chars()
+                .all(|c| c.is_ascii_digit() || c == '.' || c == '/');
+        let takes = match setting {
+            Some(s) => s.set(&mut Settings::default(), token).is_ok(),
+            None => {
+                numeral
+                    || (name == "renderer" || name == "renderers")
+                        && crate::registry::REGISTRY.iter().any(|e| e.name == token)
+                    || name == "numeric" && token.parse::<cwisim_xproc::Numeric>().is_ok()
+                    || matches!(
+                        (name, token),
+                        ("timing", "fast" | "stepped") | ("overflow", "saturate" | "wrap")
+                    )
+            }
+        };
+        if !takes {
+            continue;
+        }
+        let value = match (setting, token) {
+            (Some(Setting::Shadows), "on") | (Some(Setting::MergeSubscanlines), "true") => {
+                "True".to_string()
+            }
+            (Some(Setting::Shadows), "off") | (Some(Setting::MergeSubscanlines), "false") => {
+                "False".to_string()
+            }
+            (Some(Setting::Size), _) if token.split_once('x').is_some() => {
+                let (w, h) = token.split_once('x').unwrap_or_default();
+                format!("({w}, {h})")
+            }
+            _ if numeral => token.to_string(),
+            _ => format!("\"{token}\""),
+        };
+        out.push_str(&value);
+        rest = &after[token.len()..];
+    }
+    out.push_str(rest);
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn messages_speak_in_keywords() {
+        assert_eq!(
+            keyword_spelling(
+                "--samples is not used by vanrij (--samples is for woo-chall, sbuffer, bsp)"
+            ),
+            "samples= is not used by vanrij (samples= is for woo-chall, sbuffer, bsp)"
+        );
+        assert_eq!(
+            keyword_spelling(
+                "--eval0-tolerance is used with --visibility eval0 and --shading gouraud only"
+            ),
+            "eval0_tolerance= is used with visibility=\"eval0\" and shading=\"gouraud\" only"
+        );
+        assert_eq!(
+            keyword_spelling("--size 60000x60000: the image would hold"),
+            "size=(60000, 60000): the image would hold"
+        );
+        assert_eq!(
+            keyword_spelling("--merge-subscanlines is used with --samples 2 or more"),
+            "merge_subscanlines= is used with samples=2 or more"
+        );
+        assert_eq!(
+            keyword_spelling("use --renderer vanrij; --shadows off; --csv out.csv, a-- b"),
+            "use renderer=\"vanrij\"; shadows=False; --csv out.csv, a-- b"
+        );
+        assert_eq!(keyword_spelling("nothing to change"), "nothing to change");
+        // a command quoted whole is the command line's, as written
+        assert_eq!(
+            keyword_spelling("use `--samples 4`; `cwisim render --renderer refine` prints it"),
+            "use `samples=4`; `cwisim render --renderer refine` prints it"
+        );
+    }
 
     #[test]
     fn sizes_parse_print_and_refuse() {

@@ -50,7 +50,11 @@ pub const MAX_WORLD_COORDINATE: f64 = 1e9;
 pub const MAX_TRIANGLES: usize = 4_000_000;
 
 /// One number for every channel, or one per channel.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+///
+/// Read by hand rather than as an untagged enum, so that a value of neither form is
+/// refused saying what is expected (`expected a number, or a list of numbers (one per
+/// channel)`), not that it matched no variant.
+#[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum PerChannel {
     /// The same value in every channel.
@@ -195,13 +199,77 @@ pub struct Transform {
 }
 
 /// A uniform or per-axis scale.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+///
+/// Read by hand (as [`PerChannel`]), so that a value of neither form says what is
+/// expected.
+#[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum Scale {
     /// The same factor on every axis.
     Uniform(f64),
     /// One factor per axis.
     Axes([f64; 3]),
+}
+
+/// A number or a list of numbers, as one of two variants: `one` of a number, `many` of
+/// the list (each element read as `f64`), `expecting` the words for what is expected.
+struct NumberOrList<T> {
+    expecting: &'static str,
+    one: fn(f64) -> T,
+    many: fn(Vec<f64>) -> Result<T, usize>,
+}
+
+impl<'de, T> serde::de::Visitor<'de> for NumberOrList<T> {
+    type Value = T;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str(self.expecting)
+    }
+
+    fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<T, E> {
+        Ok((self.one)(v))
+    }
+
+    fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<T, E> {
+        Ok((self.one)(v as f64))
+    }
+
+    fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<T, E> {
+        Ok((self.one)(v as f64))
+    }
+
+    fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<T, A::Error> {
+        let mut values = Vec::new();
+        while let Some(v) = seq.next_element::<f64>()? {
+            values.push(v);
+        }
+        let n = values.len();
+        (self.many)(values).map_err(|_| serde::de::Error::invalid_length(n, &self))
+    }
+}
+
+impl<'de> Deserialize<'de> for PerChannel {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_any(NumberOrList {
+            expecting: "a number, or a list of numbers (one per channel)",
+            one: PerChannel::All,
+            many: |v| Ok(PerChannel::Each(v)),
+        })
+    }
+}
+
+impl<'de> Deserialize<'de> for Scale {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_any(NumberOrList {
+            expecting: "a number, or a list of 3 numbers (one per axis)",
+            one: Scale::Uniform,
+            many: |v| {
+                <[f64; 3]>::try_from(v)
+                    .map(Scale::Axes)
+                    .map_err(|v| v.len())
+            },
+        })
+    }
 }
 
 /// A surface of revolution about the y axis.

@@ -231,3 +231,49 @@ fn obj_errors_name_the_obj_file_and_line() {
     let e = load_any(&dir.join("s.json")).expect_err("missing obj");
     assert_eq!(e.kind, SceneErrorKind::Io, "{e}");
 }
+
+#[test]
+fn a_number_or_list_of_neither_form_says_what_is_expected() {
+    // (read by hand: an untagged enum would say only that no variant matched)
+    let (m, k, line) = fault(r#""k_d": 0.6"#, r#""k_d": "red""#);
+    assert_eq!((k, line), (SceneErrorKind::Schema, Some(7)), "{m}");
+    assert!(
+        m.contains(
+            r#"invalid type: string "red", expected a number, or a list of numbers (one per channel)"#
+        ),
+        "{m}"
+    );
+    assert!(!m.contains("variant"), "{m}");
+    let (m, _, _) = fault(r#""k_d": 0.6"#, r#""k_d": [0.6, "x", 1]"#);
+    assert!(
+        m.contains(r#"invalid type: string "x", expected f64"#),
+        "{m}"
+    );
+    let (m, _, _) = fault(r#""ambient": 0.2"#, r#""ambient": {"r": 1}"#);
+    assert!(
+        m.contains("invalid type: map, expected a number, or a list"),
+        "{m}"
+    );
+    // both forms still read
+    parse_any(&GOOD.replacen(r#""k_d": 0.6"#, r#""k_d": [0.6]"#, 1), None).expect("a list");
+    let scaled = r#""faces": [[0, 1, 2]], "transform": { "scale": "#;
+    for (scale, ok) in [
+        ("2", true),
+        ("[1, 2, 1]", true),
+        ("[1, 2]", false),
+        ("true", false),
+    ] {
+        let text = GOOD.replacen(r#""faces": [[0, 1, 2]]"#, &format!("{scaled}{scale} }}"), 1);
+        match parse_any(&text, None) {
+            Ok(_) => assert!(ok, "{scale}"),
+            Err(e) => {
+                assert!(!ok, "{scale}: {e}");
+                assert!(
+                    e.to_string()
+                        .contains("expected a number, or a list of 3 numbers (one per axis)"),
+                    "{e}"
+                );
+            }
+        }
+    }
+}

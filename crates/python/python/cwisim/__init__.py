@@ -18,6 +18,7 @@ import contextlib
 import json
 import os
 import tempfile
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple, Union
@@ -40,6 +41,7 @@ __all__ = [
     "setting_names",
     "tradeoff",
     "mark_pareto",
+    "TradeoffWarning",
     "frame",
     "Stream",
     "emit",
@@ -55,6 +57,11 @@ __all__ = [
 #: A scene: an embedded scene's name or a scene file's path (``None``: the default,
 #: ``pot``), or the scene itself as Python data (the JSON scene as dicts and lists).
 SceneLike = Union[str, "os.PathLike[str]", Mapping[str, Any], None]
+
+
+class TradeoffWarning(UserWarning):
+    """A renderer :func:`tradeoff` leaves out of its grid, and why (the command line's
+    ``skipped nishita: …``)."""
 
 
 def scenes() -> Dict[str, str]:
@@ -99,7 +106,12 @@ class Render:
     ``ready``, ``deadline``, ``slack``, ``late``, ``overflows``, ``suppressed``, … and a
     count per opcode, ``SetI`` … ``Nop``). ``counters``: the renderer's own figures by
     name; ``totals``: the array's (instructions, cycles, late lines, …); ``summary``: the
-    renderer's summary rows, as ``cwisim render`` prints them.
+    rows ``(label, text)`` of the summary ``cwisim render`` prints, but for its wall
+    times (``time``) and the files it wrote (``wrote``): ``scene``, the renderer's own
+    rows (``geometry``, ``visibility``, …), ``Y-processor`` (its counters),
+    ``instructions``, ``cycles``, ``worst line``, and ``late`` and ``overflows`` when they
+    apply. A text of several lines continues as the command line prints it, indented to
+    column 13: ``print(f"{label:12} {text}")`` prints the rows as it does.
     """
 
     image: np.ndarray
@@ -127,11 +139,9 @@ class Render:
         return self.image[k * self.height : (k + 1) * self.height]
 
     def lines_frame(self):
-        """The per-scanline records as a pandas DataFrame (pandas is not a dependency
-        of cwisim: install it to use this)."""
-        import pandas as pd  # noqa: PLC0415 (optional)
-
-        return pd.DataFrame(self.lines)
+        """The per-scanline records as a pandas DataFrame, a row per scanline (pandas:
+        installed by ``crates/python/install.sh``; not needed by the rest of cwisim)."""
+        return _pandas().DataFrame(self.lines)
 
     def __repr__(self) -> str:
         late = int(self.lines["late"].sum()) if len(self.lines) else 0
@@ -155,8 +165,25 @@ def _spelled(name: str, value: Any) -> str:
     return str(value)
 
 
+def _pandas():
+    """pandas, or an ImportError saying how to install it."""
+    try:
+        import pandas  # noqa: PLC0415 (optional)
+    except ImportError as e:
+        raise ImportError(
+            "cwisim's DataFrames need pandas: `python3 -m pip install pandas` "
+            "(crates/python/install.sh installs it)"
+        ) from e
+    return pandas
+
+
 def _where(scene: SceneLike) -> Dict[str, Any]:
     """The native module's arguments naming a scene."""
+    if scene is not None and not isinstance(scene, (str, os.PathLike, Mapping)):
+        raise TypeError(
+            "scene: expected an embedded scene's name, a scene file's path, or a dict "
+            f"(the scene as Python data, as cwisim.scene(name) gives), not {type(scene).__name__}"
+        )
     if isinstance(scene, Mapping):
         # indented, so that a located error's line and column point into
         # json.dumps(scene, indent=2)
@@ -179,6 +206,11 @@ def _named(scene: SceneLike, what: str) -> Optional[str]:
     if isinstance(scene, Mapping):
         raise UsageError(
             f"{what} takes a scene file or an embedded scene's name (write a dict to a file first)"
+        )
+    if scene is not None and not isinstance(scene, (str, os.PathLike)):
+        raise TypeError(
+            f"{what}: expected an embedded scene's name or a scene file's path, "
+            f"not {type(scene).__name__}"
         )
     return _path(scene)
 
@@ -320,18 +352,30 @@ def tradeoff(
     shares a stream (of every scene) becomes a Dask task, run on the cluster's workers,
     and the rows gathered in the same order — equal to the local sweep's, row for row,
     but for the host times.
+
+    A field that does not apply to a row is ``None``: ``aa`` (a renderer that does not
+    read it), ``samples`` (one that does not supersample), ``visibility``, ``shadows``
+    (a screen scene), ``tessellate`` and ``root_tolerance``. A renderer left out of the
+    grid (``nishita`` on a scene without Bézier patches) is a :class:`TradeoffWarning`
+    saying why, as the command line's ``skipped nishita: …``.
     """
     many = isinstance(scene, (list, tuple))
     plans = [
         _plan_args(one, size, tessellate, shadows, renderers, numeric, machine)
         for one in (scene if many else [scene])
     ]
+    native = [_native.TradeoffPlan(**args) for args in plans]
+    for args, plan in zip(plans, native):
+        # as the command line says `skipped nishita: …`
+        for name, why in plan.skipped():
+            where = f" (scene {args['scene']})" if many else ""
+            warnings.warn(f"skipped {name}{where}: {why}", TradeoffWarning, stacklevel=2)
     if client is not None:
         from . import sweep  # noqa: PLC0415 (Dask is optional)
 
         per_scene = sweep.tradeoff_on(client, plans, repeat)
     else:
-        per_scene = [_measured_here(args, repeat, threads) for args in plans]
+        per_scene = [_measured_here(plan, repeat, threads) for plan in native]
     rows: List[Dict[str, Any]] = []
     for args, scene_rows in zip(plans, per_scene):
         mark_pareto(scene_rows)
@@ -342,9 +386,8 @@ def tradeoff(
     return rows
 
 
-def _measured_here(args: Dict[str, Any], repeat: int, threads: int) -> List[Dict[str, Any]]:
+def _measured_here(plan: Any, repeat: int, threads: int) -> List[Dict[str, Any]]:
     """The rows of one plan, measured in this process on ``threads`` threads, unmarked."""
-    plan = _native.TradeoffPlan(**args)
     rows: List[Dict[str, Any]] = []
     if threads == 1:
         for g in range(plan.groups()):
@@ -359,13 +402,21 @@ def _measured_here(args: Dict[str, Any], repeat: int, threads: int) -> List[Dict
     return rows
 
 
+#: The fields of a tradeoff row that may not apply to its renderer or scene (the CSV's
+#: ``-``); ``None`` in Python, as ``samples``, ``tessellate`` and ``root_tolerance`` are.
+NOT_APPLICABLE = ("aa", "visibility", "shadows")
+
+
 def rows_of(text: str) -> List[Dict[str, Any]]:
     """Rows from the native module's JSON: an exact image's PSNR (infinite, which JSON
-    cannot say) back to ``inf``."""
+    cannot say) back to ``inf``; a field that does not apply (the CSV's ``-``) ``None``."""
     rows = json.loads(text)
     for r in rows:
         if r.get("psnr_db") is None:
             r["psnr_db"] = float("inf")
+        for k in NOT_APPLICABLE:
+            if r.get(k) == "-":
+                r[k] = None
     return rows
 
 
@@ -382,10 +433,8 @@ def mark_pareto(rows: List[Dict[str, Any]]) -> List[Dict[str, Any]]:
 
 def frame(rows: List[Dict[str, Any]]):
     """Rows (of :func:`tradeoff`) as a pandas DataFrame, the renderer's counters left out
-    (pandas is not a dependency of cwisim: install it to use this)."""
-    import pandas as pd  # noqa: PLC0415 (optional)
-
-    return pd.DataFrame([{k: v for k, v in r.items() if k != "counters"} for r in rows])
+    (pandas: installed by ``crates/python/install.sh``; not needed by the rest of cwisim)."""
+    return _pandas().DataFrame([{k: v for k, v in r.items() if k != "counters"} for r in rows])
 
 
 #: Opcode names by binary code (``Stream.instructions["op"]`` holds the names).
