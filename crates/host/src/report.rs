@@ -222,37 +222,7 @@ pub fn unrefreshed_warning(stats: &RunStats) -> Option<String> {
     })
 }
 
-/// The overflow events of a narrow numeric format, in words: how many, in how many
-/// scanlines, and the first scanline that had one (from the per-scanline records, when
-/// they were kept). `None` when there were none.
-pub fn overflow_note(stats: &RunStats) -> Option<String> {
-    let n = stats.totals.overflows;
-    if n == 0 {
-        return None;
-    }
-    let mut hit = stats.lines.iter().filter(|l| l.overflows > 0);
-    Some(match hit.next() {
-        Some(first) => format!(
-            "{n} overflow event(s) in {} scanline(s), the first in scanline {} (the registers are too narrow: see `cwisim fit`)",
-            1 + hit.count(),
-            first.line
-        ),
-        None => format!(
-            "{n} overflow event(s) (the registers are too narrow: see `cwisim fit`)"
-        ),
-    })
-}
-
-/// When every scanline is late because a token cannot even cross the array within one
-/// line period, the reason in words.
-pub fn late_reason(stats: &RunStats) -> Option<String> {
-    (stats.totals.late_lines > 0 && stats.traversal_cycles >= stats.line_period).then(|| {
-        format!(
-            "a token needs {} cycles to cross the array, not less than the line period of {} cycles: no scanline can be ready in time (a narrower image, a faster clock or a longer line period)",
-            stats.traversal_cycles, stats.line_period
-        )
-    })
-}
+pub use cwisim_render::summary::{late_reason, overflow_note};
 
 /// Writes the `--stats` summary.
 pub fn write_summary(
