@@ -472,3 +472,39 @@ fn shards_joined_by_merge_are_the_whole_sweep() {
         "{stderr}"
     );
 }
+
+#[test]
+fn merge_is_budgeted_before_any_part_is_read_and_refuses_what_is_not_a_file() {
+    let dir = scratch("tradeoff-merge-budget");
+    std::fs::write(dir.join("big.csv"), "x,y\n".repeat(1000)).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_cwisim"))
+        .args(["tradeoff", "--merge", "big.csv", "--csv", "out.csv"])
+        .current_dir(&dir)
+        .env("CWISIM_MAX_MEMORY", "8000")
+        .output()
+        .unwrap();
+    let (_, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("merging 1 part(s) of 4000 bytes"),
+        "{stderr}"
+    );
+    assert!(!dir.join("out.csv").exists());
+    // within the budget, the part is read, and found not to be a tradeoff CSV
+    let out = cwisim(
+        &dir,
+        &["tradeoff", "--merge", "big.csv", "--csv", "out.csv"],
+    );
+    let (_, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains(
+            "big.csv:1: not a tradeoff CSV of this cwisim: column 1 is `x`, expected `renderer`"
+        ),
+        "{stderr}"
+    );
+    let out = cwisim(&dir, &["tradeoff", "--merge", "/dev/null"]);
+    let (_, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("/dev/null: not a regular file"), "{stderr}");
+}

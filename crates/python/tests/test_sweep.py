@@ -31,8 +31,11 @@ def test_the_rows_are_the_command_line_s(tmp_path, local):
     rows = list(csv.DictReader(io.StringIO((tmp_path / "t.csv").read_text())))
     assert len(rows) == len(local) > 20
     for k, (theirs, ours) in enumerate(zip(rows, local)):
+        # where the row stands in the sweep, for `tradeoff --merge` (the CSV's own)
+        assert (theirs["setting"], theirs["settings"]) == (str(k), str(len(rows)))
+        assert theirs["sweep"].startswith("still-life:")
         for field, value in theirs.items():
-            if field in ("host_ms",):
+            if field in ("host_ms", "sweep", "setting", "settings"):
                 continue
             if field in cwisim.NOT_APPLICABLE:
                 # the CSV's `-` is None

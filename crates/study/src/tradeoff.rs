@@ -395,16 +395,63 @@ pub fn mark_pareto(rows: &mut [Row]) {
 }
 
 /// Which of the points (bus cycles, register bits, RMS error) are Pareto-optimal: no
-/// other point is at most as large in all three and smaller in one ([`mark_pareto`]).
+/// other point is at most as large in all three and smaller in one ([`mark_pareto`]). A
+/// point whose error is not a number is never optimal, and dominates none.
+///
+/// In O(n log n), so that a merged sweep of a million rows is marked in a moment: a point
+/// dominates only points after it in lexicographic order (cycles, bits, error), so the
+/// points are taken in that order, and each is dominated exactly when a point before it
+/// (not equal to it) has at most its bits and at most its error — a prefix minimum of the
+/// error over the bits seen, kept in a Fenwick tree over the distinct bit counts.
 pub fn pareto(points: &[(u64, u32, f64)]) -> Vec<bool> {
-    points
-        .iter()
-        .map(|&(c, b, e)| {
-            !points
-                .iter()
-                .any(|&(c2, b2, e2)| c2 <= c && b2 <= b && e2 <= e && (c2 < c || b2 < b || e2 < e))
-        })
-        .collect()
+    let mut order: Vec<usize> = (0..points.len())
+        .filter(|&i| !points[i].2.is_nan())
+        .collect();
+    order.sort_by(|&i, &j| {
+        let (a, b) = (points[i], points[j]);
+        (a.0, a.1).cmp(&(b.0, b.1)).then(a.2.total_cmp(&b.2))
+    });
+    let mut bits: Vec<u32> = order.iter().map(|&i| points[i].1).collect();
+    bits.sort_unstable();
+    bits.dedup();
+    // tree[k]: the least error over a range of bit ranks ending at k (1-based), `None`
+    // before any point is entered there
+    let mut tree: Vec<Option<f64>> = vec![None; bits.len() + 1];
+    let rank = |b: u32| bits.partition_point(|&x| x < b) + 1;
+    let least = |a: Option<f64>, b: Option<f64>| match (a, b) {
+        (Some(x), Some(y)) => Some(x.min(y)),
+        (x, None) | (None, x) => x,
+    };
+    let least_up_to = |tree: &[Option<f64>], mut k: usize| {
+        let mut m = None;
+        while k > 0 {
+            m = least(m, tree[k]);
+            k &= k - 1;
+        }
+        m
+    };
+    let mut optimal = vec![false; points.len()];
+    let mut start = 0;
+    while start < order.len() {
+        // a run of equal points: none dominates another, so all are judged before any
+        // is entered
+        let p = points[order[start]];
+        let mut end = start + 1;
+        while end < order.len() && points[order[end]] == p {
+            end += 1;
+        }
+        let dominated = least_up_to(&tree, rank(p.1)).is_some_and(|m| m <= p.2);
+        for &i in &order[start..end] {
+            optimal[i] = !dominated;
+        }
+        let mut k = rank(p.1);
+        while k < tree.len() {
+            tree[k] = least(tree[k], Some(p.2));
+            k += k & k.wrapping_neg();
+        }
+        start = end;
+    }
+    optimal
 }
 
 /// The exact image of the scene SCENE names, at `size`: the box-filtered Gouraud image of
@@ -659,6 +706,47 @@ impl Plan {
             axes,
             references: References::default(),
         })
+    }
+
+    /// Where the rows of groups `groups` (a [`Shard`]'s, or all of them) measured on
+    /// `machine` stand in this sweep: its identity and their first setting's index
+    /// ([`Provenance`]), which [`csv`] writes with every row and [`merge_csv`] checks.
+    pub fn provenance(&self, machine: &Machine, groups: std::ops::Range<usize>) -> Provenance {
+        // FNV-1a over the scene's name, every setting (renderer, drawing settings but the
+        // threads, numeric format) and the machine: two parts agree on it only when they
+        // measure one grid on one machine
+        let name =
+            Source::resolve(self.scene.as_deref()).map_or_else(|_| "scene".into(), |s| s.name());
+        let mut text = format!("{name}\n{machine:?}\n");
+        for s in &self.settings {
+            let settings = Settings {
+                threads: 0,
+                ..s.settings
+            };
+            text.push_str(&format!("{}|{settings:?}|{}\n", s.renderer.name, s.numeric));
+        }
+        let mut hash: u64 = 0xcbf2_9ce4_8422_2325;
+        for b in text.bytes() {
+            hash = (hash ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3);
+        }
+        let safe: String = name
+            .chars()
+            .map(|c| {
+                if c.is_ascii_alphanumeric() || "._-".contains(c) {
+                    c
+                } else {
+                    '_'
+                }
+            })
+            .collect();
+        Provenance {
+            sweep: format!("{safe}:{hash:016x}"),
+            first: self
+                .groups
+                .get(groups.start)
+                .map_or(self.settings.len(), |g| g.start),
+            settings: self.settings.len(),
+        }
     }
 
     /// The rows of group `g` (in the grid's order; none marked Pareto-optimal yet): its
@@ -1165,10 +1253,28 @@ pub const CSV_COLUMNS: [&str; 20] = [
     "pareto",
 ];
 
+/// The CSV's columns that say where each row stands in its sweep: the sweep's identity
+/// (`SCENE:HASH` of its grid and machine), the row's setting's index in the grid (from 0)
+/// and the grid's size. [`merge_csv`] checks with them that parts tile one grid once.
+pub const PROVENANCE_COLUMNS: [&str; 3] = ["sweep", "setting", "settings"];
+
+/// Where a run of rows stands in its sweep ([`Plan::provenance`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Provenance {
+    /// The sweep's identity: `SCENE:HASH`.
+    pub sweep: String,
+    /// The grid index of the first row.
+    pub first: usize,
+    /// The grid's size.
+    pub settings: usize,
+}
+
 /// The table as CSV (one header line, one line per setting). After the fixed columns
-/// come the renderers' own counters, one column `counter_NAME` per name (the union over
-/// the rows, in the order first met), empty where a row's renderer does not count it.
-pub fn csv(rows: &[Row]) -> String {
+/// ([`CSV_COLUMNS`]) come the provenance's ([`PROVENANCE_COLUMNS`]: row `k` is setting
+/// `prov.first + k`) and then the renderers' own counters, one column `counter_NAME` per
+/// name (the union over the rows, in the order first met), empty where a row's renderer
+/// does not count it.
+pub fn csv(rows: &[Row], prov: &Provenance) -> String {
     let mut names: Vec<&'static str> = Vec::new();
     for r in rows {
         for (name, _) in r.counters.iter() {
@@ -1178,12 +1284,16 @@ pub fn csv(rows: &[Row]) -> String {
         }
     }
     let mut s = CSV_COLUMNS.join(",");
+    for c in PROVENANCE_COLUMNS {
+        s.push(',');
+        s.push_str(c);
+    }
     for name in &names {
         s.push_str(",counter_");
         s.push_str(name);
     }
     s.push('\n');
-    for r in rows {
+    for (k, r) in rows.iter().enumerate() {
         s.push_str(&format!(
             "{},{},{},{},{},{},{},{},\"{}\",{},{},{},{},{},{},{:e},{:e},{},{},{}",
             r.renderer,
@@ -1207,6 +1317,12 @@ pub fn csv(rows: &[Row]) -> String {
             r.psnr_db,
             r.overflows,
             r.pareto
+        ));
+        s.push_str(&format!(
+            ",{},{},{}",
+            prov.sweep,
+            prov.first + k,
+            prov.settings
         ));
         for name in &names {
             s.push(',');
@@ -1309,49 +1425,124 @@ fn row_of_fields(f: &[String]) -> Result<Row, String> {
     })
 }
 
-/// A row of a part's CSV: its fixed fields, and its counters by name.
-type CsvRecord = (Vec<String>, Vec<(String, String)>);
+/// A row of a part placed in the grid: the row, its part and line, and the line itself.
+struct Placed<'a> {
+    row: Row,
+    part: usize,
+    line: usize,
+    text: &'a str,
+}
 
-/// Shards' CSVs (`--shard`, each `(its name, its text)`, in shard order) merged into the
-/// whole sweep's: the rows concatenated in order, the counters' columns united (in the
-/// order first seen), and the Pareto column marked again over every row — the CSV a
-/// sweep in one go writes, but for the host times. Also the rows, without their counters,
-/// for the table and the plot. A file that is not such a CSV is refused, located
-/// (`name:line`, the column).
-pub fn merge_csv(parts: &[(String, String)]) -> Result<(String, Vec<Row>), StudyError> {
-    let mut counters: Vec<String> = Vec::new();
-    let mut records: Vec<CsvRecord> = Vec::new();
-    let mut rows = Vec::new();
-    for (name, text) in parts {
-        let mut lines = text.lines().enumerate();
-        let header = match lines.next() {
-            Some((_, h)) => {
-                csv_fields(h).map_err(|e| StudyError::Usage(format!("{name}:1: {e}")))?
+/// The measured figures of a row that must be finite numbers (`psnr_db` may be infinite
+/// where the RMS error is 0: an exact image).
+const FIGURES: [&str; 5] = [
+    "worst_line_share",
+    "host_ms",
+    "max_error",
+    "rms_error",
+    "psnr_db",
+];
+
+/// Refuses a figure of `row` that is not a finite number ≥ 0 (PSNR: any number, or +∞ for
+/// an exact image), naming its column.
+fn check_figures(row: &Row) -> Result<(), String> {
+    let values = [
+        row.worst_line_share,
+        row.host_ms,
+        row.max_error,
+        row.rms_error,
+        row.psnr_db,
+    ];
+    for (name, v) in FIGURES.iter().zip(values) {
+        let fine = match *name {
+            "psnr_db" => v.is_finite() || (v == f64::INFINITY && row.rms_error == 0.0),
+            _ => v.is_finite() && v >= 0.0,
+        };
+        if !fine {
+            return Err(format!(
+                "column `{name}`: {v} is not a measured figure (a finite number{})",
+                if *name == "psnr_db" {
+                    "; +inf only for an exact image"
+                } else {
+                    " ≥ 0"
+                }
+            ));
+        }
+    }
+    if let Some(t) = row.root_tolerance.filter(|t| !t.is_finite()) {
+        return Err(format!(
+            "column `root_tolerance`: {t} is not a finite number"
+        ));
+    }
+    Ok(())
+}
+
+/// The header a part's CSV must start with: [`CSV_COLUMNS`], then [`PROVENANCE_COLUMNS`];
+/// the first column that differs, or is missing, said.
+fn check_header(name: &str, header: &[String]) -> Result<(), StudyError> {
+    let expected: Vec<&str> = CSV_COLUMNS
+        .iter()
+        .chain(&PROVENANCE_COLUMNS)
+        .copied()
+        .collect();
+    for (k, want) in expected.iter().enumerate() {
+        match header.get(k) {
+            Some(found) if found == want => {}
+            Some(found) => {
+                return Err(StudyError::Usage(format!(
+                    "{name}:1: not a tradeoff CSV of this cwisim: column {} is `{found}`, expected `{want}`",
+                    k + 1
+                )))
             }
             None => {
                 return Err(StudyError::Usage(format!(
-                    "{name}: empty, not a tradeoff CSV"
+                    "{name}:1: not a tradeoff CSV of this cwisim: it has {} column(s), and `{want}` (column {}) is missing",
+                    header.len(),
+                    k + 1
                 )))
             }
+        }
+    }
+    Ok(())
+}
+
+/// The CSVs of a sweep's parts (`--shard`, each `(its name, its text)`, in any order)
+/// merged into the whole sweep's — the CSV a sweep in one go writes, but for the host
+/// times: the rows in the grid's order, the counters' columns united (in the grid's order
+/// of first use), and the Pareto column marked again over every row. Also the rows,
+/// without their counters, for the table and the plot.
+///
+/// Strict, so that a partial sweep is never presented as whole: every part must be of one
+/// sweep (the provenance columns' `sweep`: one scene, grid and machine), the parts must
+/// hold every setting of its grid exactly once (a part given twice, parts that overlap and
+/// a part left out are each refused, saying which part and line repeats a setting or which
+/// settings no part holds), and every measured figure must be a finite number (a `NaN`
+/// error is refused at its row and column, never marked Pareto-optimal). A file that is
+/// not such a CSV is refused, located (`name:line`, the column).
+pub fn merge_csv(parts: &[(String, String)]) -> Result<(String, Vec<Row>), StudyError> {
+    let usage = StudyError::Usage;
+    let fixed = CSV_COLUMNS.len() + PROVENANCE_COLUMNS.len();
+    let mut own: Vec<Vec<String>> = Vec::with_capacity(parts.len());
+    // the sweep: its identity, its size, and the part and line that said so first
+    let mut sweep: Option<(String, usize, usize, usize)> = None;
+    // the rows by their setting's index: as many as the parts hold, whatever size the
+    // sweep claims
+    let mut placed: BTreeMap<usize, Placed<'_>> = BTreeMap::new();
+    for (p, (name, text)) in parts.iter().enumerate() {
+        let mut lines = text.lines().enumerate();
+        let header = match lines.next() {
+            Some((_, h)) => csv_fields(h).map_err(|e| usage(format!("{name}:1: {e}")))?,
+            None => return Err(usage(format!("{name}: empty, not a tradeoff CSV"))),
         };
-        if header.len() < CSV_COLUMNS.len() || header[..CSV_COLUMNS.len()] != CSV_COLUMNS {
-            return Err(StudyError::Usage(format!(
-                "{name}:1: not a tradeoff CSV (its columns start {}; expected {})",
-                header.iter().take(3).cloned().collect::<Vec<_>>().join(","),
-                CSV_COLUMNS[..3].join(",")
-            )));
-        }
-        let own: Vec<String> = header[CSV_COLUMNS.len()..]
-            .iter()
-            .map(|c| c.strip_prefix("counter_").unwrap_or(c).to_string())
-            .collect();
-        for c in &own {
-            if !counters.contains(c) {
-                counters.push(c.clone());
-            }
-        }
+        check_header(name, &header)?;
+        own.push(
+            header[fixed..]
+                .iter()
+                .map(|c| c.strip_prefix("counter_").unwrap_or(c).to_string())
+                .collect(),
+        );
         for (k, line) in lines {
-            let at = |e: String| StudyError::Usage(format!("{name}:{}: {e}", k + 1));
+            let at = |e: String| usage(format!("{name}:{}: {e}", k + 1));
             let fields = csv_fields(line).map_err(at)?;
             if fields.len() != header.len() {
                 return Err(at(format!(
@@ -1360,23 +1551,106 @@ pub fn merge_csv(parts: &[(String, String)]) -> Result<(String, Vec<Row>), Study
                     header.len()
                 )));
             }
-            rows.push(row_of_fields(&fields).map_err(at)?);
-            let (fixed, theirs) = fields.split_at(CSV_COLUMNS.len());
-            records.push((
-                fixed.to_vec(),
-                own.iter().cloned().zip(theirs.iter().cloned()).collect(),
-            ));
+            let row = row_of_fields(&fields).map_err(at)?;
+            check_figures(&row).map_err(at)?;
+            let prov = &fields[CSV_COLUMNS.len()..fixed];
+            let number = |v: &str, c: &str| {
+                v.parse::<usize>().map_err(|_| {
+                    at(format!(
+                        "column `{c}`: expected a whole number, found `{v}`"
+                    ))
+                })
+            };
+            let (id, index, size) = (
+                prov[0].as_str(),
+                number(&prov[1], "setting")?,
+                number(&prov[2], "settings")?,
+            );
+            match &sweep {
+                None => sweep = Some((id.to_string(), size, p, k + 1)),
+                Some((first, first_size, fp, fl)) if first != id || *first_size != size => {
+                    return Err(at(format!(
+                        "a row of another sweep ({id}, {size} settings) than {}:{fl}'s ({first}, {first_size} settings): the parts of one sweep share its scene, grid and machine",
+                        parts[*fp].0
+                    )));
+                }
+                Some(_) => {}
+            }
+            if index >= size {
+                return Err(at(format!("setting {index} is past the sweep's {size}")));
+            }
+            if let Some(before) = placed.get(&index) {
+                return Err(at(format!(
+                    "setting {index} again, already at {}:{} (a part given twice, or parts that overlap)",
+                    parts[before.part].0, before.line
+                )));
+            }
+            placed.insert(
+                index,
+                Placed {
+                    row,
+                    part: p,
+                    line: k + 1,
+                    text: line,
+                },
+            );
         }
     }
+    let Some((id, size, _, _)) = sweep else {
+        return Err(usage("the parts hold no row: nothing to merge".into()));
+    };
+    if placed.len() < size {
+        // the first few gaps, found from the indices held (never a walk over `size`)
+        let mut shown = Vec::new();
+        let mut next = 0usize;
+        for &i in placed.keys().chain(std::iter::once(&size)) {
+            shown.extend(
+                (next..i)
+                    .take(8 - shown.len().min(8))
+                    .map(|m| m.to_string()),
+            );
+            next = i + 1;
+            if shown.len() >= 8 {
+                break;
+            }
+        }
+        let missing = size - placed.len();
+        return Err(usage(format!(
+            "setting(s) {}{} of the sweep's {size} are in no part ({missing} missing): a part left out?",
+            shown.join(", "),
+            if missing > shown.len() { ", …" } else { "" },
+        )));
+    }
+    let placed: Vec<Placed<'_>> = placed.into_values().collect();
+    // the counters' columns: each row's own, in the grid's order of first use
+    // (each line split again where it is needed, not held split: a field is a heap block)
+    let mut counters: Vec<&str> = Vec::new();
+    for pl in &placed {
+        let fields = csv_fields(pl.text).expect("parsed once already");
+        for (c, v) in own[pl.part].iter().zip(&fields[fixed..]) {
+            if !v.is_empty() && !counters.contains(&c.as_str()) {
+                counters.push(c);
+            }
+        }
+    }
+    let (lines, mut rows): (Vec<(usize, &str)>, Vec<Row>) = placed
+        .into_iter()
+        .map(|pl| ((pl.part, pl.text), pl.row))
+        .unzip();
     mark_pareto(&mut rows);
     let mut out = CSV_COLUMNS.join(",");
+    for c in PROVENANCE_COLUMNS {
+        out.push(',');
+        out.push_str(c);
+    }
     for c in &counters {
         out.push_str(",counter_");
         out.push_str(c);
     }
     out.push('\n');
-    for ((fixed, theirs), row) in records.iter().zip(&rows) {
-        for (k, v) in fixed.iter().enumerate() {
+    for (index, (&(part, text), row)) in lines.iter().zip(&rows).enumerate() {
+        let fields = csv_fields(text).expect("parsed once already");
+        for (k, v) in fields[..CSV_COLUMNS.len()].iter().enumerate() {
             if k > 0 {
                 out.push(',');
             }
@@ -1390,9 +1664,11 @@ pub fn merge_csv(parts: &[(String, String)]) -> Result<(String, Vec<Row>), Study
                 _ => out.push_str(v),
             }
         }
+        out.push_str(&format!(",{id},{index},{size}"));
+        let theirs = &fields[fixed..];
         for c in &counters {
             out.push(',');
-            if let Some((_, v)) = theirs.iter().find(|(n, _)| n == c) {
+            if let Some((_, v)) = own[part].iter().zip(theirs).find(|(n, _)| n == c) {
                 out.push_str(v);
             }
         }
@@ -1469,16 +1745,21 @@ mod tests {
                 let groups = shard.groups(plan.groups.len());
                 assert_eq!(groups.start, covered);
                 covered = groups.end;
-                let rows = measure_groups(&plan, groups, &machine, 1, 2, &mut |_| {}).unwrap();
+                let rows =
+                    measure_groups(&plan, groups.clone(), &machine, 1, 2, &mut |_| {}).unwrap();
                 assert!(rows.iter().all(|r| !r.pareto));
-                parts.push((format!("part-{index}.csv"), csv(&rows)));
+                let prov = plan.provenance(&machine, groups.clone());
+                parts.push((format!("part-{index}.csv"), csv(&rows, &prov)));
             }
             assert_eq!(covered, plan.groups.len());
             let (merged, rows) = merge_csv(&parts).unwrap();
             assert_eq!(rows.len(), whole.len());
             assert_eq!(
                 without_host_times(&merged),
-                without_host_times(&csv(&whole)),
+                without_host_times(&csv(
+                    &whole,
+                    &plan.provenance(&machine, 0..plan.groups.len())
+                )),
                 "{count} shards"
             );
         }
@@ -1491,7 +1772,101 @@ mod tests {
             e.to_string().starts_with("x.csv:1: not a tradeoff CSV"),
             "{e}"
         );
-        let mut broken = csv(&whole);
+        // in any order
+        let mut parts = Vec::new();
+        for index in (0..3).rev() {
+            let shard = Shard { index, count: 3 };
+            let groups = shard.groups(plan.groups.len());
+            let rows = measure_groups(&plan, groups.clone(), &machine, 1, 1, &mut |_| {}).unwrap();
+            let prov = plan.provenance(&machine, groups);
+            parts.push((format!("part-{index}.csv"), csv(&rows, &prov)));
+        }
+        let (merged, _) = merge_csv(&parts).unwrap();
+        let whole_csv = csv(&whole, &plan.provenance(&machine, 0..plan.groups.len()));
+        assert_eq!(without_host_times(&merged), without_host_times(&whole_csv));
+        // strict: a part twice, a part left out, a part of another sweep, a NaN figure
+        let err = |parts: &[(String, String)]| merge_csv(parts).unwrap_err().to_string();
+        let twice = [
+            parts[0].clone(),
+            parts[1].clone(),
+            parts[2].clone(),
+            parts[0].clone(),
+        ];
+        let e = err(&twice);
+        assert!(
+            e.starts_with("part-2.csv:2: setting ") && e.contains("again, already at part-2.csv:2"),
+            "{e}"
+        );
+        let e = err(&parts[..2]);
+        assert!(
+            e.contains("are in no part") && e.contains("missing): a part left out?"),
+            "{e}"
+        );
+        let other = Plan::new(
+            Some(Path::new("fig25")),
+            size,
+            &[],
+            &[],
+            &renderers,
+            &formats,
+        )
+        .unwrap();
+        let fig = measure_groups(&other, 0..1, &machine, 1, 1, &mut |_| {}).unwrap();
+        let foreign = (
+            "fig.csv".to_string(),
+            csv(&fig, &other.provenance(&machine, 0..1)),
+        );
+        let e = err(&[parts[0].clone(), parts[1].clone(), foreign]);
+        assert!(
+            e.starts_with("fig.csv:2: a row of another sweep (fig25:"),
+            "{e}"
+        );
+        let faster = Machine {
+            clock_hz: machine.clock_hz * 2.0,
+            ..machine.clone()
+        };
+        assert_ne!(
+            plan.provenance(&faster, 0..1).sweep,
+            plan.provenance(&machine, 0..1).sweep,
+            "the machine is part of a sweep's identity"
+        );
+        let at = CSV_COLUMNS.iter().position(|c| *c == "rms_error").unwrap();
+        let mut lines: Vec<String> = parts[0].1.lines().map(str::to_string).collect();
+        let mut f = csv_fields(&lines[1]).unwrap();
+        f[at] = "NaN".into();
+        lines[1] = f
+            .iter()
+            .map(|v| {
+                if v.contains(',') {
+                    format!("\"{v}\"")
+                } else {
+                    v.clone()
+                }
+            })
+            .collect::<Vec<_>>()
+            .join(",");
+        let nan = (parts[0].0.clone(), lines.join("\n"));
+        let e = err(&[nan, parts[1].clone(), parts[2].clone()]);
+        assert!(
+            e.starts_with("part-2.csv:2: column `rms_error`: NaN is not a measured figure"),
+            "{e}"
+        );
+        // an older CSV, without the provenance: the first column missing is named
+        let old: String = parts[0]
+            .1
+            .lines()
+            .next()
+            .unwrap()
+            .split(',')
+            .take(CSV_COLUMNS.len())
+            .collect::<Vec<_>>()
+            .join(",");
+        let e = err(&[("old.csv".into(), old)]);
+        assert!(
+            e.starts_with("old.csv:1: not a tradeoff CSV of this cwisim: it has 20 column(s), and `sweep` (column 21) is missing"),
+            "{e}"
+        );
+        let mut broken = csv(&whole, &plan.provenance(&machine, 0..plan.groups.len()));
         broken = broken.replacen("vanrij", "vanrij-typo", 1);
         let e = merge_csv(&[("y.csv".into(), broken)]).unwrap_err();
         assert!(
@@ -1845,6 +2220,41 @@ mod tests {
         mark_pareto(&mut rows);
         let front: Vec<bool> = rows.iter().map(|r| r.pareto).collect();
         assert_eq!(front, [false, true, true]);
+    }
+
+    /// The brute-force front: every pair compared.
+    fn pareto_by_pairs(points: &[(u64, u32, f64)]) -> Vec<bool> {
+        points
+            .iter()
+            .map(|&(c, b, e)| {
+                !e.is_nan()
+                    && !points.iter().any(|&(c2, b2, e2)| {
+                        c2 <= c && b2 <= b && e2 <= e && (c2 < c || b2 < b || e2 < e)
+                    })
+            })
+            .collect()
+    }
+
+    proptest::proptest! {
+        #[test]
+        fn the_fast_front_is_the_front_of_every_pair(
+            points in proptest::collection::vec(
+                (0u64..6, 0u32..4, proptest::sample::select(vec![0.0, 0.1, 0.2, 0.5, f64::INFINITY, f64::NAN])),
+                0..60,
+            )
+        ) {
+            proptest::prop_assert_eq!(pareto(&points), pareto_by_pairs(&points));
+        }
+    }
+
+    #[test]
+    fn a_nan_error_is_never_on_the_front() {
+        let mut rows = vec![row(100, f64::NAN), row(200, 0.1)];
+        mark_pareto(&mut rows);
+        assert_eq!(
+            rows.iter().map(|r| r.pareto).collect::<Vec<_>>(),
+            [false, true]
+        );
     }
 
     #[test]

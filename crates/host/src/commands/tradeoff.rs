@@ -135,6 +135,7 @@ pub fn run(args: &TradeoffArgs, stdout: &mut dyn Write, progress: bool) -> Resul
         Some(shard) => shard.groups(plan.groups.len()),
         None => 0..plan.groups.len(),
     };
+    let provenance = plan.provenance(&machine, groups.clone());
     let mut rows = measure_groups(
         &plan,
         groups,
@@ -195,11 +196,39 @@ pub fn run(args: &TradeoffArgs, stdout: &mut dyn Write, progress: bool) -> Resul
         )
         .map_err(CliError::Stdout)?,
     }
-    finish(args, stdout, &rows, csv(&rows), &name, args.shard.is_none())
+    let text = csv(&rows, &provenance);
+    finish(args, stdout, &rows, text, &name, args.shard.is_none())
 }
+
+/// The memory `tradeoff --merge` holds per byte of its parts (their text, the rows, the
+/// merged CSV): 5.7 measured on a part of 250,000 rows (57 MB, 326 MB peak), with room
+/// for parts of shorter lines (docs/LIMITS.md).
+const MERGE_BYTES_PER_BYTE: u64 = 8;
 
 /// Runs `cwisim tradeoff --merge`.
 fn merge(args: &TradeoffArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
+    // the parts' sizes against the memory budget before any is read: the merge holds
+    // their text, a row per line and the merged CSV, about MERGE_BYTES_PER_BYTE times
+    // their size (measured: docs/LIMITS.md)
+    let mut size = 0u64;
+    for path in &args.merge {
+        let meta = std::fs::metadata(path)
+            .map_err(|e| CliError::Usage(format!("{}: cannot be read: {e}", path.display())))?;
+        if !meta.is_file() {
+            return Err(CliError::Usage(format!(
+                "{}: not a regular file (a part's CSV is expected)",
+                path.display()
+            )));
+        }
+        size = size.saturating_add(meta.len());
+    }
+    cwisim_scene::budget::Budget::current().check_memory(
+        &format!(
+            "merging {} part(s) of {size} bytes (about {MERGE_BYTES_PER_BYTE} bytes held per byte read)",
+            args.merge.len()
+        ),
+        size.saturating_mul(MERGE_BYTES_PER_BYTE),
+    )?;
     let mut parts = Vec::with_capacity(args.merge.len());
     for path in &args.merge {
         let text = std::fs::read_to_string(path)
