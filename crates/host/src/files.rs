@@ -304,7 +304,64 @@ pub fn trace_output_encoding(path: &Path) -> Result<cwisim_isa::Encoding, CliErr
     }
 }
 
-/// Writes `path` through `fill`, all or nothing (see the module's documentation).
+/// A writer that stops at the output budget (`CWISIM_MAX_OUTPUT`): a write that would
+/// take the file past it fails, and [`Self::over`] says so, so that every output of every
+/// command is held to the one budget.
+struct Budgeted<W: Write> {
+    inner: W,
+    written: u64,
+    limit: u64,
+    over: bool,
+}
+
+impl<W: Write> Budgeted<W> {
+    fn new(inner: W) -> Self {
+        Budgeted {
+            inner,
+            written: 0,
+            limit: cwisim_scene::budget::Budget::current().output_bytes,
+            over: false,
+        }
+    }
+
+    /// The budget's refusal of the output `path`, if a write went past it.
+    fn over(&self, path: &Path) -> Option<CliError> {
+        self.over.then(|| {
+            let budget = cwisim_scene::budget::Budget {
+                output_bytes: self.limit,
+                ..cwisim_scene::budget::Budget::current()
+            };
+            let what = format!("the output {}", path.display());
+            CliError::Budget(
+                budget
+                    .check_output(&what, self.limit.saturating_add(1))
+                    .expect_err("past the budget"),
+            )
+        })
+    }
+}
+
+impl<W: Write> Write for Budgeted<W> {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        if self.written.saturating_add(buf.len() as u64) > self.limit {
+            self.over = true;
+            return Err(io::Error::other(
+                "the output budget (CWISIM_MAX_OUTPUT) is spent",
+            ));
+        }
+        let n = self.inner.write(buf)?;
+        self.written += n as u64;
+        Ok(n)
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        self.inner.flush()
+    }
+}
+
+/// Writes `path` through `fill`, all or nothing (see the module's documentation), within
+/// the output budget (`CWISIM_MAX_OUTPUT`: a file that would grow past it is refused and
+/// not written).
 ///
 /// A regular file's bytes go to a hidden sibling (a [`PartialFile`]), flushed and synced,
 /// then renamed over the path: at once outside a [`transaction`], at its successful end
@@ -319,17 +376,26 @@ where
             .write(true)
             .open(path)
             .map_err(|e| CliError::write(path, e))?;
-        let mut out = BufWriter::new(file);
-        fill(&mut out)?;
+        let mut out = Budgeted::new(BufWriter::new(file));
+        let filled = fill(&mut out);
+        if let Some(over) = out.over(path) {
+            return Err(over);
+        }
+        filled?;
         return out.flush().map_err(|e| CliError::write(path, e));
     }
     let target = resolve_output(path)?;
     let (dir, prefix) = partial_place(&target, path)?;
     let (partial, file) =
         PartialFile::create_in(&dir, &prefix, ".partial").map_err(|e| CliError::write(path, e))?;
-    let mut out = BufWriter::new(file);
-    fill(&mut out)?;
+    let mut out = Budgeted::new(BufWriter::new(file));
+    let filled = fill(&mut out);
+    if let Some(over) = out.over(path) {
+        return Err(over);
+    }
+    filled?;
     let file = out
+        .inner
         .into_inner()
         .map_err(|e| CliError::write(path, e.into_error()))?;
     file.sync_all().map_err(|e| CliError::write(path, e))?;

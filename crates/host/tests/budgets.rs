@@ -184,3 +184,94 @@ fn a_shadow_pass_past_the_budget_is_refused_before_any_light_s_view() {
     );
     assert!(out.status.success(), "{:?}", text(&out));
 }
+
+#[test]
+fn every_command_s_outputs_are_held_to_the_output_budget() {
+    // each output below is larger than 2 KiB: refused, exit 2, the file not made (nor an
+    // old one replaced), the budget named
+    let dir = scratch("budgets-output-every-command");
+    let trace = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../traces/visibility.cwt");
+    let t = trace.to_str().unwrap();
+    std::fs::write(dir.join("old.txt"), b"old").unwrap();
+    // a trace of 8 KiB or so, outside the directory watched
+    let elsewhere = scratch("budgets-output-every-command-input");
+    many_lines(&elsewhere, "long.cwt", 400);
+    let long = elsewhere.join("long.cwt");
+    let long = long.to_str().unwrap();
+    let cases: [(&str, &[&str]); 10] = [
+        (
+            "render --stats-json",
+            &["render", "fig25", "--stats-json", "out.json"],
+        ),
+        (
+            "render --trace",
+            &[
+                "render",
+                "fig25",
+                "--trace",
+                "out.cwt",
+                "--npy",
+                "/dev/null",
+            ],
+        ),
+        (
+            "render -o",
+            &["render", "pot", "--size", "200x200", "-o", "out.png"],
+        ),
+        (
+            "stats --stats-json",
+            &["stats", "fig25", "--stats-json", "out.json"],
+        ),
+        ("emit", &["emit", "fig25", "-o", "out.cwt"]),
+        ("inspect", &["inspect", t, "-o", "out.html"]),
+        ("vcd", &["vcd", t, "--line", "0", "-o", "out.vcd"]),
+        (
+            "rtl",
+            &[
+                "rtl",
+                "--numeric",
+                "fixed:I=2.15,dI=1.16,ddI=1.16",
+                "-o",
+                "out.v",
+            ],
+        ),
+        (
+            "tradeoff --csv",
+            &[
+                "tradeoff",
+                "fig25",
+                "--renderers",
+                "vanrij",
+                "--repeat",
+                "1",
+                "--csv",
+                "out.csv",
+            ],
+        ),
+        ("convert", &["convert", long, "out.jsonl"]),
+    ];
+    for (what, args) in cases {
+        let out = cwisim_env(&dir, &[("CWISIM_MAX_OUTPUT", "2K")], args);
+        let (_, stderr) = text(&out);
+        assert_eq!(out.status.code(), Some(2), "{what}: {stderr}");
+        assert!(
+            stderr.contains("would be larger than 2.0 KiB") && stderr.contains("CWISIM_MAX_OUTPUT"),
+            "{what}: {stderr}"
+        );
+        let left: Vec<String> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|n| n != "old.txt")
+            .collect();
+        assert!(left.is_empty(), "{what} left {left:?}");
+        // and within a budget that holds it, it is written
+        let out = cwisim_env(&dir, &[("CWISIM_MAX_OUTPUT", "64M")], args);
+        assert_eq!(out.status.code(), Some(0), "{what}: {:?}", text(&out));
+        for e in std::fs::read_dir(&dir).unwrap() {
+            let e = e.unwrap();
+            if e.file_name() != "old.txt" {
+                std::fs::remove_file(e.path()).unwrap();
+            }
+        }
+    }
+}

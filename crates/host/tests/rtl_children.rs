@@ -226,3 +226,45 @@ fn a_simulator_that_writes_nothing_is_said_so_and_its_files_removed() {
     assert!(!stderr.contains("cannot write"), "{stderr}");
     assert!(names(&tmp).is_empty(), "left behind: {:?}", names(&tmp));
 }
+
+#[test]
+fn a_cosimulation_past_the_cycle_limit_is_refused_before_it_starts() {
+    if skipped() {
+        return;
+    }
+    let dir = scratch("rtl-children-cycles");
+    let tmp = dir.join("tmp");
+    std::fs::create_dir(&tmp).unwrap();
+    let gouraud = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../traces/gouraud.cwt");
+    let start = Instant::now();
+    let out = rtl(
+        &dir,
+        &tmp,
+        None,
+        &[
+            "--for",
+            gouraud.to_str().unwrap(),
+            "--numeric",
+            FORMAT,
+            "--cosim",
+            "icarus",
+            "--set",
+            "clock_hz=1e12",
+            "-o",
+            "x.v",
+        ],
+    )
+    .output()
+    .unwrap();
+    let (stdout, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("the co-simulation would run 1633986942 cycles")
+            && stderr.contains("over the limit of 200000000"),
+        "{stderr}"
+    );
+    assert!(start.elapsed() < Duration::from_secs(60));
+    assert!(!stdout.contains("wrote"), "{stdout}");
+    assert!(!dir.join("x.v").exists());
+    assert!(names(&tmp).is_empty(), "left behind: {:?}", names(&tmp));
+}

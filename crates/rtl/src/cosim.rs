@@ -60,6 +60,11 @@ fn write_file(path: &Path, text: &str) -> Result<(), RtlError> {
     std::fs::write(path, text).map_err(|e| RtlError::io(path, e))
 }
 
+/// The most cycles a co-simulation may run: the simulators step every cycle, idle ones
+/// too, so a machine whose line period is long (`clock_hz=1e12`) would keep them for hours.
+/// A typical scene takes a few million (the pot at 400×400: 1.5 million).
+pub const MAX_COSIM_CYCLES: u64 = 200_000_000;
+
 /// Co-simulates `trace` on design `d` with `sim` in the (existing, empty) directory
 /// `dir`, watching the token arrivals at `watch`.
 pub fn cosimulate(
@@ -81,6 +86,13 @@ pub fn cosimulate(
     let started = Instant::now();
     let want = expected(d, header, trace, machine, watch)?;
     let reference = started.elapsed();
+    // the simulators step every cycle, idle ones too: said before, refused past the limit
+    if want.cycles > MAX_COSIM_CYCLES {
+        return Err(RtlError::Settings(format!(
+            "the co-simulation would run {} cycles ({} scanline(s) of the machine's line period), over the limit of {MAX_COSIM_CYCLES}: the simulators step every idle cycle; a lower clock_hz (--set clock_hz=…) or a shorter trace",
+            want.cycles, want.lines.len()
+        )));
+    }
     // generous: twice the model's cycles and then some; a hung design stops there
     let limit = want.cycles.saturating_mul(2).saturating_add(1000);
     let stim_path = dir.join(STIMULUS_FILE);

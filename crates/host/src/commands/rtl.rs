@@ -276,7 +276,6 @@ pub fn run(args: &RtlArgs, stdout: &mut dyn Write, progress: bool) -> Result<(),
             format!("max error {e:.4e} against the f64 array"),
         )?;
     }
-    say(out, "wrote", args.output.display().to_string())?;
     if args.area {
         let dir = WorkDir::new(None, "area")?;
         let a = area::synthesize(&design, dir.path()).map_err(rtl_error)?;
@@ -337,5 +336,9 @@ pub fn run(args: &RtlArgs, stdout: &mut dyn Write, progress: bool) -> Result<(),
             }
         }
     }
+    // last: the files are written only when the whole command succeeded (a transaction)
+    let mut written = vec![args.output.display().to_string()];
+    written.extend(args.testbench.iter().map(|t| t.display().to_string()));
+    say(out, "wrote", written.join(", "))?;
     Ok(())
 }
