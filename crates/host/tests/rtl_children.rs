@@ -31,6 +31,29 @@ fn rtl(dir: &Path, tmp: &Path, path: Option<&str>, args: &[&str]) -> Command {
     c
 }
 
+/// `cwisim rtl --for traces/gouraud.cwt --numeric FORMAT --cosim icarus -o x.v EXTRA…`,
+/// run to its end (see [`rtl`]).
+fn cosim_gouraud(
+    dir: &Path,
+    tmp: &Path,
+    path: Option<&str>,
+    extra: &[&str],
+) -> std::process::Output {
+    let gouraud = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../traces/gouraud.cwt");
+    let mut args = vec![
+        "--for",
+        gouraud.to_str().unwrap(),
+        "--numeric",
+        FORMAT,
+        "--cosim",
+        "icarus",
+        "-o",
+        "x.v",
+    ];
+    args.extend_from_slice(extra);
+    rtl(dir, tmp, path, &args).output().unwrap()
+}
+
 /// The names in `dir`.
 fn names(dir: &Path) -> Vec<String> {
     let mut v: Vec<String> = std::fs::read_dir(dir)
@@ -199,24 +222,7 @@ fn a_simulator_that_writes_nothing_is_said_so_and_its_files_removed() {
         bin.display(),
         std::env::var("PATH").unwrap_or_default()
     );
-    let gouraud = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../traces/gouraud.cwt");
-    let out = rtl(
-        &dir,
-        &tmp,
-        Some(&path),
-        &[
-            "--for",
-            gouraud.to_str().unwrap(),
-            "--numeric",
-            FORMAT,
-            "--cosim",
-            "icarus",
-            "-o",
-            "x.v",
-        ],
-    )
-    .output()
-    .unwrap();
+    let out = cosim_gouraud(&dir, &tmp, Some(&path), &[]);
     let (_, stderr) = text(&out);
     assert_eq!(out.status.code(), Some(4), "{stderr}");
     assert!(
@@ -235,27 +241,8 @@ fn a_cosimulation_past_the_cycle_limit_is_refused_before_it_starts() {
     let dir = scratch("rtl-children-cycles");
     let tmp = dir.join("tmp");
     std::fs::create_dir(&tmp).unwrap();
-    let gouraud = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../traces/gouraud.cwt");
     let start = Instant::now();
-    let out = rtl(
-        &dir,
-        &tmp,
-        None,
-        &[
-            "--for",
-            gouraud.to_str().unwrap(),
-            "--numeric",
-            FORMAT,
-            "--cosim",
-            "icarus",
-            "--set",
-            "clock_hz=1e12",
-            "-o",
-            "x.v",
-        ],
-    )
-    .output()
-    .unwrap();
+    let out = cosim_gouraud(&dir, &tmp, None, &["--set", "clock_hz=1e12"]);
     let (stdout, stderr) = text(&out);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(

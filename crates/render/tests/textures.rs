@@ -55,6 +55,28 @@ fn square(dir: &Path, size: u32, a: f64, tilt: f64) -> WorldScene {
     }
 }
 
+/// What the ray cast finds under a hit `h` of mesh 0: its `(u, v)` (from the hit's world
+/// barycentrics and the corners' `(u, v)`) and the test texture's texel there, as the
+/// 8-bit PNG holds it; `None` within 1e-6 texel of a texel's edge, where rounding decides.
+fn texel_under(w: &WorldScene, h: &common::raycast::Hit) -> Option<([f64; 2], f64)> {
+    let face = &w.meshes[0].faces[h.face];
+    let uv = [0, 1].map(|a| {
+        (0..3)
+            .map(|k| h.bary[k] * face.uv[h.corners[k]][a])
+            .sum::<f64>()
+    });
+    let (tx, ty) = (uv[0] * TW as f64, uv[1] * TH as f64);
+    let near_edge = |t: f64| (t - t.round()).abs() < 1e-6;
+    if near_edge(tx) || near_edge(ty) {
+        return None;
+    }
+    let want = texel(
+        (tx.floor() as usize).min(TW - 1),
+        (ty.floor() as usize).min(TH - 1),
+    );
+    Some((uv, (want * 255.0).round() / 255.0))
+}
+
 fn settings(shading: Shading, aa: Antialias, filter: TextureFilter) -> Settings {
     Settings {
         shading,
@@ -128,7 +150,6 @@ fn point_sampling_is_perspective_correct_against_a_ray_cast() {
         &w,
         &settings(Shading::Gouraud, Antialias::None, TextureFilter::Point),
     );
-    let mesh = &w.meshes[0];
     let (mut checked, mut affine_would_differ) = (0, 0);
     for py in 0..size as usize {
         for px in 0..size as usize {
@@ -141,23 +162,9 @@ fn point_sampling_is_perspective_correct_against_a_ray_cast() {
                 continue;
             }
             assert_eq!(h.mesh, 0);
-            // the hit's (u, v) from its world barycentrics and the corners' (u, v)
-            let face = &mesh.faces[h.face];
-            let uv = [0, 1].map(|a| {
-                (0..3)
-                    .map(|k| h.bary[k] * face.uv[h.corners[k]][a])
-                    .sum::<f64>()
-            });
-            let (tx, ty) = (uv[0] * TW as f64, uv[1] * TH as f64);
-            let near_edge = |t: f64| (t - t.round()).abs() < 1e-6;
-            if near_edge(tx) || near_edge(ty) {
+            let Some((uv, want)) = texel_under(&w, &h) else {
                 continue;
-            }
-            let want = texel(
-                (tx.floor() as usize).min(TW - 1),
-                (ty.floor() as usize).min(TH - 1),
-            );
-            let want = (want * 255.0).round() / 255.0;
+            };
             let got = image[py * size as usize + px];
             assert!(
                 (got - want).abs() < 1e-12,
@@ -253,7 +260,6 @@ fn point_filtered_pixels_split_by_a_shared_edge_read_the_texel_under_their_centr
     let dir = texture_dir("point-seam");
     let size = 64u32;
     let w = square(&dir, size, 3.0, -40.0);
-    let mesh = &w.meshes[0];
     for shading in [Shading::Flat, Shading::Gouraud] {
         let image = rendered(&w, &settings(shading, Antialias::Box, TextureFilter::Point));
         let (mut checked, mut split) = (0, 0);
@@ -274,22 +280,12 @@ fn point_filtered_pixels_split_by_a_shared_edge_read_the_texel_under_their_centr
                 let Some(h) = hits(&w, o, d).into_iter().next() else {
                     continue;
                 };
-                let face = &mesh.faces[h.face];
-                let uv = [0, 1].map(|a| {
-                    (0..3)
-                        .map(|k| h.bary[k] * face.uv[h.corners[k]][a])
-                        .sum::<f64>()
-                });
-                let (tx, ty) = (uv[0] * TW as f64, uv[1] * TH as f64);
-                let near_edge = |t: f64| (t - t.round()).abs() < 1e-6;
-                if near_edge(tx) || near_edge(ty) || h.margin.abs() < 1e-9 {
+                if h.margin.abs() < 1e-9 {
                     continue;
                 }
-                let want = texel(
-                    (tx.floor() as usize).min(TW - 1),
-                    (ty.floor() as usize).min(TH - 1),
-                );
-                let want = (want * 255.0).round() / 255.0;
+                let Some((_, want)) = texel_under(&w, &h) else {
+                    continue;
+                };
                 let got = image[py * size as usize + px];
                 assert!(
                     (got - want).abs() < 1e-9,
