@@ -422,11 +422,26 @@ impl ImageFile<'_> {
         }
         let mut file = std::fs::File::open(&self.path).map_err(|e| self.io(e))?;
         // the size the header claims, against the limit before the decoder sees it (a
-        // width of 2^31, beyond PNG's own range, is over the limit, not a decoder's error)
+        // width of 2^31, beyond PNG's own range, is over the limit, not a decoder's
+        // error); the decoder not asked at all when the header is read here, since it
+        // would inflate the chunks before the image data (an iCCP profile) to find it
         let mut head = [0u8; 24];
-        let got = std::io::Read::read(&mut file, &mut head).map_err(|e| self.io(e))?;
-        if let Some((w, h)) = png_header_size(&head[..got]) {
-            self.within_limit(w, h)?;
+        let mut got = 0;
+        while got < head.len() {
+            match std::io::Read::read(&mut file, &mut head[got..]).map_err(|e| self.io(e))? {
+                0 => break,
+                n => got += n,
+            }
+        }
+        if let Some((width, height)) = png_header_size(&head[..got]) {
+            if width == 0 || height == 0 {
+                return Err(self.fail(
+                    SceneErrorKind::Shape,
+                    format!("the image is empty ({width}×{height})"),
+                ));
+            }
+            self.within_limit(width, height)?;
+            return Ok((width, height));
         }
         std::io::Seek::rewind(&mut file).map_err(|e| self.io(e))?;
         let reader =
@@ -455,6 +470,38 @@ impl ImageFile<'_> {
         }
         Ok(())
     }
+}
+
+/// The PNG `bytes` with only its critical chunks (a chunk type whose first letter is upper
+/// case: IHDR, PLTE, IDAT, IEND), which are all the decoder needs for the texels: an
+/// ancillary chunk (a colour profile, text, …) is never inflated, whatever it would
+/// inflate to. Bytes that are not a well-formed sequence of chunks are given back whole,
+/// for the decoder to refuse.
+fn critical_chunks(bytes: &[u8]) -> std::borrow::Cow<'_, [u8]> {
+    const SIGNATURE: &[u8; 8] = b"\x89PNG\r\n\x1a\n";
+    if bytes.len() < 8 || &bytes[..8] != SIGNATURE {
+        return bytes.into();
+    }
+    let mut out = SIGNATURE.to_vec();
+    let mut at = 8;
+    while at < bytes.len() {
+        let Some(head) = bytes.get(at..at + 8) else {
+            return bytes.into();
+        };
+        let len = u32::from_be_bytes([head[0], head[1], head[2], head[3]]) as usize;
+        // length, type, data, CRC
+        let Some(end) = at.checked_add(12).and_then(|e| e.checked_add(len)) else {
+            return bytes.into();
+        };
+        let Some(chunk) = bytes.get(at..end) else {
+            return bytes.into();
+        };
+        if head[4].is_ascii_uppercase() {
+            out.extend_from_slice(chunk);
+        }
+        at = end;
+    }
+    out.into()
 }
 
 /// The width and height a PNG's first 24 bytes claim (the signature, then the IHDR chunk's
@@ -531,8 +578,12 @@ pub fn load(
         .take(MAX_TEXTURE_BYTES + 1)
         .read_to_end(&mut bytes)
         .map_err(|e| file.io(e))?;
+    // ancillary chunks (a colour profile, text) left out before the decoder sees them: an
+    // iCCP profile is inflated whatever its size (a 0.5 MB file took 530 MB), and no
+    // texel depends on one
+    let bytes = critical_chunks(&bytes);
     let mut reader =
-        image::ImageReader::with_format(std::io::Cursor::new(&bytes), image::ImageFormat::Png);
+        image::ImageReader::with_format(std::io::Cursor::new(&*bytes), image::ImageFormat::Png);
     let mut limits = image::Limits::default();
     limits.max_image_width = Some(width);
     limits.max_image_height = Some(height);
