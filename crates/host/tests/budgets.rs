@@ -275,3 +275,72 @@ fn every_command_s_outputs_are_held_to_the_output_budget() {
         }
     }
 }
+
+#[test]
+fn the_memory_budget_holds_tradeoff_fit_refine_and_inspect() {
+    // each holds whole images (8 bytes a value): past the budget it is refused before the
+    // first is made, naming what; within it, it runs
+    let dir = scratch("budgets-memory-studies");
+    let cases: [(&str, &str, &[&str]); 4] = [
+        (
+            "tradeoff",
+            "tradeoff's images",
+            &[
+                "tradeoff",
+                "fig25",
+                "--size",
+                "400x400",
+                "--renderers",
+                "vanrij",
+                "--numeric",
+                "f64",
+                "--repeat",
+                "1",
+            ],
+        ),
+        (
+            "fit",
+            "fit's images",
+            &[
+                "fit",
+                "fig25",
+                "--size",
+                "400x400",
+                "--threads",
+                "1",
+                "--max-error",
+                "1/64",
+            ],
+        ),
+        (
+            "refine",
+            "refine's 2 frame(s) of 200×200×1 values",
+            &[
+                "refine",
+                "pot",
+                "--size",
+                "200x200",
+                "--phases",
+                "flat,gouraud",
+                "--csv",
+                "r.csv",
+            ],
+        ),
+        (
+            "inspect",
+            "the page's images",
+            &["inspect", "fig25", "--size", "400x400", "-o", "p.html"],
+        ),
+    ];
+    for (command, says, args) in cases {
+        let out = cwisim_env(&dir, &[("CWISIM_MAX_MEMORY", "512K")], args);
+        let (_, stderr) = text(&out);
+        assert_eq!(out.status.code(), Some(2), "{command}: {stderr}");
+        assert!(
+            stderr.contains(says) && stderr.contains("over the budget of 512.0 KiB"),
+            "{command}: {stderr}"
+        );
+        let out = cwisim_env(&dir, &[("CWISIM_MAX_MEMORY", "256M")], args);
+        assert_eq!(out.status.code(), Some(0), "{command}: {:?}", text(&out));
+    }
+}

@@ -571,10 +571,38 @@ pub fn fit_scene(
     threads: usize,
     cancel: Option<&AtomicBool>,
 ) -> Result<SceneFit, StudyError> {
-    let exact = crate::tradeoff::exact_image(scene, size)?;
     let header = renderer.header();
+    // the images the search holds (the exact one, the f64 array's, one per thread's
+    // replay), 8 bytes a value, against the memory budget before any is made; the
+    // stream's once it is drawn
+    let values = u64::from(header.width) * u64::from(header.lines) * header.channel_count() as u64;
+    let workers = if threads == 0 {
+        std::thread::available_parallelism().map_or(1, |n| n.get())
+    } else {
+        threads
+    } as u64;
+    let images = (workers + 2).saturating_mul(values).saturating_mul(8);
+    let budget = cwisim_scene::budget::Budget::current();
+    let refuse = |e: cwisim_scene::budget::BudgetError| StudyError::Usage(e.to_string());
+    budget
+        .check_memory(
+            &format!("fit's images ({} of {values} values)", workers + 2),
+            images,
+        )
+        .map_err(refuse)?;
+    let exact = crate::tradeoff::exact_image(scene, size)?;
     let mut instructions: Vec<Instruction> = Vec::new();
     cwisim_render::emit(renderer, &mut instructions)?;
+    let stream = (instructions.len() * std::mem::size_of::<Instruction>()) as u64;
+    budget
+        .check_memory(
+            &format!(
+                "fit's images and its stream of {} instructions",
+                instructions.len()
+            ),
+            images.saturating_add(stream),
+        )
+        .map_err(refuse)?;
     let mut bench = Bench::new(header, &instructions, machine, &exact)?
         .threads(threads)
         .cancel(cancel);

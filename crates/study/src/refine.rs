@@ -209,6 +209,16 @@ fn pass(
     let refine = Refine::with_phases(loaded, settings, &setup.phases)?;
     let h = refine.header();
     let (w, lines, ch) = (h.width as usize, h.lines as usize, h.channel_count());
+    // every frame's image is kept (8 bytes a value), with the cost maps' counts (8 bytes
+    // a pixel) when asked for: against the memory budget before the first is drawn
+    let frames = u64::from(refine.frames());
+    let per_frame = (w * lines) as u64 * (8 * ch as u64 + if setup.cost_maps { 8 } else { 0 });
+    cwisim_scene::budget::Budget::current()
+        .check_memory(
+            &format!("refine's {frames} frame(s) of {w}×{lines}×{ch} values"),
+            frames.saturating_mul(per_frame),
+        )
+        .map_err(|e| StudyError::Usage(e.to_string()))?;
     let mut sink = ImageSink::new(w, ch, ImageSink::DEFAULT_LIMIT_BYTES);
     let mut tap = Tap {
         lines,

@@ -632,6 +632,8 @@ pub struct Plan {
     pub skipped: Vec<(&'static str, String)>,
     axes: Axes,
     references: References,
+    /// Values of one image: width × height × channels.
+    image_values: u64,
 }
 
 impl Plan {
@@ -698,6 +700,11 @@ impl Plan {
                 why.join("; ")
             )));
         }
+        let (w, h) = probe.size();
+        let channels = match &probe {
+            cwisim_world::AnyScene::Screen(s) => s.channel_count(),
+            cwisim_world::AnyScene::World(w) => w.channels(),
+        };
         Ok(Plan {
             scene: scene.map(Path::to_path_buf),
             groups: streams(&settings),
@@ -705,7 +712,36 @@ impl Plan {
             settings,
             axes,
             references: References::default(),
+            image_values: u64::from(w) * u64::from(h) * channels as u64,
         })
+    }
+
+    /// Refuses, before any is made, the images measuring `at_once` groups at a time holds
+    /// past the memory budget (`CWISIM_MAX_MEMORY`): each group's image per format, and the
+    /// references every group is measured against (made once, kept to the end), 8 bytes a
+    /// value.
+    pub fn check_memory(&self, at_once: usize) -> Result<(), StudyError> {
+        let widest = self.groups.iter().map(|g| g.len()).max().unwrap_or(0);
+        let mut keys: Vec<ReferenceKey> = self
+            .settings
+            .iter()
+            .map(|s| reference_key(s, self.axes.world, self.axes.textured))
+            .collect();
+        keys.sort();
+        keys.dedup();
+        let images = (at_once.max(1) * widest + keys.len()) as u64;
+        let what = format!(
+            "tradeoff's images ({images} at once: {} group(s) of up to {widest} format(s) and {} reference(s), {} values each)",
+            at_once.max(1),
+            keys.len(),
+            self.image_values
+        );
+        cwisim_scene::budget::Budget::current()
+            .check_memory(
+                &what,
+                images.saturating_mul(self.image_values).saturating_mul(8),
+            )
+            .map_err(|e| StudyError::Usage(e.to_string()))
     }
 
     /// Where the rows of groups `groups` (a [`Shard`]'s, or all of them) measured on
@@ -771,6 +807,7 @@ impl Plan {
         cancel: Option<&std::sync::atomic::AtomicBool>,
     ) -> Result<Vec<Row>, StudyError> {
         check_repeat(repeat)?;
+        self.check_memory(1)?;
         let scene = self.scene.as_deref();
         let group = &self.settings[self.groups[g].clone()];
         let measured = measure_stream_until(scene, group, machine, repeat, cancel)?;
@@ -843,6 +880,12 @@ pub fn measure_groups(
     progress: &mut dyn FnMut(Step<'_>),
 ) -> Result<Vec<Row>, StudyError> {
     check_repeat(repeat)?;
+    let workers = if threads == 0 {
+        std::thread::available_parallelism().map_or(1, |n| n.get())
+    } else {
+        threads
+    };
+    plan.check_memory(workers.min(groups.len()))?;
     let settings = &plan.settings;
     let first = groups.start;
     let ranges = &plan.groups[groups];
@@ -958,6 +1001,16 @@ struct References {
 /// or any shading's on a textured scene), the tessellation, the shadows.
 type ReferenceKey = (Option<String>, Option<u32>, Option<bool>);
 
+/// The reference `setting` is measured against, as a key ([`References::get`]).
+fn reference_key(setting: &Setting, world: bool, textured: bool) -> ReferenceKey {
+    let shading = setting.settings.shading;
+    (
+        (shading == Shading::Phong || textured).then(|| shading.to_string()),
+        reference_tessellation(setting, world),
+        setting.settings.shadows,
+    )
+}
+
 type Reference = std::sync::Arc<std::sync::Mutex<Option<std::sync::Arc<Vec<f64>>>>>;
 
 impl References {
@@ -972,12 +1025,7 @@ impl References {
         textured: bool,
     ) -> Result<std::sync::Arc<Vec<f64>>, StudyError> {
         let tessellation = reference_tessellation(setting, world);
-        let shading = setting.settings.shading;
-        let key = (
-            (shading == Shading::Phong || textured).then(|| shading.to_string()),
-            tessellation,
-            setting.settings.shadows,
-        );
+        let key = reference_key(setting, world, textured);
         let slot = {
             let mut made = self.made.lock().expect("no reference panicked");
             std::sync::Arc::clone(made.entry(key).or_default())

@@ -541,6 +541,17 @@ pub fn run(args: &InspectArgs, stdout: &mut dyn Write, progress: bool) -> Result
     let runs = if b.is_some() { 2 } else { 1 };
     // the limits, before any scene is rendered or anything replayed
     check_frames(width, lines, frames.1.saturating_sub(frames.0), runs)?;
+    // the frames' images and references (8 bytes a value) and costs (4 a pixel), of every
+    // run, against the memory budget before any is made
+    let pixels = width
+        .saturating_mul(lines)
+        .saturating_mul(frames.1.saturating_sub(frames.0))
+        .saturating_mul(runs);
+    let channels = a.header.channel_count() as u64;
+    cwisim_scene::budget::Budget::current().check_memory(
+        &format!("the page's images ({pixels} pixels of {channels} channel(s), with their references and costs)"),
+        pixels.saturating_mul(16 * channels + 4),
+    )?;
     let window = window(args, width, lines, frames, runs)?;
     let (a, mut reader_a) = a.finish(&args.draw, &args.input, threads, &stage)?;
     let mut b = match (b.take(), &against) {
