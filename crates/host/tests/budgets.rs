@@ -136,6 +136,51 @@ fn nishita_pieces_past_the_budget_are_refused_band_by_band() {
 }
 
 #[test]
+fn woo_chall_s_rows_with_the_image_past_the_budget_are_refused_before_any_row() {
+    // 4000 × 4000 at --samples 8: a 48 MB PNG within 64 MB, but with woo-chall's rows
+    // (64,000 sample columns) it is not (89 MB peak measured, drawn in 27 s, before)
+    let dir = scratch("budget-woo-chall");
+    let args = [
+        "render",
+        "still-life",
+        "--renderer",
+        "woo-chall",
+        "--size",
+        "4000x4000",
+        "--samples",
+        "8",
+        "--threads",
+        "2",
+        "-o",
+        "w.png",
+    ];
+    let out = cwisim_env(&dir, &[("CWISIM_MAX_MEMORY", "64M")], &args);
+    let stderr = refused(&out, "woo-chall's rows of 4000 pixels on 2 thread(s)");
+    assert!(stderr.contains("the image of 4000 scanline(s)"), "{stderr}");
+    assert!(!dir.join("w.png").exists());
+    // without an image, the rows alone are checked (by the renderer, for every caller)
+    let out = cwisim_env(
+        &dir,
+        &[("CWISIM_MAX_MEMORY", "64M")],
+        &[
+            &args[..6],
+            &[
+                "--samples",
+                "32",
+                "--threads",
+                "2",
+                "--stats-json",
+                "s.json",
+            ],
+        ]
+        .concat(),
+    );
+    let stderr = refused(&out, "woo-chall's rows of 4000 pixels on 2 thread(s)");
+    assert!(!stderr.contains("the image"), "{stderr}");
+    assert!(!dir.join("s.json").exists());
+}
+
+#[test]
 fn a_waveform_past_the_budget_is_refused() {
     let dir = scratch("budget-vcd");
     std::fs::write(

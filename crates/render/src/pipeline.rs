@@ -79,6 +79,26 @@ pub struct Rendered {
 /// Bands per thread: enough that uneven bands balance out.
 const BANDS_PER_THREAD: u32 = 8;
 
+/// Refuses, before the first scanline, a renderer whose frames would hold more than the
+/// memory budget while they are emitted ([`Renderer::frame_memory`]).
+pub fn check_frame_memory(renderer: &dyn Renderer, threads: usize) -> Result<(), RenderError> {
+    let bytes = renderer.frame_memory(threads);
+    cwisim_scene::budget::Budget::current()
+        .check_memory(&frame_memory_phrase(renderer, threads), bytes)
+        .map_err(|e| RenderError::Usage(e.to_string()))
+}
+
+/// What [`Renderer::frame_memory`] is for, in a refusal.
+pub fn frame_memory_phrase(renderer: &dyn Renderer, threads: usize) -> String {
+    let h = renderer.header();
+    format!(
+        "{}'s rows of {} pixels on {threads} thread(s) ({})",
+        renderer.name(),
+        h.width,
+        renderer.settings_phrase()
+    )
+}
+
 /// Renders every frame of `renderer` into the array `array`, handing its scanlines to
 /// `lines`, on `threads` threads (0: as many as the machine has; 1: serially, in bands
 /// of rows in stream order).
@@ -93,6 +113,7 @@ pub fn render(
     renderer
         .check_numeric(&array.numeric)
         .map_err(RenderError::Usage)?;
+    check_frame_memory(renderer, threads)?;
     let header = renderer.header();
     let keep = renderer.needs_previous_frame() && renderer.frames() > 1;
     let frame_image = keep.then(|| Rc::new(RefCell::new(empty_image(&header))));

@@ -72,6 +72,15 @@ pub trait Renderer: Sync {
         serde_json::Value::Null
     }
 
+    /// The most memory its frames hold while they are emitted on `threads` threads, in
+    /// bytes, beyond what is built and the image the array shifts out: checked against
+    /// the memory budget (`CWISIM_MAX_MEMORY`) before the first scanline. The default, 0,
+    /// is for renderers whose frames are made before they are emitted (their fragments
+    /// or pieces are part of what is built) and send them a row at a time.
+    fn frame_memory(&self, _threads: usize) -> u64 {
+        0
+    }
+
     /// Refuses a numeric format its stream is not meant for, saying why (a study mode
     /// that relies on exact cancellation in `f64`, say). `render` asks before anything is
     /// sent; the default accepts every format.

@@ -1,7 +1,8 @@
 //! `woo-chall` makes its rows as they are emitted, holding one row's instructions at a
 //! time rather than the frame's: the heap a frame needs grows with the image's side (the
 //! rows' state, the bands of scanlines), not with its area. (One test in this binary: the
-//! counting allocator sees every thread's allocations.)
+//! counting allocator sees every thread's allocations.) `woochall_frame_memory.rs` checks
+//! the bound the memory budget is checked with.
 
 use cwisim_fuzzing::heap::Counting;
 use cwisim_render::{registry, render, ArrayConfig, LoadedScene, Settings, Taps};

@@ -48,6 +48,18 @@ impl ImageArgs {
     /// (a frame, known from the header) of `width × channels` values, 8 bytes each for
     /// `--npy`, 1 for `-o`'s PNG.
     pub fn check_memory(&self, width: u32, channels: usize, lines: u64) -> Result<(), CliError> {
+        self.check_memory_with(width, channels, lines, None)
+    }
+
+    /// [`Self::check_memory`], with `also` (what, bytes) held at the same time: a
+    /// renderer's frames as they are emitted ([`cwisim_render::Renderer::frame_memory`]).
+    pub fn check_memory_with(
+        &self,
+        width: u32,
+        channels: usize,
+        lines: u64,
+        also: Option<(String, u64)>,
+    ) -> Result<(), CliError> {
         let values = lines
             .saturating_mul(u64::from(width))
             .saturating_mul(channels as u64);
@@ -55,7 +67,7 @@ impl ImageArgs {
         if per_value == 0 {
             return Ok(());
         }
-        let what = format!(
+        let mut what = format!(
             "the image of {lines} scanline(s) of {width} × {channels} value(s) ({})",
             match (self.npy.is_some(), self.output.is_some()) {
                 (true, true) => "--npy and -o",
@@ -63,8 +75,13 @@ impl ImageArgs {
                 _ => "-o",
             }
         );
+        let mut bytes = values.saturating_mul(per_value);
+        if let Some((also, more)) = also.filter(|(_, more)| *more > 0) {
+            what = format!("{what} with {also}");
+            bytes = bytes.saturating_add(more);
+        }
         cwisim_scene::budget::Budget::current()
-            .check_memory(&what, values.saturating_mul(per_value))
+            .check_memory(&what, bytes)
             .map_err(CliError::from)
     }
 

@@ -167,7 +167,16 @@ pub fn run_render(
     };
     let h = renderer.header();
     image_args.check(h.channel_count())?;
-    image_args.check_memory(h.width, h.channel_count(), frames_lines_of(renderer))?;
+    let threads = cwisim_scene::budget::resolve_threads(args.threads);
+    image_args.check_memory_with(
+        h.width,
+        h.channel_count(),
+        frames_lines_of(renderer),
+        Some((
+            cwisim_render::pipeline::frame_memory_phrase(renderer, threads),
+            renderer.frame_memory(threads),
+        )),
+    )?;
     let trace_bytes = match &args.trace {
         Some(path) => Some(encode(renderer, path)?),
         None => None,

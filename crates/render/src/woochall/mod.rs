@@ -229,6 +229,18 @@ impl<'a> Scan<'a> {
 /// enough (a few MB) that memory does not grow with the frame.
 const CHUNK_INSTRUCTIONS: usize = 1 << 16;
 
+/// What a frame's rows hold per sample column (`width × l`), an upper bound: the most
+/// measured over the embedded scenes is 2.2 KB (`still-life` at 1600×1200, `--samples 8`,
+/// two threads: the sub-scanlines' winners and colours, the layers behind transparent
+/// surfaces, the shading's and the emitter's rows); `crates/render/tests/woochall_memory.rs`
+/// checks it on every embedded scene. Transparent surfaces stacked deeper than those
+/// scenes' can hold more.
+pub const FRAME_BYTES_PER_SAMPLE_COLUMN: u64 = 3 * 1024;
+
+/// What a frame holds per thread: its chunk of instructions ([`CHUNK_INSTRUCTIONS`], 48
+/// bytes each) and the pipeline's buffers, an upper bound.
+pub const FRAME_BYTES_PER_THREAD: u64 = 4 << 20;
+
 /// One frame, made as it is emitted: the shading state runs from row to row, so bands of
 /// rows are made in order (a band asked for ahead of its turn waits for the bands before
 /// it), the instructions sent in chunks of about [`CHUNK_INSTRUCTIONS`]. Only the
@@ -407,6 +419,17 @@ impl Renderer for WooChall {
             turn: Condvar::new(),
             sorted_triangles,
         }))
+    }
+
+    /// The rows' state (`l` sub-scanlines of samples, their layers, the shading's and the
+    /// emitter's), a bound of [`FRAME_BYTES_PER_SAMPLE_COLUMN`] per sample column, and a
+    /// chunk of instructions with the pipeline's buffers per thread,
+    /// [`FRAME_BYTES_PER_THREAD`].
+    fn frame_memory(&self, threads: usize) -> u64 {
+        let columns = u64::from(self.sampler.width) * u64::from(self.sampler.l);
+        columns
+            .saturating_mul(FRAME_BYTES_PER_SAMPLE_COLUMN)
+            .saturating_add((threads as u64).saturating_mul(FRAME_BYTES_PER_THREAD))
     }
 
     fn settings_phrase(&self) -> String {
