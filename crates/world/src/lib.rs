@@ -12,7 +12,9 @@
 //!    [`face::ScreenTriangle`]s.
 //! 3. [`visibility`] — visible surfaces, two ways ([`Visibility`]): exact object-space
 //!    fragments (polygon booleans with `i_overlay`), or the triangles in front-to-back
-//!    order so that the array's `Eval0` claims hide farther ones.
+//!    order so that the array's `Eval0` claims hide farther ones. [`sweep`] finds the
+//!    visible parts of pieces along a strip slab by slab, with no polygon boolean
+//!    (`nishita`'s strips).
 //! 4. [`to_screen`] — the result as a `cwisim_scene::ScreenScene`.
 //!
 //! [`parse_any`] / [`load_any`] read any scene file (screen or world); [`embedded`] holds
@@ -38,6 +40,7 @@ pub mod project;
 pub mod scene;
 pub mod shade;
 pub mod shadow;
+pub mod sweep;
 pub mod texture;
 pub mod visibility;
 

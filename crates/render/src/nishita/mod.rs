@@ -10,7 +10,7 @@
 //! * [`classify`] — front, back or twisted: the sign of `(S − E)·(S_u × S_v)` over a
 //!   subpatch, exactly (Bernstein coefficients of degree 8 × 8).
 //!
-//! * [`segments`] — visibility along one strip between two row lines: the paper's scan
+//! * [`cwisim_world::sweep`] — visibility along one strip between two row lines: the paper's scan
 //!   segments, slab by slab between the pieces' corners, exact (no polygon boolean).
 //! * [`resolve`] — the bands made and resolved strip by strip, on `--threads`.
 //! * [`merged`] — a patch's visible fragments on a pixel row box-filtered on the host and
@@ -30,7 +30,6 @@ pub mod band;
 pub mod classify;
 pub mod merged;
 pub mod resolve;
-pub mod segments;
 
 use crate::error::RenderError;
 use crate::prepare::{PhongSurfaces, PolygonScene};
@@ -352,9 +351,9 @@ pub struct Nishita {
     /// the polygons are drawn as `vanrij` draws them (`inner`'s).
     merged: Option<merged::Fragments>,
     /// What the scan segments did, when the scene is all patches (visibility strip by
-    /// strip, [`segments`]); `None` when its other meshes share exact visibility with
+    /// strip, [`cwisim_world::sweep`]); `None` when its other meshes share exact visibility with
     /// the pieces.
-    segments: Option<segments::SegmentStats>,
+    segments: Option<cwisim_world::sweep::SegmentStats>,
 }
 
 /// Whether `w` has a Bézier mesh.

@@ -15,12 +15,12 @@
 //! ([`super::merged::Fragments`]), until the rows are emitted.
 
 use super::merged::Fragments;
-use super::segments::{strip_fragments, SegmentStats};
 use super::{check_budget, PatchScene, Pieces};
 use crate::error::RenderError;
 use crate::settings::Settings;
 use cwisim_scene::PackedPolygons;
 use cwisim_world::face::ScreenTriangle;
+use cwisim_world::sweep::{strip_fragments, SegmentStats};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Condvar, Mutex};
 use std::time::{Duration, Instant};

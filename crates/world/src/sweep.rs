@@ -30,8 +30,8 @@
 //! overlapping pieces, and no polygon boolean is needed. The areas are exact up to
 //! rounding: coverage, depth order and intersections are all lines.
 
-use cwisim_world::face::ScreenTriangle;
-use cwisim_world::visibility::Fragment;
+use crate::face::ScreenTriangle;
+use crate::visibility::Fragment;
 
 /// Slabs narrower than this (px) are not cut further (rounding at a crossing).
 const MIN_WIDTH: f64 = 1e-9;
@@ -767,7 +767,7 @@ impl Sweep<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use cwisim_world::visibility::exact_fragments;
+    use crate::visibility::exact_fragments;
     use proptest::prelude::*;
 
     fn piece(points: [[f64; 2]; 3], inv_depth: [f64; 3]) -> ScreenTriangle {
@@ -925,7 +925,7 @@ mod tests {
         fn degenerate_strips_show_the_nearest_piece_everywhere(tris in grid_strip()) {
             // a ray cast is the reference (on such strips the polygon booleans covered a
             // point twice, where a pinched outline got a hole cut: fixed since, and tested
-            // in cwisim_world::visibility)
+            // in crate::visibility)
             let mut stats = SegmentStats::default();
             let fragments = strip_fragments(&tris, 1, &mut stats);
             let points = (0..96).flat_map(|i| {
