@@ -14,7 +14,7 @@
 //!    fragments (polygon booleans with `i_overlay`), or the triangles in front-to-back
 //!    order so that the array's `Eval0` claims hide farther ones. [`sweep`] finds the
 //!    visible parts of pieces along a strip slab by slab, with no polygon boolean
-//!    (`nishita`'s strips).
+//!    (`nishita`'s strips; a frame strip by strip, not yet drawn with).
 //! 4. [`to_screen`] — the result as a `cwisim_scene::ScreenScene`.
 //!
 //! [`parse_any`] / [`load_any`] read any scene file (screen or world); [`embedded`] holds

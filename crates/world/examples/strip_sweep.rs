@@ -1,0 +1,110 @@
+//! Exact visibility pair by pair (`visibility::exact_fragments_on`, one thread) against
+//! strip by strip (`sweep::strip_by_strip`), on the teapot tessellated `N × N` per patch,
+//! the two alternated in one run: the engine issue 54 moves to, measured where it stands.
+//!
+//! ```text
+//! cargo run --release -p cwisim-world --example strip_sweep [N [ROWS [RUNS]]]
+//! ```
+//!
+//! N defaults to 32 (65,280 triangles), ROWS (pixel rows a strip) to 4, RUNS to 5; with
+//! `STACKED=L` the scene is the pot as `L` stacked shells instead (`depth_complexity`'s
+//! `stacked` family). Prints each engine's median wall time, the ratio, the peak heap each
+//! allocated (a counting allocator, the fragments included), their fragments, and the
+//! largest difference between the visible areas they give a triangle (they must agree:
+//! the run stops if not). The figures are in `docs/VISIBILITY.md`.
+
+use cwisim_scene::Shading;
+use cwisim_world::embedded::embedded;
+use cwisim_world::visibility::{exact_fragments_on, Fragment};
+use cwisim_world::{parse_any, AnyScene};
+use std::time::{Duration, Instant};
+
+#[path = "../tests/layers/mod.rs"]
+mod layers;
+
+/// Each source's visible area.
+fn areas(fragments: &[Fragment], n: usize) -> Vec<f64> {
+    let mut out = vec![0.0; n];
+    for f in fragments {
+        let v = &f.polygon.vertices;
+        let o = v[0];
+        out[f.source] += 0.5
+            * (1..v.len() - 1)
+                .map(|i| {
+                    (v[i][0] - o[0]) * (v[i + 1][1] - o[1])
+                        - (v[i][1] - o[1]) * (v[i + 1][0] - o[0])
+                })
+                .sum::<f64>()
+                .abs();
+    }
+    out
+}
+
+fn median(mut v: Vec<Duration>) -> Duration {
+    v.sort();
+    v[v.len() / 2]
+}
+
+fn main() {
+    let arg = |k: usize, default: u32| -> u32 {
+        std::env::args().nth(k).map_or(default, |s| {
+            s.parse().expect("N, ROWS and RUNS are whole numbers")
+        })
+    };
+    let (n, rows, runs) = (arg(1, 32), arg(2, 4), arg(3, 5).max(1));
+    let w = match std::env::var("STACKED") {
+        // the pot as stacked shells (`depth_complexity`'s `stacked` family)
+        Ok(l) => cwisim_world::scene::parse_world(
+            &layers::layered_pot(l.parse().expect("STACKED=LAYERS"), 0.02),
+            None,
+        )
+        .expect("a valid scene"),
+        Err(_) => {
+            let scene = parse_any(embedded("teapot").expect("the teapot").text, None)
+                .and_then(|s| s.with_tessellation(n))
+                .expect("the teapot tessellated");
+            let AnyScene::World(w) = scene else {
+                unreachable!("the teapot is a world scene")
+            };
+            w
+        }
+    };
+    let (tris, _) = cwisim_world::project::project(&w, Shading::Gouraud).expect("projected");
+    let channels = w.channels();
+    let (mut pairs, mut strips) = (Vec::new(), Vec::new());
+    let (mut by_pairs, mut by_strips) = (Vec::new(), Vec::new());
+    let (mut heap_pairs, mut heap_strips) = (0, 0);
+    for _ in 0..runs {
+        let t = Instant::now();
+        (by_pairs, heap_pairs) = layers::peak_heap(|| exact_fragments_on(&tris, channels, 1).0);
+        pairs.push(t.elapsed());
+        let t = Instant::now();
+        (by_strips, heap_strips) =
+            layers::peak_heap(|| cwisim_world::sweep::strip_by_strip(&tris, channels, rows).0);
+        strips.push(t.elapsed());
+    }
+    let (a, b) = (areas(&by_pairs, tris.len()), areas(&by_strips, tris.len()));
+    let worst = a
+        .iter()
+        .zip(&b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max);
+    let (p, s) = (median(pairs), median(strips));
+    println!("| triangles | strip rows | pair by pair | strip by strip | ratio | peak heap (pairs / strips) | fragments (pairs / strips) | largest area difference |");
+    println!("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
+    println!(
+        "| {} | {rows} | {:.1} ms | {:.1} ms | {:.2}× | {:.1} / {:.1} MB | {} / {} | {worst:.1e} px² |",
+        tris.len(),
+        p.as_secs_f64() * 1e3,
+        s.as_secs_f64() * 1e3,
+        p.as_secs_f64() / s.as_secs_f64(),
+        heap_pairs as f64 / 1e6,
+        heap_strips as f64 / 1e6,
+        by_pairs.len(),
+        by_strips.len()
+    );
+    assert!(
+        worst <= 1e-7,
+        "the engines disagree by {worst} px² on a triangle"
+    );
+}
