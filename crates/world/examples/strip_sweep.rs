@@ -8,7 +8,8 @@
 //!
 //! N defaults to 32 (65,280 triangles), ROWS (pixel rows a strip) to 4, RUNS to 5; with
 //! `STACKED=L` the scene is the pot as `L` stacked shells instead (`depth_complexity`'s
-//! `stacked` family). Prints each engine's median wall time, the ratio, the peak heap each
+//! `stacked` family). Prints each engine's median wall time on one thread, the ratio, strip by strip's on two
+//! threads (and its speed-up; the fragments must be the same), the peak heap each
 //! allocated (a counting allocator, the fragments included), their fragments, and the
 //! largest difference between the visible areas they give a triangle (they must agree:
 //! the run stops if not). The figures are in `docs/VISIBILITY.md`.
@@ -71,7 +72,7 @@ fn main() {
     };
     let (tris, _) = cwisim_world::project::project(&w, Shading::Gouraud).expect("projected");
     let channels = w.channels();
-    let (mut pairs, mut strips) = (Vec::new(), Vec::new());
+    let (mut pairs, mut strips, mut strips2) = (Vec::new(), Vec::new(), Vec::new());
     let (mut by_pairs, mut by_strips) = (Vec::new(), Vec::new());
     let (mut heap_pairs, mut heap_strips) = (0, 0);
     for _ in 0..runs {
@@ -82,6 +83,10 @@ fn main() {
         (by_strips, heap_strips) =
             layers::peak_heap(|| cwisim_world::sweep::strip_by_strip(&tris, channels, rows).0);
         strips.push(t.elapsed());
+        let t = Instant::now();
+        let two = cwisim_world::sweep::strip_by_strip_on(&tris, channels, rows, 2).0;
+        strips2.push(t.elapsed());
+        assert!(two == by_strips, "two threads gave other fragments");
     }
     let (a, b) = (areas(&by_pairs, tris.len()), areas(&by_strips, tris.len()));
     let worst = a
@@ -89,15 +94,17 @@ fn main() {
         .zip(&b)
         .map(|(x, y)| (x - y).abs())
         .fold(0.0, f64::max);
-    let (p, s) = (median(pairs), median(strips));
-    println!("| triangles | strip rows | pair by pair | strip by strip | ratio | peak heap (pairs / strips) | fragments (pairs / strips) | largest area difference |");
-    println!("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
+    let (p, s, s2) = (median(pairs), median(strips), median(strips2));
+    println!("| triangles | strip rows | pair by pair | strip by strip | ratio | strips, 2 threads | peak heap (pairs / strips) | fragments (pairs / strips) | largest area difference |");
+    println!("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
     println!(
-        "| {} | {rows} | {:.1} ms | {:.1} ms | {:.2}× | {:.1} / {:.1} MB | {} / {} | {worst:.1e} px² |",
+        "| {} | {rows} | {:.1} ms | {:.1} ms | {:.2}× | {:.1} ms ({:.2}×) | {:.1} / {:.1} MB | {} / {} | {worst:.1e} px² |",
         tris.len(),
         p.as_secs_f64() * 1e3,
         s.as_secs_f64() * 1e3,
         p.as_secs_f64() / s.as_secs_f64(),
+        s2.as_secs_f64() * 1e3,
+        s.as_secs_f64() / s2.as_secs_f64(),
         heap_pairs as f64 / 1e6,
         heap_strips as f64 / 1e6,
         by_pairs.len(),
