@@ -674,29 +674,43 @@ impl Sweep<'_> {
                             (xa, run.1 .0),
                             (xb, run.1 .1),
                         ];
+                        let at_corners = run_corners.map(|(x, y)| d(x, y));
+                        if at_corners.iter().all(|&v| v <= tol) {
+                            // not nearer anywhere on the run; but a coplanar piece that
+                            // comes first wins all they share (the lower index), and the
+                            // cells found at the middle are cells across the slab only
+                            // when no two lines cross in it
+                            let tie = !all_cuts
+                                && sc.bounds[b].0 < sc.bounds[w].0
+                                && at_corners.iter().any(|&v| v >= -tol)
+                                && overlap(own, run)
+                                && {
+                                    let (common, n) = corners(own, run);
+                                    common[..n]
+                                        .iter()
+                                        .all(|&(t, y)| d(xa + t * (xb - xa), y).abs() <= tol)
+                                };
+                            if tie {
+                                return self.slab(active, xa, xb, extra, added, true);
+                            }
+                            continue;
+                        }
                         if !overlap(own, run) {
                             continue;
                         }
-                        // a coplanar piece that comes first wins all they share (the
-                        // lower index): the cells found at the middle are cells across the
-                        // slab only when no two lines cross in it
-                        if !all_cuts && sc.bounds[b].0 < sc.bounds[w].0 {
-                            let (common, n) = corners(own, run);
-                            if common[..n]
-                                .iter()
-                                .all(|&(t, y)| d(xa + t * (xb - xa), y).abs() <= tol)
+                        let (common, n) = corners(own, run);
+                        let common = &common[..n];
+                        if common.iter().all(|&(t, y)| d(xa + t * (xb - xa), y) <= tol) {
+                            // not nearer where they share: as near all over it (coplanar
+                            // there) and first, it wins it, as above
+                            if !all_cuts
+                                && sc.bounds[b].0 < sc.bounds[w].0
+                                && common
+                                    .iter()
+                                    .all(|&(t, y)| d(xa + t * (xb - xa), y) >= -tol)
                             {
                                 return self.slab(active, xa, xb, extra, added, true);
                             }
-                        }
-                        if run_corners.iter().all(|&(x, y)| d(x, y) <= tol) {
-                            continue;
-                        }
-                        let (common, n) = corners(own, run);
-                        if common[..n]
-                            .iter()
-                            .all(|&(t, y)| d(xa + t * (xb - xa), y) <= tol)
-                        {
                             continue;
                         }
                         // d = ga·x + gb·y + c0 = 0: a line across the slab, or, upright,
