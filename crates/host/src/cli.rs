@@ -32,12 +32,16 @@ error (an unknown option, a missing argument) is clap's message and the usage, s
     version,
     about = "Cycle-level simulator of the CWI display architecture's X-processor array",
     long_about = "Cycle-level simulator of the CWI display architecture's X-processor array.\n\n\
-Replays traces of scanline instructions (Eval0…Eval3, Set…, Dis, Acc_mode, Refresh, Nop) on a \
-simulated one-dimensional array of X-processors, and reports the image it outputs and how \
-many cycles it took against the display's line period.\n\n\
+`render` draws a scene end to end: the Y-processor (a renderer) scan-converts it into \
+scanline instructions (Eval0…Eval3, Set…, Dis, Acc_mode, Refresh, Nop), and a simulated \
+one-dimensional array of X-processors executes them; it writes the image and reports how \
+many cycles each scanline took against the display's line period. `emit` writes the \
+instructions as a trace instead, and `run` replays a trace on the array.\n\n\
 Traces come in three lossless encodings, chosen by file extension: .cwt (text), .jsonl \
 (JSON Lines) and .cwb (binary).\n\n\
-Example:\n  cwisim run scene.cwb -o scene.png --stats",
+Examples:\n  cwisim render                  # the embedded pot, to pot.png\n  \
+cwisim emit pot -o pot.cwb     # its instructions, as a trace\n  \
+cwisim run pot.cwb -o pot-replayed.png --stats",
     after_help = AFTER_HELP,
     propagate_version = true,
     arg_required_else_help = true
@@ -67,7 +71,8 @@ scanlines completed before the bad instruction, a warning says so, and the exit 
 trace's dimensions, the machine, the timing model and the statistics (per scanline too) as \
 JSON. Otherwise a successful run prints nothing. Instructions after the last Refresh never \
 reach the output; a warning on standard error says so.\n\n\
-Example:\n  cwisim run scene.cwt -o scene.png --npy scene.npy --set clock_hz=2e8 --stats",
+Examples:\n  cwisim emit pot -o pot.cwt    # a trace to replay\n  \
+cwisim run pot.cwt -o pot.png --npy pot.npy --set clock_hz=2e8 --stats",
         after_help = AFTER_HELP
     )]
     Run(RunArgs),
@@ -97,8 +102,8 @@ output is asked for), --npy the exact values (float64, shape (height, width, cha
 --trace the instruction stream (a .cwt trace is annotated with the DO_FILL case of every \
 trapezium row). A progress bar shows on a terminal when a render takes over a second.\n\n\
 Examples:\n  cwisim render\n  cwisim render still-life --size 960x640 -o still-life.png\n  \
-cwisim render pot --visibility eval0 --shading flat --stats\n  cwisim render scene.json \
---trace scene.cwt --npy scene.npy",
+cwisim render pot --visibility eval0 --shading flat --stats -o pot-eval0.png\n  \
+cwisim render fig25 --trace fig25.cwt --npy fig25.npy",
         after_help = AFTER_HELP
     )]
     Render(RenderArgs),
@@ -327,7 +332,8 @@ The notes of the instructions (where each came from: the comment lines directly 
 instruction of a .cwt, \"note\" in a .jsonl) are kept when OUT is .cwt or .jsonl (.cwb has no place \
 for them); other comments are not (the output is the canonical form). IN and OUT must \
 be different files; OUT is replaced only once the whole input converted without error.\n\n\
-Examples:\n  cwisim convert scene.cwt -o scene.cwb\n  cwisim convert scene.cwt scene.cwb",
+Examples:\n  cwisim emit pot -o pot.cwt    # a trace to convert\n  \
+cwisim convert pot.cwt -o pot.cwb\n  cwisim convert pot.cwt pot.jsonl",
         after_help = AFTER_HELP
     )]
     Convert(ConvertArgs),
@@ -499,7 +505,7 @@ fn dispatch(
 ) -> Result<u8, CliError> {
     match command {
         Command::Run(args) => run::run(args, stdout, stderr, progress).map(|()| 0),
-        Command::Convert(args) => convert::run(args).map(|_| 0),
+        Command::Convert(args) => convert::run(args, stdout, stderr).map(|_| 0),
         Command::Machine(args) => machine::run(args, stdout, stderr).map(|()| 0),
         Command::Render(args) => scene::run_render(args, stdout, progress).map(|()| 0),
         Command::Scenes(args) => scenes::run(args, stdout, stderr).map(|()| 0),
@@ -508,7 +514,7 @@ fn dispatch(
         Command::Refine(args) => refine::run(args, stdout, progress).map(|()| 0),
         Command::Fit(args) => fit::run(args, stdout, progress).map(|()| 0),
         Command::Rtl(args) => rtl::run(args, stdout, progress).map(|()| 0),
-        Command::Emit(args) => scene::run_emit(args).map(|()| 0),
+        Command::Emit(args) => scene::run_emit(args, stdout).map(|()| 0),
         Command::Stats(args) => stats::run(args, stdout, stderr).map(|()| 0),
         Command::History(args) => history::run(args, stdout, progress).map(|()| 0),
         Command::Inspect(args) => inspect::run(args, stdout, progress).map(|()| 0),

@@ -451,6 +451,34 @@ pub fn check_writable(path: &Path) -> Result<(), CliError> {
     Ok(())
 }
 
+/// The line a command prints once it has written `paths`, `wrote A, B` (with `detail`
+/// after a colon when given), leaving out an output that is standard output itself (its
+/// reader has it already, and the line would land in the stream); `None` when nothing is
+/// left.
+pub fn wrote_line(paths: &[&Path], detail: Option<&str>) -> Option<String> {
+    let names: Vec<String> = paths
+        .iter()
+        .filter(|p| !is_standard_output(p))
+        .map(|p| p.display().to_string())
+        .collect();
+    if names.is_empty() {
+        return None;
+    }
+    Some(match detail {
+        Some(d) => format!("wrote {}: {d}", names.join(", ")),
+        None => format!("wrote {}", names.join(", ")),
+    })
+}
+
+/// True when `path` is the file, pipe or terminal this process's standard output goes to.
+fn is_standard_output(path: &Path) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    match (std::fs::metadata(path), std::fs::metadata("/dev/stdout")) {
+        (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
+        _ => false,
+    }
+}
+
 /// True when `a` and `b` name the same file, also when the file does not exist yet
 /// (`./t.cwt` and `t.cwt` are the same; symbolic links are followed where they
 /// exist).

@@ -175,7 +175,10 @@ fn cost_outputs_are_deterministic_and_change_nothing_else() {
         "--cost-npy",
         "a.npy",
     ];
-    assert_eq!(cwisim_ok(&dir, &args), "");
+    assert_eq!(
+        cwisim_ok(&dir, &args),
+        "wrote i.npy, a.png, a.npy, s.json: 6 scanline(s) of 16 × 1 channel(s)\n"
+    );
     let (png, npy) = (read(dir.join("a.png")), read(dir.join("a.npy")));
     cwisim_ok(&dir, &args);
     assert_eq!(png, read(dir.join("a.png")), "byte-identical PNG");

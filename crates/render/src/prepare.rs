@@ -45,6 +45,9 @@ pub struct PolygonScene {
     /// Meshes whose material lets light through (`transmittance` > 0), drawn opaque
     /// here: polygon renderers keep the nearest surface only.
     pub transparent_meshes: u64,
+    /// A screen scene whose polygons carry depths, which the polygon renderers do not
+    /// read: their polygons add up.
+    pub ignored_depths: bool,
 }
 
 /// What per-pixel (Phong) shading needs: the projected triangles with their world
@@ -241,6 +244,7 @@ impl PolygonScene {
             shadow_time: Duration::ZERO,
             phong: None,
             transparent_meshes: 0,
+            ignored_depths: false,
         };
         if settings.shading == Shading::Hidden {
             return Err(RenderError::Usage(
@@ -256,6 +260,7 @@ impl PolygonScene {
             AnyScene::Screen(_) if phong => return Err(phong_needs_world()),
             AnyScene::Screen(s) => {
                 check_intensities(&s, &prepared.source)?;
+                prepared.ignored_depths = s.polygons.iter().any(|p| p.depth.is_some());
                 prepared.screen = s
             }
             AnyScene::World(_) if phong && settings.visibility != Visibility::Exact => {
@@ -385,6 +390,12 @@ impl PolygonScene {
                     "{} mesh(es) with a transmittance drawn opaque: this renderer keeps the nearest surface (woo-chall composites layers)",
                     self.transparent_meshes
                 ),
+            ));
+        }
+        if self.ignored_depths {
+            rows.push((
+                "note",
+                "the scene's polygons carry depths, which this renderer does not read: they add up, each drawn whole (woo-chall, sbuffer and bsp draw the nearest)".to_string(),
             ));
         }
         rows

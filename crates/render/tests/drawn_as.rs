@@ -68,3 +68,40 @@ fn size_and_tessellation_apply_to_a_scene_built_in_code() {
         }
     }
 }
+
+/// A screen scene whose polygons carry depths (two squares, the nearer drawn first).
+fn squares_with_depths() -> AnyScene {
+    let text = r#"{"kind": "screen", "width": 8, "height": 8, "channels": 1, "polygons": [
+        {"vertices": [[0,0],[6,0],[6,6],[0,6]], "intensity": [[1],[1],[1],[1]], "depth": [1,1,1,1]},
+        {"vertices": [[2,2],[8,2],[8,8],[2,8]], "intensity": [[0.5],[0.5],[0.5],[0.5]], "depth": [2,2,2,2]}
+    ]}"#;
+    cwisim_world::parse_any(text, None).unwrap()
+}
+
+#[test]
+fn a_renderer_that_does_not_read_a_screen_scene_s_depths_says_so() {
+    // the README's cp-bench scene carries depths: drawn by vanrij its polygons add up
+    // (white, every scanline late), which the summary now says; those that read them don't
+    let mut built = Vec::new();
+    for entry in REGISTRY {
+        let Ok(r) = (entry.build)(
+            LoadedScene::built("squares", squares_with_depths()),
+            &Settings::default(),
+        ) else {
+            continue;
+        };
+        let rows = r.summary_rows(&Default::default(), &Default::default());
+        let noted = rows
+            .iter()
+            .any(|(label, text)| *label == "note" && text.contains("carry depths"));
+        let reads_depths = ["woo-chall", "sbuffer", "bsp"].contains(&entry.name);
+        assert_eq!(noted, !reads_depths, "{}: {rows:?}", entry.name);
+        built.push(entry.name);
+    }
+    for name in ["vanrij", "refine", "woo-chall", "sbuffer", "bsp"] {
+        assert!(
+            built.contains(&name),
+            "{name} draws screen scenes: {built:?}"
+        );
+    }
+}

@@ -4,6 +4,7 @@ use crate::error::CliError;
 use crate::files::{write_atomic, Io};
 use clap::Args;
 use cwisim_isa::{Encoding, FileReader, TraceRead};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// The arguments of `cwisim convert`.
@@ -25,6 +26,18 @@ pub struct ConvertArgs {
     /// The trace to write, as the second argument (the same as `-o OUT`).
     #[arg(value_name = "OUT", hide = true)]
     pub out: Option<PathBuf>,
+    /// Print nothing on standard output (errors and warnings still go to standard error).
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// What [`convert`] did.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Converted {
+    /// Instructions copied.
+    pub instructions: u64,
+    /// Notes of the input its output's encoding has no record for (`.cwb`), not written.
+    pub notes_dropped: u64,
 }
 
 impl ConvertArgs {
@@ -37,9 +50,31 @@ impl ConvertArgs {
     }
 }
 
-/// Runs `cwisim convert`. Returns the number of instructions copied.
-pub fn run(args: &ConvertArgs) -> Result<u64, CliError> {
-    convert(&args.input, args.output()?)
+/// Runs `cwisim convert`: says what it wrote on `stdout` (unless `--quiet`), and on
+/// `stderr` what of the input it could not write.
+pub fn run(
+    args: &ConvertArgs,
+    stdout: &mut dyn Write,
+    stderr: &mut dyn Write,
+) -> Result<Converted, CliError> {
+    let output = args.output()?;
+    let done = convert(&args.input, output)?;
+    if done.notes_dropped > 0 {
+        // a lost warning is no reason to fail the run
+        let _ = writeln!(
+            stderr,
+            "warning: {} note(s) of {} not written: .cwb has no record for them (.cwt and .jsonl keep them)",
+            done.notes_dropped,
+            args.input.display()
+        );
+    }
+    if !args.quiet {
+        let detail = format!("{} instruction(s)", done.instructions);
+        if let Some(line) = crate::files::wrote_line(&[output], Some(&detail)) {
+            writeln!(stdout, "{line}").map_err(CliError::Stdout)?;
+        }
+    }
+    Ok(done)
 }
 
 /// Copies every instruction of the trace `input` into a new trace `output`, each in the
@@ -47,9 +82,9 @@ pub fn run(args: &ConvertArgs) -> Result<u64, CliError> {
 /// written all-or-nothing, so a malformed input leaves no partial file. The notes of the
 /// instructions (where each came from: the comment lines directly above an instruction
 /// of a `.cwt`, `"note"` in a `.jsonl`; `cwisim_isa::note`) are kept when `output`'s
-/// encoding carries them (`.cwt`, `.jsonl`; `.cwb` carries none); other comments are
-/// not.
-pub fn convert(input: &Path, output: &Path) -> Result<u64, CliError> {
+/// encoding carries them (`.cwt`, `.jsonl`; `.cwb` carries none: they are counted in
+/// [`Converted::notes_dropped`]); other comments are not.
+pub fn convert(input: &Path, output: &Path) -> Result<Converted, CliError> {
     Encoding::from_path(input)?;
     let out_encoding = crate::files::trace_output_encoding(output)?;
     Io::new()
@@ -59,24 +94,31 @@ pub fn convert(input: &Path, output: &Path) -> Result<u64, CliError> {
     let mut reader = FileReader::open(input)?;
     let header = *reader.header();
     let mut count = 0;
+    let mut dropped = 0;
     write_atomic(output, |out| {
         let io_err = |e| CliError::write(output, e);
         let mut writer = out_encoding.writer(out, &header).map_err(io_err)?;
         let notes = writer.wants_comments();
         let mut last_note = None;
         while let Some(instr) = reader.next_instruction()? {
-            if notes {
-                // each note once, before the first instruction it covers
-                let note = reader.note();
-                if let Some(n) = note.filter(|n| last_note != Some(n.serial)) {
+            // each note once, before the first instruction it covers (or counted, when
+            // the output has no record for it)
+            let note = reader.note();
+            if let Some(n) = note.filter(|n| last_note != Some(n.serial)) {
+                if notes {
                     writer.comment(n.text).map_err(io_err)?;
+                } else {
+                    dropped += 1;
                 }
-                last_note = note.map(|n| n.serial);
             }
+            last_note = note.map(|n| n.serial);
             writer.write(&instr).map_err(io_err)?;
             count += 1;
         }
         writer.finish().map_err(io_err)
     })?;
-    Ok(count)
+    Ok(Converted {
+        instructions: count,
+        notes_dropped: dropped,
+    })
 }

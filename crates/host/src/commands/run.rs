@@ -86,6 +86,9 @@ pub struct RunArgs {
     /// it. Statistics and cost outputs are not written for a bad trace.
     #[arg(long)]
     pub keep_partial: bool,
+    /// Print nothing on standard output (errors and warnings still go to standard error).
+    #[arg(short, long, conflicts_with = "stats")]
+    pub quiet: bool,
     /// How to draw a scene (refused with a trace).
     #[command(flatten, next_help_heading = crate::draw::SCENE_ONLY)]
     pub draw: crate::draw::DrawArgs,
@@ -233,6 +236,28 @@ before the error (a frame has {})",
     if args.stats {
         write_summary(stdout, &header, timing, stats).map_err(CliError::Stdout)?;
         stdout.flush().map_err(CliError::Stdout)?;
+    }
+    if !args.quiet {
+        let [cost_image, cost_npy] = args.cost.outputs();
+        let written: Vec<&Path> = [
+            args.image.output.as_deref(),
+            args.image.npy.as_deref(),
+            cost_image.1.map(PathBuf::as_path),
+            cost_npy.1.map(PathBuf::as_path),
+            args.stats_json.as_deref(),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        let detail = format!(
+            "{} scanline(s) of {} × {} channel(s)",
+            stats.totals.lines,
+            header.width,
+            header.channel_count()
+        );
+        if let Some(line) = crate::files::wrote_line(&written, Some(&detail)) {
+            writeln!(stdout, "{line}").map_err(CliError::Stdout)?;
+        }
     }
     Ok(())
 }

@@ -33,6 +33,9 @@ pub struct EmitArgs {
     /// How to draw it.
     #[command(flatten)]
     pub draw: DrawArgs,
+    /// Print nothing on standard output (errors and warnings still go to standard error).
+    #[arg(short, long)]
+    pub quiet: bool,
 }
 
 /// The arguments of `cwisim render`.
@@ -72,8 +75,8 @@ pub struct RenderArgs {
     /// Write the scene's, the scan conversion's and the array's statistics as JSON.
     #[arg(long, value_name = "FILE")]
     pub stats_json: Option<PathBuf>,
-    /// Print nothing (errors still go to standard error).
-    #[arg(short, long)]
+    /// Print nothing on standard output (errors and warnings still go to standard error).
+    #[arg(short, long, conflicts_with = "stats")]
     pub quiet: bool,
     /// Threads: the Y-processor emits bands of scanlines and runs each through processors
     /// of its own, whose scanlines the array takes in, in order; with N > 1, exact
@@ -99,7 +102,7 @@ fn encode(renderer: &dyn Renderer, path: &Path) -> Result<Vec<u8>, CliError> {
 }
 
 /// Runs `cwisim emit`.
-pub fn run_emit(args: &EmitArgs) -> Result<(), CliError> {
+pub fn run_emit(args: &EmitArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
     Io::new()
         .source("scene", Some(&args.scene))
         .output("-o", Some(&args.output))
@@ -109,7 +112,22 @@ pub fn run_emit(args: &EmitArgs) -> Result<(), CliError> {
     write_atomic(&args.output, |w| {
         w.write_all(&bytes)
             .map_err(|e| CliError::write(&args.output, e))
-    })
+    })?;
+    if !args.quiet {
+        let h = drawn.renderer.header();
+        let detail = format!(
+            "{}'s stream for {} × {} × {} channel(s), {} byte(s)",
+            drawn.renderer.name(),
+            h.width,
+            h.lines,
+            h.channel_count(),
+            bytes.len()
+        );
+        if let Some(line) = crate::files::wrote_line(&[&args.output], Some(&detail)) {
+            writeln!(stdout, "{line}").map_err(CliError::Stdout)?;
+        }
+    }
+    Ok(())
 }
 
 /// The PNG path `render` writes when given no output at all.

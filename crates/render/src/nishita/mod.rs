@@ -535,6 +535,7 @@ impl Nishita {
                 .iter()
                 .filter(|m| m.material.transmittance > 0.0)
                 .count() as u64,
+            ignored_depths: false,
         };
         Ok(Nishita {
             inner: VanRij::from_polygons(scene, settings),
