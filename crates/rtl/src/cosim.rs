@@ -65,6 +65,24 @@ fn write_file(path: &Path, text: &str) -> Result<(), RtlError> {
 /// A typical scene takes a few million (the pot at 400×400: 1.5 million).
 pub const MAX_COSIM_CYCLES: u64 = 200_000_000;
 
+/// Where a co-simulation is, for a progress display: its stages in order, the long ones
+/// (Verilator's build, a long simulation) minutes long.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CosimStage {
+    /// The stepped engine's expected outputs, and the stimulus and Verilog written.
+    Reference,
+    /// The simulator built from the Verilog (`iverilog`; `verilator --binary`, C++
+    /// compiled: the longest).
+    Build,
+    /// The simulation, of about this many cycles.
+    Simulate {
+        /// The cycles the stepped engine took.
+        cycles: u64,
+    },
+    /// The simulator's dump read and compared.
+    Compare,
+}
+
 /// Co-simulates `trace` on design `d` with `sim` in the (existing, empty) directory
 /// `dir`, watching the token arrivals at `watch`.
 pub fn cosimulate(
@@ -76,6 +94,21 @@ pub fn cosimulate(
     sim: Simulator,
     dir: &Path,
 ) -> Result<Outcome, RtlError> {
+    cosimulate_with(d, header, trace, machine, watch, sim, dir, &mut |_| {})
+}
+
+/// [`cosimulate`], telling `stage` as each [`CosimStage`] begins.
+#[allow(clippy::too_many_arguments)]
+pub fn cosimulate_with(
+    d: &Design,
+    header: &TraceHeader,
+    trace: &[Instruction],
+    machine: &Machine,
+    watch: &Watch,
+    sim: Simulator,
+    dir: &Path,
+    stage: &mut dyn FnMut(CosimStage),
+) -> Result<Outcome, RtlError> {
     if trace.is_empty() {
         return Err(RtlError::Settings(
             "the trace is empty: nothing to co-simulate".into(),
@@ -84,6 +117,7 @@ pub fn cosimulate(
     // absolute: the tools run in it, and the compiled simulator is named by its path
     let dir = &dir.canonicalize().map_err(|e| RtlError::io(dir, e))?;
     let started = Instant::now();
+    stage(CosimStage::Reference);
     let want = expected(d, header, trace, machine, watch)?;
     let reference = started.elapsed();
     // the simulators step every cycle, idle ones too: said before, refused past the limit
@@ -107,6 +141,7 @@ pub fn cosimulate(
     write_file(&dir.join("testbench.v"), &verilog::testbench(d, watch))?;
     let instructions = trace.len();
     let started = Instant::now();
+    stage(CosimStage::Build);
     match sim {
         Simulator::Icarus => {
             run(
@@ -152,6 +187,9 @@ pub fn cosimulate(
     }
     let build = started.elapsed();
     let started = Instant::now();
+    stage(CosimStage::Simulate {
+        cycles: want.cycles,
+    });
     match sim {
         Simulator::Icarus => run("vvp", &["-n", "sim.vvp"], dir)?,
         Simulator::Verilator => {
@@ -163,6 +201,7 @@ pub fn cosimulate(
         }
     };
     let simulate = started.elapsed();
+    stage(CosimStage::Compare);
     let dump_path = dir.join(DUMP_FILE);
     let no_dump = |source| RtlError::NoOutput {
         tool: sim.name().into(),

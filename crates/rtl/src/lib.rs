@@ -44,6 +44,6 @@ pub mod tools;
 pub mod verilog;
 
 pub use compare::{Agreement, Mismatch};
-pub use cosim::{cosimulate, Outcome, Simulator};
+pub use cosim::{cosimulate, cosimulate_with, CosimStage, Outcome, Simulator};
 pub use design::{all_opcodes, opcodes_used, BusTiming, Design};
 pub use error::RtlError;

@@ -115,3 +115,37 @@ fn the_widest_registers_agree() {
         }
     }
 }
+
+#[test]
+fn a_co_simulation_tells_its_stages_in_order() {
+    if !hdl_tools("the stages of an Icarus co-simulation") {
+        return;
+    }
+    let machine = Machine::default();
+    let (header, instrs) = trace("gouraud");
+    let d = design_for(
+        format("fixed:I=8.24,dI=4.28,ddI=2.30,acc=10.24"),
+        &header,
+        &instrs,
+        &machine,
+    );
+    let dir = scratch("stages");
+    let mut stages = Vec::new();
+    let out = cwisim_rtl::cosimulate_with(
+        &d,
+        &header,
+        &instrs,
+        &machine,
+        &Watch::all(d.width),
+        Simulator::Icarus,
+        &dir,
+        &mut |s| stages.push(s),
+    )
+    .unwrap();
+    assert!(out.result.is_ok(), "the gouraud trace agrees");
+    use cwisim_rtl::CosimStage::*;
+    assert!(
+        matches!(stages[..], [Reference, Build, Simulate { cycles }, Compare] if cycles > 0),
+        "{stages:?}"
+    );
+}

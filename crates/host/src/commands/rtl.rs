@@ -13,7 +13,8 @@ use clap::Args;
 use cwisim_isa::{io::read_all, TraceHeader};
 use cwisim_rtl::verilog::{self, Watch};
 use cwisim_rtl::{
-    all_opcodes, area, cosimulate, opcodes_used, BusTiming, Design, RtlError, Simulator,
+    all_opcodes, area, cosimulate_with, opcodes_used, BusTiming, CosimStage, Design, RtlError,
+    Simulator,
 };
 use cwisim_study::fit::fit_scene;
 use cwisim_xproc::numeric::Overflow;
@@ -92,6 +93,24 @@ pub struct RtlArgs {
     /// How to draw a --for scene.
     #[command(flatten, next_help_heading = crate::draw::SCENE_ONLY)]
     pub draw: crate::draw::DrawArgs,
+}
+
+/// What the progress spinner says while `--cosim` is at `stage` with simulator `sim`.
+fn cosim_stage_message(sim: Simulator, stage: CosimStage) -> String {
+    let name = sim.name();
+    match stage {
+        CosimStage::Reference => {
+            "rtl: co-simulating: the stepped engine's reference, the stimulus".to_string()
+        }
+        CosimStage::Build if sim == Simulator::Verilator => {
+            "rtl: co-simulating: verilator building the simulator (C++, a few minutes)".to_string()
+        }
+        CosimStage::Build => format!("rtl: co-simulating: {name} compiling the Verilog"),
+        CosimStage::Simulate { cycles } => {
+            format!("rtl: co-simulating: {name} simulating {cycles} cycles")
+        }
+        CosimStage::Compare => "rtl: co-simulating: comparing the dump".to_string(),
+    }
 }
 
 /// `--cosim`.
@@ -293,8 +312,17 @@ pub fn run(args: &RtlArgs, stdout: &mut dyn Write, progress: bool) -> Result<(),
         let sim = sim_of(sim);
         let dir = WorkDir::new(args.work_dir.as_deref(), "cosim")?;
         let stage = crate::progress::Stage::new(progress, "rtl: co-simulating");
-        let outcome = cosimulate(&design, &header, trace, &machine, &watch, sim, dir.path())
-            .map_err(rtl_error)?;
+        let outcome = cosimulate_with(
+            &design,
+            &header,
+            trace,
+            &machine,
+            &watch,
+            sim,
+            dir.path(),
+            &mut |now| stage.message(&cosim_stage_message(sim, now)),
+        )
+        .map_err(rtl_error)?;
         drop(stage);
         match outcome.result {
             Ok(a) => {
