@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{cwisim_ok, read, scratch};
+use common::{cwisim, cwisim_ok, read, scratch, text};
 use std::path::Path;
 
 /// The embedded pot, small, as `render` draws it.
@@ -179,8 +179,15 @@ fn convert_keeps_the_notes_where_the_encoding_carries_them() {
     // .jsonl as emitted carries them too
     emit(&dir, "emitted.jsonl");
     assert_eq!(read(dir.join("emitted.jsonl")), read(dir.join("pot.jsonl")));
-    // .cwb has no place for them: back in text, the trace without its notes
-    cwisim_ok(&dir, &["convert", "pot.cwt", "pot.cwb"]);
+    // .cwb has no place for them, and convert says so: back in text, the trace without
+    // its notes
+    let out = cwisim(&dir, &["convert", "pot.cwt", "pot.cwb"]);
+    let (_, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.starts_with("warning: ") && stderr.contains(" note(s) of pot.cwt not written"),
+        "{stderr}"
+    );
     cwisim_ok(&dir, &["convert", "pot.cwb", "plain.cwt"]);
     let plain = String::from_utf8(read(dir.join("plain.cwt"))).unwrap();
     assert_eq!(plain, without_notes(&String::from_utf8(trace).unwrap()));

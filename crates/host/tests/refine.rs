@@ -59,6 +59,15 @@ fn refine_prints_the_phase_table_and_writes_its_files() {
         "{out}"
     );
     assert!(out.contains("× FB)"), "{out}");
+    // the lower panel's scanline axis has its numbers: ink just under the axis at its
+    // left end (the "0"), where only the axis title, centred, was before
+    let plot = image::open(dir.join("q.png")).unwrap().to_rgb8();
+    let (left, axis) = (90, plot.height() - 60);
+    let ink = (axis + 6..axis + 20)
+        .flat_map(|y| (left - 6..left + 6).map(move |x| (x, y)))
+        .filter(|&(x, y)| plot.get_pixel(x, y).0.iter().all(|&c| c < 128))
+        .count();
+    assert!(ink > 5, "no tick label under the scanline axis");
     for name in [
         "phase-1-flat",
         "phase-2-gouraud",

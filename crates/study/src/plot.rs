@@ -113,6 +113,43 @@ pub fn text_width(text: &str, size: f32) -> f32 {
     w
 }
 
+/// `text` in lines no wider than `width` pixels at `size`, broken at spaces (a word wider
+/// than that alone, such as a long numeric format, also after its commas): what a legend
+/// draws so that nothing runs off the canvas. A word that cannot be broken keeps a line
+/// of its own.
+pub fn wrap(text: &str, size: f32, width: f32) -> Vec<String> {
+    let fits = |t: &str| text_width(t, size) <= width;
+    // (joined to the piece before without a space, the piece)
+    let mut pieces: Vec<(bool, &str)> = Vec::new();
+    for word in text.split(' ') {
+        if fits(word) || !word.contains(',') {
+            pieces.push((false, word));
+        } else {
+            for (k, part) in word.split_inclusive(',').enumerate() {
+                pieces.push((k > 0, part));
+            }
+        }
+    }
+    let mut lines: Vec<String> = Vec::new();
+    let mut line = String::new();
+    for (glued, piece) in pieces {
+        let joined = match (line.is_empty(), glued) {
+            (true, _) => piece.to_string(),
+            (false, true) => format!("{line}{piece}"),
+            (false, false) => format!("{line} {piece}"),
+        };
+        if line.is_empty() || fits(&joined) {
+            line = joined;
+        } else {
+            lines.push(std::mem::replace(&mut line, piece.to_string()));
+        }
+    }
+    if !line.is_empty() || lines.is_empty() {
+        lines.push(line);
+    }
+    lines
+}
+
 /// An RGB bitmap, 3 bytes per pixel, row-major.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Rgb {

@@ -6,8 +6,8 @@
 //! image equal to the full-quality one) sit on the floor.
 
 use crate::plot::{
-    decade_grid, decades, draw_on, err, log_log_panel, panel_area, rgb, Align, Label, LogAxis, Rgb,
-    OVERRUN,
+    decade_grid, decades, draw_on, err, log_log_panel, nice_step, panel_area, rgb, Align, Label,
+    LogAxis, Rgb, OVERRUN,
 };
 use crate::refine::{PhaseRow, RefineRun};
 use plotters::prelude::*;
@@ -121,6 +121,8 @@ pub fn render_refine_plot(runs: &[(Option<String>, RefineRun)]) -> Result<Rgb, S
         labels.push(
             Label::new("RMS error", (left - 8, top_upper - 12), 14.0).align(Align::End, Align::End),
         );
+        // each phase's name once where two series' points of it (nearly) coincide
+        let mut named: Vec<(&str, i32, i32)> = Vec::new();
         for (_, color, rows) in &series {
             let pts: Vec<(f64, f64)> = rows
                 .iter()
@@ -136,6 +138,13 @@ pub fn render_refine_plot(runs: &[(Option<String>, RefineRun)]) -> Result<Rgb, S
                 let (px, py) = chart.backend_coord(p);
                 root.draw(&Circle::new((px, py), 4, rgb(*color).filled()))
                     .map_err(err)?;
+                let near = |&&(name, x, y): &&(&str, i32, i32)| {
+                    name == r.phase && (x - px).abs() < 24 && (y - py).abs() < 12
+                };
+                if named.iter().any(|n| near(&n)) {
+                    continue;
+                }
+                named.push((r.phase, px, py));
                 labels.push(
                     Label::new(r.phase, (px + 6, py - 4), 11.0)
                         .align(Align::Start, Align::End)
@@ -192,8 +201,24 @@ pub fn render_refine_plot(runs: &[(Option<String>, RefineRun)]) -> Result<Rgb, S
             )
             .align(Align::Start, Align::End),
         );
+        // scanline ticks, about every 80 pixels
+        let step = nice_step(80.0 * lines / f64::from((right - left).max(1) as u32));
+        let mut tick = 0u64;
+        while tick as f64 <= lines {
+            let (px, _) = chart.backend_coord(&(tick as f64, b0));
+            root.draw(&PathElement::new(
+                vec![(px, bot_lower), (px, bot_lower + 4)],
+                BLACK,
+            ))
+            .map_err(err)?;
+            labels.push(
+                Label::new(tick.to_string(), (px, bot_lower + 7), 12.0)
+                    .align(Align::Center, Align::Start),
+            );
+            tick += step;
+        }
         labels.push(
-            Label::new("scanline", ((left + right) / 2, bot_lower + 8), 14.0)
+            Label::new("scanline", ((left + right) / 2, bot_lower + 26), 14.0)
                 .align(Align::Center, Align::Start),
         );
         root.draw(&PathElement::new(

@@ -7,12 +7,15 @@
 //! report's), a hollow one point sampling; a circle is exact visibility, a square eval0 (or a screen scene). Errors
 //! below [`ERROR_FLOOR`] (an exact image) are drawn on the floor.
 
-use crate::plot::{decades, draw_on, err, log_log_panel, panel_area, rgb, Align, Label, Rgb};
+use crate::plot::{decades, draw_on, err, log_log_panel, panel_area, rgb, wrap, Align, Label, Rgb};
 use crate::tradeoff::Row;
 use plotters::prelude::*;
 
 /// The smallest error the chart shows; smaller ones sit on this line.
 pub const ERROR_FLOOR: f64 = 1e-12;
+
+/// The blank kept at the right edge of the legend, pixels.
+const LEGEND_MARGIN: i32 = 10;
 
 /// Width and height of the chart, pixels.
 pub const TRADEOFF_PLOT_SIZE: (u32, u32) = (1100, 700);
@@ -149,8 +152,13 @@ pub fn render_tradeoff_plot(rows: &[Row], name: &str) -> Result<Rgb, String> {
                 rgb(PALETTE[k % PALETTE.len()]).filled(),
             ))
             .map_err(err)?;
-            labels.push(Label::new(*f, (lx + 20, ly), 12.0).align(Align::Start, Align::Center));
-            ly += 20;
+            let width = (w as i32 - LEGEND_MARGIN - lx - 20) as f32;
+            for line in wrap(f, 12.0, width) {
+                labels
+                    .push(Label::new(line, (lx + 20, ly), 12.0).align(Align::Start, Align::Center));
+                ly += 16;
+            }
+            ly += 4;
         }
         ly += 14;
         for (text, shape) in [
@@ -182,55 +190,68 @@ pub fn render_tradeoff_plot(rows: &[Row], name: &str) -> Result<Rgb, String> {
                 .align(Align::Start, Align::Center),
         );
         ly += 22;
-        // as many as fit above the bottom edge; the rest said in one line
-        const ROW: i32 = 17;
-        let room = ((h as i32 - 20 - ly) / ROW).max(1) as usize;
-        let shown = if front.len() > room {
-            room - 1
-        } else {
-            front.len()
+        // as many as fit above the bottom edge, each wrapped to the legend's width (a
+        // line of the same setting indented); the rest said in the last lines
+        const ROW: i32 = 15;
+        let width = (w as i32 - LEGEND_MARGIN - lx) as f32;
+        let bottom = h as i32 - 12;
+        let named: Vec<Vec<String>> = front
+            .iter()
+            .map(|r| {
+                // the row's own settings, what does not apply ("-") left out
+                let mut words = vec![r.renderer.to_string()];
+                if let Some(n) = r.tessellate {
+                    words.push(format!("tessellated {n},"));
+                }
+                words.push(r.shading.to_string());
+                words.extend(
+                    [r.aa, r.visibility]
+                        .into_iter()
+                        .filter(|w| *w != "-")
+                        .map(str::to_string),
+                );
+                if let Some(l) = r.samples {
+                    words.push(format!("{l}×{l} samples"));
+                }
+                words.push(short(&r.numeric));
+                wrap(&words.join(" "), 11.0, width - 12.0)
+            })
+            .collect();
+        let more = |n: usize| {
+            wrap(
+                &format!("… and {n} more (the table's Pareto front, the CSV's pareto column)"),
+                11.0,
+                width,
+            )
         };
-        for r in &front[..shown] {
-            labels.push(
-                Label::new(
-                    {
-                        // the row's own settings, what does not apply ("-") left out
-                        let mut words = vec![r.renderer.to_string()];
-                        if let Some(n) = r.tessellate {
-                            words.push(format!("tessellated {n},"));
-                        }
-                        words.push(r.shading.to_string());
-                        words.extend(
-                            [r.aa, r.visibility]
-                                .into_iter()
-                                .filter(|w| *w != "-")
-                                .map(str::to_string),
-                        );
-                        if let Some(l) = r.samples {
-                            words.push(format!("{l}×{l} samples"));
-                        }
-                        words.push(short(&r.numeric));
-                        words.join(" ")
-                    },
-                    (lx, ly),
-                    11.0,
-                )
-                .align(Align::Start, Align::Center),
-            );
-            ly += ROW;
+        let mut shown = 0;
+        let mut used = 0;
+        for (k, lines) in named.iter().enumerate() {
+            let rest = if k + 1 < named.len() {
+                more(named.len() - k - 1).len()
+            } else {
+                0
+            };
+            if ly + ROW * (used + lines.len() + rest) as i32 > bottom {
+                break;
+            }
+            shown += 1;
+            used += lines.len();
         }
-        if shown < front.len() {
-            labels.push(
-                Label::new(
-                    format!(
-                        "… and {} more (the table's Pareto front, the CSV's pareto column)",
-                        front.len() - shown
-                    ),
-                    (lx, ly),
-                    11.0,
-                )
-                .align(Align::Start, Align::Center),
-            );
+        for lines in &named[..shown] {
+            for (k, line) in lines.iter().enumerate() {
+                let x = if k == 0 { lx } else { lx + 12 };
+                labels.push(
+                    Label::new(line.as_str(), (x, ly), 11.0).align(Align::Start, Align::Center),
+                );
+                ly += ROW;
+            }
+        }
+        if shown < named.len() {
+            for line in more(named.len() - shown) {
+                labels.push(Label::new(line, (lx, ly), 11.0).align(Align::Start, Align::Center));
+                ly += ROW;
+            }
         }
         Ok(())
     })?;
@@ -242,4 +263,83 @@ fn short(numeric: &str) -> String {
     numeric
         .strip_prefix("fixed:")
         .map_or_else(|| numeric.to_string(), |f| format!("fx {f}"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(k: usize, numeric: &str) -> Row {
+        Row {
+            renderer: ["woo-chall", "sbuffer", "vanrij"][k % 3],
+            shading: "gouraud",
+            aa: if k.is_multiple_of(2) { "box" } else { "none" },
+            samples: Some(1 + (k % 4) as u32),
+            visibility: "exact",
+            shadows: "-",
+            tessellate: Some(16),
+            root_tolerance: None,
+            numeric: numeric.to_string(),
+            register_bits: 40 + k as u32,
+            instructions: 1000 + k as u64,
+            busy_cycles: 100 + 17 * k as u64,
+            worst_line_share: 0.5,
+            late_lines: 0,
+            host_ms: 1.0,
+            max_error: 0.1,
+            rms_error: 1e-3 / (1 + k) as f64,
+            psnr_db: 60.0,
+            overflows: 0,
+            counters: Default::default(),
+            pareto: true,
+        }
+    }
+
+    /// Whether any pixel of the image's last `columns` columns is darker than the grid.
+    fn ink_at_the_right_edge(img: &Rgb, columns: u32) -> Option<(u32, u32)> {
+        (img.width - columns..img.width)
+            .flat_map(|x| (0..img.height).map(move |y| (x, y)))
+            .find(|&(x, y)| img.get(x, y).iter().any(|&c| c < 160))
+    }
+
+    #[test]
+    fn the_legend_stays_within_the_canvas() {
+        // 40 Pareto-optimal settings with long names (the last line used to run off the
+        // right edge: "… the CSV's pareto colum"), and a format longer than the legend
+        let long = "fixed:I=10.22,dI=4.28,ddI=1.35,acc=12.40,dI_extra=1.1,more=2.2";
+        let rows: Vec<Row> = (0..40)
+            .map(|k| {
+                row(
+                    k,
+                    if k % 5 == 0 {
+                        long
+                    } else {
+                        "fixed:I=10.14,dI=4.20,ddI=1.27"
+                    },
+                )
+            })
+            .collect();
+        let img = render_tradeoff_plot(&rows, "a scene").unwrap();
+        assert_eq!(
+            ink_at_the_right_edge(&img, LEGEND_MARGIN as u32 / 2),
+            None,
+            "text at the right edge"
+        );
+    }
+
+    #[test]
+    fn wrapped_lines_fit_and_keep_every_word() {
+        let text = "… and 12 more (the table's Pareto front, the CSV's pareto column)";
+        let lines = wrap(text, 11.0, 200.0);
+        assert!(lines.len() >= 2, "{lines:?}");
+        assert!(lines
+            .iter()
+            .all(|l| crate::plot::text_width(l, 11.0) <= 200.0));
+        assert_eq!(lines.join(" "), text);
+        // a format wider than the width is broken after its commas
+        let f = "fixed:I=10.22,dI=4.28,ddI=1.35,acc=12.40";
+        let lines = wrap(f, 12.0, 100.0);
+        assert!(lines.len() >= 2, "{lines:?}");
+        assert_eq!(lines.concat(), f);
+    }
 }
