@@ -124,6 +124,10 @@ impl NonFinite {
     /// other error not yet located (a fault of the renderer's, an internal error) said
     /// to be the row's (`row R: …`), so that its message names the scanline.
     pub fn at_row(e: io::Error, row: u32) -> io::Error {
+        if scene_error_in(&e).is_some() {
+            // located in the scene already
+            return e;
+        }
         match NonFinite::carried_by(&e) {
             Some(nf) if nf.row.is_none() => NonFinite {
                 row: Some(row),
@@ -135,6 +139,18 @@ impl NonFinite {
             None => io::Error::new(e.kind(), AtRow { row, source: e }),
         }
     }
+}
+
+/// A scene's error found while a renderer emits (a texture that fails to decode when a
+/// shading call first needs it), as an [`io::Error`] for an emitter to return; the
+/// pipeline reports it as the scene error it is ([`RenderError::Scene`]).
+pub fn scene_io(e: SceneError) -> io::Error {
+    io::Error::new(io::ErrorKind::InvalidData, e)
+}
+
+/// The [`SceneError`] an [`io::Error`] carries ([`scene_io`]), if any.
+pub fn scene_error_in(e: &io::Error) -> Option<&SceneError> {
+    e.get_ref()?.downcast_ref()
 }
 
 /// A renderer's error located at the pixel row it was making.
@@ -163,6 +179,9 @@ impl RenderError {
     /// otherwise the renderer's fault ([`RenderError::Renderer`]). For renderers that
     /// make a frame's values before it is emitted (their `frame`), and the pipeline.
     pub fn of_renderer(renderer: &'static str, source: io::Error) -> RenderError {
+        if let Some(e) = scene_error_in(&source) {
+            return RenderError::Scene(e.clone());
+        }
         match NonFinite::carried_by(&source) {
             Some(nf) => RenderError::Overflow {
                 renderer,

@@ -27,7 +27,7 @@
 //! its targets, so a pixel that `m` pieces reach (its trapezia, where fragments meet) is
 //! within `m ×` the tolerance of its tolerance-0 value.
 
-use crate::error::NonFinite;
+use crate::error::{scene_io, NonFinite};
 use crate::prepare::PhongSurfaces;
 use crate::renderer::{Counters, FramePlan};
 use crate::span::{fit_span, SpanStats};
@@ -170,10 +170,14 @@ impl FramePlan for PhongFrame<'_> {
                     for (k, &c) in coverage.iter().enumerate() {
                         let centre = [(first + k as i64) as f64 + 0.5, f64::from(row) + 0.5];
                         let p = nearest_in(triangle, centre);
-                        let shade = self
-                            .surfaces
-                            .shade_pixel(t.polygon as usize, p, centre)
-                            .unwrap_or_default();
+                        let shade = self.surfaces.shade_pixel(t.polygon as usize, p, centre);
+                        let shade = match shade {
+                            Ok(s) => s.unwrap_or_default(),
+                            Err(e) => {
+                                result = Err(scene_io(e));
+                                return;
+                            }
+                        };
                         targets.extend(shade[..channels].iter().map(|v| c * v.max(0.0)));
                     }
                     filled += 1;

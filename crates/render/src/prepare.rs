@@ -6,7 +6,7 @@
 use crate::error::RenderError;
 use crate::settings::Settings;
 use crate::source::{LoadedScene, Source};
-use cwisim_scene::{ScreenScene, Shading, Vector};
+use cwisim_scene::{SceneError, ScreenScene, Shading, Vector};
 use cwisim_world::face::ScreenTriangle;
 use cwisim_world::shade::PhongShader;
 use cwisim_world::shadow::{self, Casters, LightSet, ShadowStats, ShadowTest};
@@ -96,7 +96,13 @@ impl PhongSurfaces {
     /// The intensity of polygon `polygon` at screen point `p` (on its triangle) of the
     /// pixel whose centre is `centre`, by the lights that reach it, its texture read
     /// through [`Self::filter`] (`cwisim_world::shade::PhongShader::at_pixel_lit`).
-    pub fn shade_pixel(&self, polygon: usize, p: [f64; 2], centre: [f64; 2]) -> Option<Vector> {
+    /// A texture decoded here that fails is the scene's error.
+    pub fn shade_pixel(
+        &self,
+        polygon: usize,
+        p: [f64; 2],
+        centre: [f64; 2],
+    ) -> Result<Option<Vector>, SceneError> {
         let triangle = &self.triangles[self.sources[polygon]];
         match &self.shadows {
             None => self
@@ -423,14 +429,11 @@ impl PolygonScene {
         let Some(s) = &self.phong else {
             return Vec::new();
         };
-        s.shader
-            .textures()
-            .enumerate()
-            .filter_map(|(k, t)| {
-                t.map(|t| {
-                    let (w, h) = t.size();
-                    format!("mesh {k}: {} {w}×{h}", t.label())
-                })
+        let store = s.shader.textures();
+        (0..store.len() as u32)
+            .filter_map(|k| {
+                let (w, h) = store.size(k)?;
+                Some(format!("mesh {k}: {} {w}×{h}", store.label(k)?))
             })
             .collect()
     }

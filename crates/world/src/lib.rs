@@ -87,7 +87,7 @@ impl AnyScene {
     pub fn is_textured(&self) -> bool {
         match self {
             AnyScene::Screen(_) => false,
-            AnyScene::World(w) => w.textures.iter().any(Option::is_some),
+            AnyScene::World(w) => w.textures.any(),
         }
     }
 
@@ -185,10 +185,15 @@ pub fn referenced_files(text: &str, base: Option<&Path>) -> Vec<(String, std::pa
 /// Reads a scene file of any kind; errors name the file.
 pub fn load_any(path: &Path) -> Result<AnyScene, SceneError> {
     let text = cwisim_scene::read_scene_text(path)?;
-    parse_any(&text, path.parent()).map_err(|e| match e.path {
+    let scene = parse_any(&text, path.parent()).map_err(|e| match e.path {
         Some(_) => e, // an OBJ file's error names that file
         None => e.in_file(path),
-    })
+    })?;
+    if let AnyScene::World(w) = &scene {
+        // a texture decoded when first needed names the scene file too
+        w.textures.in_file(path);
+    }
+    Ok(scene)
 }
 
 /// How hidden surfaces are removed.

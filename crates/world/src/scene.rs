@@ -451,8 +451,9 @@ pub struct WorldScene {
     pub spec: WorldSpec,
     /// The meshes, in the order of `spec.meshes`.
     pub meshes: Vec<Mesh>,
-    /// Per mesh, its material's texture, loaded ([`crate::texture`]).
-    pub textures: Vec<Option<std::sync::Arc<crate::texture::Texture>>>,
+    /// Per mesh, its material's texture: its size read, its texels decoded when first
+    /// needed ([`crate::texture::TextureStore`]; clones of the scene share it).
+    pub textures: std::sync::Arc<crate::texture::TextureStore>,
 }
 
 impl WorldScene {
@@ -802,7 +803,7 @@ pub fn parse_world(text: &str, base: Option<&Path>) -> Result<WorldScene, SceneE
         crate::project::check_in_front(&camera, &built, k).map_err(locate)?;
         meshes.push(built);
     }
-    let textures = load_textures(&spec, &meshes, base).map_err(locate)?;
+    let textures = load_textures(&spec, &meshes, base, &locate).map_err(locate)?;
     Ok(WorldScene {
         spec,
         meshes,
@@ -813,12 +814,14 @@ pub fn parse_world(text: &str, base: Option<&Path>) -> Result<WorldScene, SceneE
 /// The textures of a scene's meshes (validated spec, built meshes): each textured mesh
 /// checked to have texture coordinates and each texture's size read (a checker's, an
 /// image's header) first; then what they all need checked against the memory budget
-/// (`cwisim_scene::budget`), refused at the texture that passes it; then each loaded.
+/// (`cwisim_scene::budget`), refused at the texture that passes it. Nothing is decoded:
+/// the store decodes a texture when a shading call first needs it.
 pub(crate) fn load_textures(
     spec: &WorldSpec,
     meshes: &[Mesh],
     base: Option<&Path>,
-) -> Result<Vec<Option<std::sync::Arc<crate::texture::Texture>>>, SceneError> {
+    locate: &dyn Fn(SceneError) -> SceneError,
+) -> Result<std::sync::Arc<crate::texture::TextureStore>, SceneError> {
     use crate::texture;
     let channels = spec.channels as usize;
     let field = |k: usize| format!("meshes[{k}].material.texture");
@@ -846,14 +849,11 @@ pub(crate) fn load_textures(
             )
             .map_err(|e| SceneError::at_field(SceneErrorKind::Limit, field(k), e.to_string()))?;
     }
-    spec.meshes
+    let specs = spec
+        .meshes
         .iter()
         .enumerate()
-        .map(|(k, m)| match &m.material.texture {
-            None => Ok(None),
-            Some(t) => {
-                texture::load(t, &field(k), channels, base).map(|t| Some(std::sync::Arc::new(t)))
-            }
-        })
-        .collect()
+        .map(|(k, m)| m.material.texture.clone().map(|t| (t, field(k))))
+        .collect();
+    texture::TextureStore::new(specs, channels, base, locate).map(std::sync::Arc::new)
 }

@@ -21,10 +21,21 @@
 use crate::face::ScreenTriangle;
 use crate::lighting::Lighting;
 use crate::scene::{Material, WorldScene};
-use crate::texture::{Texture, TextureFilter};
-use cwisim_scene::{Shading, Vector};
+use crate::texture::{TextureFilter, TextureStore};
+use cwisim_scene::{SceneError, Shading, Vector};
 use glam::DVec3;
 use std::sync::Arc;
+
+/// What a pixel reads of a texture.
+#[derive(Clone, Copy)]
+enum Lookup {
+    /// Nothing (no texture coordinates there): the factor is 1.
+    Nothing,
+    /// The texel under a point `(u, v)`.
+    Point([f64; 2]),
+    /// The mean over the rectangle between two corners in `(u, v)`.
+    Mean([f64; 2], [f64; 2]),
+}
 
 /// The lighting of a world scene, ready to shade its triangles at any screen point.
 #[derive(Clone, Debug)]
@@ -33,8 +44,8 @@ pub struct PhongShader {
     eye: DVec3,
     /// Per mesh.
     materials: Vec<Material>,
-    /// Per mesh, its texture.
-    textures: Vec<Option<Arc<Texture>>>,
+    /// The scene's textures, decoded when first read.
+    textures: Arc<TextureStore>,
     /// How a textured mesh is lit (every other mesh: Phong's).
     shading: Shading,
     /// Per mesh and face of a textured mesh, the face's centroid (where flat shading
@@ -55,12 +66,12 @@ impl PhongShader {
         let centroids = scene
             .meshes
             .iter()
-            .zip(&scene.textures)
-            .map(|(m, t)| match t {
-                Some(_) => (0..m.faces.len())
+            .enumerate()
+            .map(|(k, m)| match scene.textures.is_textured(k as u32) {
+                true => (0..m.faces.len())
                     .map(|f| crate::project::face_centroid(m, f))
                     .collect(),
-                None => Vec::new(),
+                false => Vec::new(),
             })
             .collect();
         PhongShader {
@@ -82,19 +93,19 @@ impl PhongShader {
         PhongShader { shading, ..self }
     }
 
-    /// The texture of mesh `mesh`, if it has one.
-    pub fn texture(&self, mesh: u32) -> Option<&Texture> {
-        self.textures.get(mesh as usize)?.as_deref()
+    /// The scene's textures (sizes and labels known, texels decoded when first read).
+    pub fn textures(&self) -> &TextureStore {
+        &self.textures
     }
 
-    /// Each mesh's texture, in mesh order (`None` for an untextured mesh).
-    pub fn textures(&self) -> impl Iterator<Item = Option<&Texture>> {
-        self.textures.iter().map(Option::as_deref)
+    /// Whether mesh `mesh` is textured (nothing decoded).
+    pub fn is_textured(&self, mesh: u32) -> bool {
+        self.textures.is_textured(mesh)
     }
 
     /// Whether any mesh is textured.
     pub fn textured(&self) -> bool {
-        self.textures.iter().any(Option::is_some)
+        self.textures.any()
     }
 
     /// The texture coordinates of `t` at screen point `p`, perspective-correct; `None`
@@ -112,26 +123,41 @@ impl PhongShader {
     /// `centre`, per channel (all 1 for an untextured mesh), read as `filter` says: the
     /// texel under `centre` on the triangle's plane, or the texture averaged over the
     /// pixel's footprint on that plane (either at `p` where the plane is at or behind the
-    /// eye there).
+    /// eye there). The texture is decoded if it is not resident: its error, if that fails.
     pub fn texture_factor(
         &self,
         t: &ScreenTriangle,
         p: [f64; 2],
         centre: [f64; 2],
         filter: TextureFilter,
-    ) -> [f64; 4] {
-        let Some(texture) = self.texture(t.mesh) else {
-            return [1.0; 4];
-        };
-        let at_p = || self.uv_at(t, p).map_or([1.0; 4], |uv| texture.point(uv));
+    ) -> Result<[f64; 4], SceneError> {
+        if !self.textures.is_textured(t.mesh) {
+            return Ok([1.0; 4]);
+        }
+        let lookup = self.lookup(t, p, centre, filter);
+        let factor = self.textures.with(t.mesh, |texture| match lookup {
+            Lookup::Nothing => [1.0; 4],
+            Lookup::Point(uv) => texture.point(uv),
+            Lookup::Mean(lo, hi) => texture.mean(lo, hi),
+        })?;
+        Ok(factor.unwrap_or([1.0; 4]))
+    }
+
+    /// What [`Self::texture_factor`] reads of the texture.
+    fn lookup(
+        &self,
+        t: &ScreenTriangle,
+        p: [f64; 2],
+        centre: [f64; 2],
+        filter: TextureFilter,
+    ) -> Lookup {
+        let at_p = || self.uv_at(t, p).map_or(Lookup::Nothing, Lookup::Point);
         match filter {
             // the texel under the pixel centre, on the triangle's plane extended to it
             // (the centre may lie outside the triangle, in a neighbour's part of the
             // pixel): every part of a pixel of one planar, uniformly mapped surface reads
             // the same texel, so no seam shows along the triangles' shared edges
-            TextureFilter::Point => self
-                .uv_at(t, centre)
-                .map_or_else(at_p, |uv| texture.point(uv)),
+            TextureFilter::Point => self.uv_at(t, centre).map_or_else(at_p, Lookup::Point),
             TextureFilter::Box => {
                 let mut lo = [f64::INFINITY; 2];
                 let mut hi = [f64::NEG_INFINITY; 2];
@@ -147,7 +173,7 @@ impl PhongShader {
                 if !(lo.iter().chain(&hi).all(|x| x.is_finite())) {
                     return at_p();
                 }
-                texture.mean(lo, hi)
+                Lookup::Mean(lo, hi)
             }
         }
     }
@@ -200,8 +226,9 @@ impl PhongShader {
         best
     }
 
-    /// The intensity of `t` at screen point `p` (see [`Self::surface_at`]).
-    pub fn at(&self, t: &ScreenTriangle, p: [f64; 2]) -> Option<Vector> {
+    /// The intensity of `t` at screen point `p` (see [`Self::surface_at`]); the error of
+    /// its texture, if it is decoded here and that fails.
+    pub fn at(&self, t: &ScreenTriangle, p: [f64; 2]) -> Result<Option<Vector>, SceneError> {
         self.at_lit(t, p, |_| true)
     }
 
@@ -213,7 +240,7 @@ impl PhongShader {
         t: &ScreenTriangle,
         p: [f64; 2],
         reaches: impl Fn(usize) -> bool,
-    ) -> Option<Vector> {
+    ) -> Result<Option<Vector>, SceneError> {
         self.at_pixel_lit(t, p, p, TextureFilter::Point, reaches)
     }
 
@@ -227,16 +254,27 @@ impl PhongShader {
         centre: [f64; 2],
         filter: TextureFilter,
         reaches: impl Fn(usize) -> bool,
+    ) -> Result<Option<Vector>, SceneError> {
+        let material = &self.materials[t.mesh as usize];
+        if !self.textures.is_textured(t.mesh) {
+            return Ok(self.surface_at(t, p).map(|(point, normal)| {
+                self.lighting
+                    .intensity_lit(material, point, normal, self.eye, reaches)
+            }));
+        }
+        let factor = self.texture_factor(t, p, centre, filter)?;
+        Ok(self.textured_at(t, p, factor, reaches))
+    }
+
+    /// A textured mesh's intensity at `p` with the texture's `factor` there.
+    fn textured_at(
+        &self,
+        t: &ScreenTriangle,
+        p: [f64; 2],
+        factor: [f64; 4],
+        reaches: impl Fn(usize) -> bool,
     ) -> Option<Vector> {
         let material = &self.materials[t.mesh as usize];
-        if self.texture(t.mesh).is_none() {
-            let (point, normal) = self.surface_at(t, p)?;
-            return Some(
-                self.lighting
-                    .intensity_lit(material, point, normal, self.eye, reaches),
-            );
-        }
-        let factor = self.texture_factor(t, p, centre, filter);
         let (diffuse, specular) = match self.shading {
             Shading::Flat => {
                 let centroid = self.centroids[t.mesh as usize][t.face as usize];

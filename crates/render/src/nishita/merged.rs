@@ -20,6 +20,7 @@
 //! Rows are emitted in order, the patches of a row by mesh and patch number: the stream
 //! is the same for any split of the rows into bands.
 
+use crate::error::scene_io;
 use crate::phong::nearest_in;
 use crate::prepare::PhongSurfaces;
 use crate::renderer::{Counters, FramePlan};
@@ -370,9 +371,17 @@ impl MergedFrame<'_> {
                                 }
                                 let centre = [i as f64 + 0.5, f64::from(slice.row) + 0.5];
                                 let p = nearest_in(triangle, centre);
-                                let shade = surfaces
-                                    .shade_pixel(base + t.polygon as usize, p, centre)
-                                    .unwrap_or_default();
+                                let shade = match surfaces.shade_pixel(
+                                    base + t.polygon as usize,
+                                    p,
+                                    centre,
+                                ) {
+                                    Ok(s) => s.unwrap_or_default(),
+                                    Err(e) => {
+                                        result = Err(scene_io(e));
+                                        return;
+                                    }
+                                };
                                 let i = i as usize;
                                 for (v, s) in slot.values[i * channels..(i + 1) * channels]
                                     .iter_mut()

@@ -421,7 +421,7 @@ impl Nishita {
             }
         };
         // Phong, or a texture under any shading: lit per pixel
-        let phong = settings.shading == Shading::Phong || w.textures.iter().any(Option::is_some);
+        let phong = settings.shading == Shading::Phong || w.textures.any();
         let shader = || PhongShader::for_shading(&w, settings.shading);
         // meshes that are not patches: projected as vanrij projects them
         let others: Vec<usize> = (0..w.spec.meshes.len())

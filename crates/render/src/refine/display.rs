@@ -32,7 +32,7 @@ pub fn is_textured(scene: &PolygonScene, k: usize) -> bool {
     scene
         .phong
         .as_ref()
-        .is_some_and(|s| s.shader.texture(s.triangles[s.sources[k]].mesh).is_some())
+        .is_some_and(|s| s.shader.is_textured(s.triangles[s.sources[k]].mesh))
 }
 
 /// Polygons lit per pixel, gathered with their source triangles and lights.

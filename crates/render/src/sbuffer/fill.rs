@@ -19,7 +19,7 @@
 use super::polys::{Poly, Polys};
 use super::sweep::{edge_value, span_gradient, LineCounts, Sweep};
 use crate::cp::{columns_in, Increment};
-use crate::error::NonFinite;
+use crate::error::{scene_io, NonFinite};
 use crate::renderer::Counters;
 use crate::span::{fit_span, SpanStats};
 use crate::subsample::{Grid, Sampler};
@@ -572,7 +572,11 @@ impl Scan<'_> {
                     targets.clear();
                     let y = f64::from(row) + 0.5;
                     for c in x..e {
-                        let v = self.scene.phong(p, c as f64 + 0.5, y).unwrap_or_default();
+                        let v = self
+                            .scene
+                            .phong(p, c as f64 + 0.5, y)
+                            .map_err(scene_io)?
+                            .unwrap_or_default();
                         targets.extend_from_slice(&v[..ch]);
                     }
                     let mut pieces = Vec::new();
@@ -613,7 +617,7 @@ impl Scan<'_> {
     }
 
     /// A sub-scanline's samples as `woo-chall`'s emitter takes them: winners and colours.
-    fn subline_of(&self, line: &DepthLine, y: f64, sub: &mut Subline) {
+    fn subline_of(&self, line: &DepthLine, y: f64, sub: &mut Subline) -> io::Result<()> {
         sub.winners.clone_from(&line.owner);
         sub.rgb.clear();
         for (c, &o) in line.owner.iter().enumerate() {
@@ -622,10 +626,12 @@ impl Scan<'_> {
                 _ if self.per_pixel() => self
                     .scene
                     .phong(&self.list[o as usize], self.sampler.column_x(c), y)
+                    .map_err(scene_io)?
                     .unwrap_or_default(),
                 _ => line.val[c],
             });
         }
+        Ok(())
     }
 
     /// Runs the whole frame in scan order.
@@ -711,7 +717,7 @@ impl Scan<'_> {
                         self.fill_line(&mut sweep, j, y, &mut line, &mut unset, None, &mut counts);
                     active = active.max(lc.active);
                     aet = aet.max(lc.aet);
-                    self.subline_of(&line, y, sub);
+                    self.subline_of(&line, y, sub)?;
                     counts.visible_runs += Scan::count_visible(&line);
                 }
                 let refs: Vec<&Subline> = sublines.iter().collect();

@@ -16,7 +16,7 @@ use crate::error::RenderError;
 use crate::settings::Settings;
 use crate::source::{LoadedScene, Source};
 use cwisim_isa::TraceHeader;
-use cwisim_scene::{Polygon, Shading, Vector};
+use cwisim_scene::{Polygon, SceneError, Shading, Vector};
 use cwisim_world::face::ScreenTriangle;
 use cwisim_world::shade::PhongShader;
 use cwisim_world::shadow::{LightSet, LineLights, ShadowTest};
@@ -182,7 +182,7 @@ impl Polys {
                 }
                 project = Some(stats);
                 // a textured mesh is lit per sample whatever the shading, as Phong is
-                if shading == Shading::Phong || w.textures.iter().any(Option::is_some) {
+                if shading == Shading::Phong || w.textures.any() {
                     shader = Some(PhongShader::for_shading(&w, shading));
                 }
                 if let Some((test, time)) = crate::prepare::sampled_shadows(&w, &tris, settings)? {
@@ -233,9 +233,12 @@ impl Polys {
     }
 
     /// With Phong shading (or textures): the lit colour of polygon `p` at `(x, y)` (negative terms
-    /// dropped), at the point of its triangle nearest `(x, y)`.
-    pub fn phong(&self, p: &Poly, x: f64, y: f64) -> Option<Vector> {
-        let (shader, tris) = (self.shader.as_ref()?, self.triangles.as_ref()?);
+    /// dropped), at the point of its triangle nearest `(x, y)`; the error of a texture
+    /// that fails to decode here, when first needed.
+    pub fn phong(&self, p: &Poly, x: f64, y: f64) -> Result<Option<Vector>, SceneError> {
+        let (Some(shader), Some(tris)) = (self.shader.as_ref(), self.triangles.as_ref()) else {
+            return Ok(None);
+        };
         let k = p.source as usize;
         let t = &tris[k];
         let at = crate::phong::nearest_in(t, [x, y]);
@@ -245,12 +248,12 @@ impl Polys {
                 shader.at_lit(t, at, |l| test.casters().reaches(lit, l))
             }
             None => shader.at(t, at),
-        }
+        }?
         .unwrap_or_default();
         for c in v.iter_mut() {
             *c = c.max(0.0);
         }
-        Some(v)
+        Ok(Some(v))
     }
 
     /// The lights that reach polygon `p` along line `y` (of a world scene with shadows),

@@ -20,13 +20,13 @@ pub mod shade;
 pub mod textures;
 pub mod triangle;
 
-use crate::error::{NonFinite, RenderError};
+use crate::error::{scene_io, NonFinite, RenderError};
 use crate::renderer::{Counters, FramePlan, Renderer};
 use crate::settings::Settings;
 use crate::source::LoadedScene;
 use crate::subsample::Sampler;
 use cwisim_isa::{Instruction, TraceHeader, TraceWrite};
-use cwisim_scene::Shading;
+use cwisim_scene::{Shading, Vector};
 use cwisim_xproc::{Image, RunStats};
 use emit::{emit_row, EmitCounts, EmitRule, Subline};
 use lists::{Layers, ListStats, Lists};
@@ -148,7 +148,7 @@ impl<'a> Scan<'a> {
             above: Vec::new(),
             layers: Layers::default(),
             figures: Vec::new(),
-            residency: Residency::new(&t.tris, &t.texture_bytes, s.height),
+            residency: Residency::new(&t.tris, t.textures.clone(), s.height),
         }
     }
 
@@ -182,6 +182,8 @@ impl<'a> Scan<'a> {
             } else {
                 let y = s.subline_y(j);
                 let residency = &mut self.residency;
+                // a texture that fails to decode when first shaded: the first such error
+                let mut failed = None;
                 self.shader.subline(
                     y,
                     &sub.winners,
@@ -189,10 +191,18 @@ impl<'a> Scan<'a> {
                     &t.tris,
                     &mut sub.rgb,
                     |tri, x, y| {
-                        residency.touch(tri.surface);
-                        t.shade(tri, x, y)
+                        let shaded = residency
+                            .touch(tri.surface)
+                            .and_then(|()| t.shade(tri, x, y));
+                        shaded.unwrap_or_else(|e| {
+                            failed.get_or_insert(e);
+                            Vector::default()
+                        })
                     },
                 );
+                if let Some(e) = failed {
+                    return Err(scene_io(e));
+                }
             }
             self.above.clone_from(&sub.winners);
         }

@@ -10,11 +10,13 @@ use crate::error::RenderError;
 use crate::settings::Settings;
 use crate::source::{LoadedScene, Source};
 use cwisim_isa::TraceHeader;
-use cwisim_scene::{ScreenScene, Shading, Vector};
+use cwisim_scene::{SceneError, ScreenScene, Shading, Vector};
 use cwisim_world::face::ScreenTriangle;
 use cwisim_world::shade::PhongShader;
 use cwisim_world::shadow::{LightSet, ShadowTest};
+use cwisim_world::texture::TextureStore;
 use cwisim_world::{AnyScene, ProjectStats};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// What shading calls need to shade with shadows.
@@ -48,9 +50,8 @@ pub struct Triangles {
     pub phong: Option<(Vec<ScreenTriangle>, PhongShader)>,
     /// With shadows: what the lights reach of each projected triangle.
     pub shadows: Option<Shadows>,
-    /// Per mesh, its texture's size in bytes (texels and summed-area table), if it has
-    /// one (empty for a screen scene).
-    pub texture_bytes: Vec<Option<u64>>,
+    /// The scene's textures, decoded when first shaded (`None` for a screen scene).
+    pub textures: Option<Arc<TextureStore>>,
     /// Wall time of the shadow pass (the lights' views).
     pub shadow_time: Duration,
     /// What projection did (world scenes).
@@ -73,7 +74,7 @@ impl Triangles {
         let loaded_textured = loaded.scene.is_textured();
         let (mut project, mut phong, mut polygons) = (None, None, 0);
         let (mut shadows, mut shadow_time) = (None, Duration::ZERO);
-        let mut texture_bytes = Vec::new();
+        let mut textures = None;
         let (width, height, channels, tris) = match loaded.scene {
             AnyScene::Screen(s) => {
                 if shading == Shading::Phong {
@@ -114,11 +115,7 @@ impl Triangles {
                     });
                     shadow_time = time;
                 }
-                texture_bytes = w
-                    .textures
-                    .iter()
-                    .map(|t| t.as_ref().map(|t| t.bytes()))
-                    .collect();
+                textures = Some(Arc::clone(&w.textures));
                 // a textured mesh is shaded per call whatever the shading, as Phong is:
                 // its texture read at the sample
                 if shading == Shading::Phong || loaded_textured {
@@ -139,7 +136,7 @@ impl Triangles {
             tris,
             phong,
             shadows,
-            texture_bytes,
+            textures,
             shadow_time,
             project,
             polygons,
@@ -155,11 +152,12 @@ impl Triangles {
 
     /// Whether a mesh is textured.
     pub fn textured(&self) -> bool {
-        self.texture_bytes.iter().any(Option::is_some)
+        self.textures.as_ref().is_some_and(|t| t.any())
     }
 
-    /// One shading call: the colour of `tri` at `(x, y)`.
-    pub fn shade(&self, tri: &Tri, x: f64, y: f64) -> Vector {
+    /// One shading call: the colour of `tri` at `(x, y)`; the error of a texture that
+    /// fails to decode here, when first needed.
+    pub fn shade(&self, tri: &Tri, x: f64, y: f64) -> Result<Vector, SceneError> {
         let channels = usize::from(self.channels);
         let k = tri.source as usize;
         // the lights that reach the sample (every light without shadows)
@@ -174,12 +172,12 @@ impl Triangles {
                         shader.at_lit(&tris[k], [x, y], |l| s.test.casters().reaches(lit, l))
                     }
                     _ => shader.at(&tris[k], [x, y]),
-                }
+                }?
                 .unwrap_or_default();
                 for c in v.iter_mut() {
                     *c = c.max(0.0);
                 }
-                v
+                Ok(v)
             }
             (None, Some(s)) if lit != LightSet::ALL => {
                 // Gouraud or flat without the lights that do not reach: the corners relit
@@ -195,9 +193,9 @@ impl Triangles {
                         &made
                     }
                 };
-                shaded.intensity_at([x, y], channels).unwrap_or_default()
+                Ok(shaded.intensity_at([x, y], channels).unwrap_or_default())
             }
-            _ => tri.intensity_at(x, y, channels),
+            _ => Ok(tri.intensity_at(x, y, channels)),
         }
     }
 

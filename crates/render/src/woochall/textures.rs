@@ -5,19 +5,24 @@
 //! the frame starts. Their Figure 10 applies four textures with memory for three.
 //!
 //! Here a texture is a textured mesh's; the shading calls say which mesh they shade
-//! ([`Residency::touch`]), and the end of each pixel row frees what no later row can use
-//! ([`Residency::end_row`]).
+//! ([`Residency::touch`]: the scene's [`TextureStore`] decodes its texels then, if they are
+//! not resident), and the end of each pixel row frees what no later row can use
+//! ([`Residency::end_row`]: the store drops the texels). The counters count what the store
+//! did: decodes and drops of texels.
 
 use super::triangle::Tri;
+use cwisim_scene::SceneError;
+use cwisim_world::texture::TextureStore;
+use std::sync::Arc;
 
 /// What loading and freeing did over a frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct ResidencyStats {
     /// Textured meshes in the scene.
     pub textures: u64,
-    /// Loads (each texture at most once: one freed is not used again).
+    /// Loads: texels decoded (each texture at most once: one freed is not used again).
     pub loads: u64,
-    /// Frees.
+    /// Frees: texels dropped.
     pub frees: u64,
     /// Most textures resident during one pixel row.
     pub peak: u64,
@@ -28,8 +33,10 @@ pub struct ResidencyStats {
 }
 
 /// Which textures are resident, row by row.
-#[derive(Clone, Debug)]
+#[derive(Debug)]
 pub struct Residency {
+    /// The textures (`None`: a screen scene).
+    store: Option<Arc<TextureStore>>,
     /// Per mesh: for a textured one, its texture's size in bytes and the last pixel row
     /// its triangles reach.
     textured: Vec<Option<(u64, u32)>>,
@@ -45,9 +52,12 @@ pub struct Residency {
 }
 
 impl Residency {
-    /// The residency of a frame of `tris` (`Tri::surface` is the mesh) where mesh `k`'s
-    /// texture, if it has one, takes `bytes[k]`; rows of an image `height` pixels high.
-    pub fn new(tris: &[Tri], bytes: &[Option<u64>], height: u32) -> Residency {
+    /// The residency of a frame of `tris` (`Tri::surface` is the mesh) whose textures
+    /// `store` holds; rows of an image `height` pixels high.
+    pub fn new(tris: &[Tri], store: Option<Arc<TextureStore>>, height: u32) -> Residency {
+        let bytes: Vec<Option<u64>> = store.as_ref().map_or_else(Vec::new, |s| {
+            (0..s.len() as u32).map(|k| s.bytes(k)).collect()
+        });
         let mut textured: Vec<Option<(u64, u32)>> = vec![None; bytes.len()];
         for t in tris {
             let k = t.surface as usize;
@@ -65,6 +75,7 @@ impl Residency {
         }
         let n = bytes.len();
         Residency {
+            store,
             stats: ResidencyStats {
                 textures: textured.iter().flatten().count() as u64,
                 ..ResidencyStats::default()
@@ -83,15 +94,20 @@ impl Residency {
         self.stats.textures > 0
     }
 
-    /// A shading call on mesh `mesh`: its texture is loaded if it is not yet.
-    pub fn touch(&mut self, mesh: u32) {
+    /// A shading call on mesh `mesh`: its texture is loaded if it is not yet (decoded by
+    /// the store); the store's error if that fails.
+    pub fn touch(&mut self, mesh: u32) -> Result<(), SceneError> {
         let k = mesh as usize;
         let Some(Some((bytes, _))) = self.textured.get(k) else {
-            return;
+            return Ok(());
         };
         if self.loaded[k] {
-            return;
+            return Ok(());
         }
+        let decoded = match &self.store {
+            Some(store) => store.load(mesh)?,
+            None => false,
+        };
         // a freed texture is never needed again: its last row is behind
         debug_assert!(
             !self.freed[k],
@@ -100,11 +116,12 @@ impl Residency {
         self.loaded[k] = true;
         self.resident += 1;
         self.bytes += bytes;
-        self.stats.loads += 1;
+        self.stats.loads += u64::from(decoded);
         self.row_peak = (
             self.row_peak.0.max(self.resident),
             self.row_peak.1.max(self.bytes),
         );
+        Ok(())
     }
 
     /// The end of pixel row `row`: the textures resident during it, counted; then those
@@ -124,7 +141,8 @@ impl Residency {
                     self.freed[k] = true;
                     self.resident -= 1;
                     self.bytes -= b;
-                    self.stats.frees += 1;
+                    let dropped = self.store.as_ref().is_some_and(|s| s.release(k as u32));
+                    self.stats.frees += u64::from(dropped);
                 }
             }
         }
@@ -157,21 +175,37 @@ mod tests {
             tri(2, 0.0, 9.0),
             tri(3, 6.0, 8.0),
         ];
-        let bytes = [Some(100), Some(10), None, Some(1000)];
-        let mut r = Residency::new(&tris, &bytes, 12);
+        let checker = |n: u32| -> cwisim_world::texture::TextureSpec {
+            serde_json::from_value(serde_json::json!({ "checker": { "squares": [n, n] } }))
+                .expect("a checker")
+        };
+        let specs = [Some(4), Some(2), None, Some(8)]
+            .map(|n| n.map(|n| (checker(n), "meshes[k].material.texture".to_string())));
+        let store = Arc::new(TextureStore::new(specs.to_vec(), 1, None, &|e| e).expect("a store"));
+        let bytes = [0, 1, 3].map(|k| store.bytes(k).expect("textured"));
+        let mut r = Residency::new(&tris, Some(Arc::clone(&store)), 12);
         assert_eq!(r.stats.textures, 3);
         let mut per_row = Vec::new();
+        let mut resident = Vec::new();
         for row in 0..12 {
             if row <= 4 {
-                r.touch(0);
+                r.touch(0).expect("decoded");
             }
             if (3..=9).contains(&row) {
-                r.touch(1);
+                r.touch(1).expect("decoded");
             }
-            r.touch(2);
+            r.touch(2).expect("untextured");
+            resident.push([0, 1, 3].map(|k| store.is_resident(k)));
             per_row.push(r.end_row(row));
         }
         assert_eq!(per_row, [1, 1, 1, 2, 2, 1, 1, 1, 1, 1, 0, 0]);
+        // the texels themselves: decoded at the first touch, dropped after the last row,
+        // and mesh 3's (never shaded) never decoded
+        assert_eq!(resident[0], [true, false, false]);
+        assert_eq!(resident[3], [true, true, false]);
+        assert_eq!(resident[5], [false, true, false]);
+        assert_eq!(resident[10], [false, false, false]);
+        assert!(!store.is_resident(3) && (store.loads(), store.frees()) == (2, 2));
         assert_eq!(
             r.stats,
             ResidencyStats {
@@ -180,7 +214,7 @@ mod tests {
                 frees: 2,
                 peak: 2,
                 peak_row: 3,
-                peak_bytes: 110,
+                peak_bytes: bytes[0] + bytes[1],
             }
         );
     }

@@ -22,6 +22,10 @@
 //! channel is not textured), a grey scene the image's luminance; texel values are the
 //! stored bytes over 255, linear, as `cwisim` writes its PNGs.
 
+pub mod store;
+
+pub use store::TextureStore;
+
 use crate::scene::PerChannel;
 use cwisim_scene::{SceneError, SceneErrorKind};
 use serde::{Deserialize, Serialize};
