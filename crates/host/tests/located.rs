@@ -41,8 +41,8 @@ const TWO_TRIANGLES: &str =
 #[test]
 fn a_light_that_cannot_cast_shadows_is_located_in_the_scene_file() {
     let dir = scratch("located-light");
-    // between the two triangles: it sees them on both sides
-    obj_scene(&dir, [0.0, 0.0, 0.5], TWO_TRIANGLES);
+    // on a vertex of the first triangle
+    obj_scene(&dir, [1.0, -1.0, 0.0], TWO_TRIANGLES);
     let stderr = refused(&dir, &["render", "s.json", "-o", "x.png"]);
     let text = std::fs::read_to_string(dir.join("s.json")).unwrap();
     let line = 1 + text
@@ -54,7 +54,11 @@ fn a_light_that_cannot_cast_shadows_is_located_in_the_scene_file() {
         "{stderr}"
     );
     assert!(stderr.contains("lights[0].position: light 0"), "{stderr}");
-    // a light that can is drawn
+    // a light that can is drawn, one between the triangles too (it sees them on both
+    // sides, through a cube's six views)
+    obj_scene(&dir, [0.0, 0.0, 0.5], TWO_TRIANGLES);
+    let out = cwisim(&dir, &["render", "s.json", "-o", "x.png", "-q"]);
+    assert_eq!(out.status.code(), Some(0), "{:?}", common::text(&out));
     obj_scene(&dir, [0.0, 0.5, 6.0], TWO_TRIANGLES);
     let out = cwisim(&dir, &["render", "s.json", "-o", "x.png", "-q"]);
     assert_eq!(out.status.code(), Some(0), "{:?}", common::text(&out));
@@ -101,4 +105,60 @@ fn obj_texture_coordinates_are_range_checked_as_inline_ones_are() {
         stderr.contains("m.obj:5:1: expected texture coordinates within ±1e9"),
         "{stderr}"
     );
+}
+
+/// A PNG chunk: length, type, data, CRC.
+fn png_chunk(kind: &[u8; 4], data: &[u8]) -> Vec<u8> {
+    let mut c = (data.len() as u32).to_be_bytes().to_vec();
+    c.extend_from_slice(kind);
+    c.extend_from_slice(data);
+    let mut crc = crc32fast::Hasher::new();
+    crc.update(kind);
+    crc.update(data);
+    c.extend_from_slice(&crc.finalize().to_be_bytes());
+    c
+}
+
+#[test]
+fn a_texture_that_fails_to_decode_when_first_needed_is_located_and_nothing_is_written() {
+    let dir = scratch("located-texture");
+    // a valid header (8×8, 8-bit RGB), then image data that is not a zlib stream: the
+    // scene reads (the size is the header's), the texels fail when first shaded
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    png.extend(png_chunk(b"IHDR", &[0, 0, 0, 8, 0, 0, 0, 8, 8, 2, 0, 0, 0]));
+    png.extend(png_chunk(b"IDAT", b"not zlib at all"));
+    png.extend(png_chunk(b"IEND", &[]));
+    std::fs::write(dir.join("t.png"), &png).unwrap();
+    let scene = serde_json::json!({
+        "kind": "world", "width": 32, "height": 24, "channels": 3,
+        "camera": { "eye": [0, 0, 5], "target": [0, 0, 0], "up": [0, 1, 0], "fov_y": 40 },
+        "ambient": 0.5, "lights": [],
+        "meshes": [ { "name": "quad", "material": { "k_a": 1, "k_d": 0, "k_s": 0, "n": 1,
+                                                     "texture": { "image": "t.png" } },
+                      "vertices": [[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]],
+                      "uv": [[0, 0], [1, 0], [1, 1], [0, 1]],
+                      "faces": [[0, 1, 2, 3]] } ]
+    });
+    let text = serde_json::to_string_pretty(&scene).unwrap();
+    std::fs::write(dir.join("s.json"), &text).unwrap();
+    let line = 1 + text.lines().position(|l| l.contains("\"image\"")).unwrap();
+    for renderer in ["vanrij", "woo-chall", "sbuffer", "bsp", "refine"] {
+        std::fs::write(dir.join("old.png"), b"the old file").unwrap();
+        let stderr = refused(
+            &dir,
+            &["render", "s.json", "--renderer", renderer, "-o", "old.png"],
+        );
+        assert!(
+            stderr.starts_with(&format!("error: s.json:{line}:"))
+                && stderr.contains(
+                    "meshes[0].material.texture.image: texture \"t.png\": not a readable PNG image"
+                ),
+            "{renderer}: {stderr}"
+        );
+        assert_eq!(
+            std::fs::read(dir.join("old.png")).unwrap(),
+            b"the old file",
+            "{renderer}: the old output replaced"
+        );
+    }
 }

@@ -10,9 +10,16 @@
 //!    of every mesh, front or back (an open surface's inside casts shadows too), is
 //!    projected through it and [`exact_fragments`] finds what the light sees of each: the
 //!    same exact polygon booleans as the camera's visibility, with their precision and
-//!    their bounds on memory and depth complexity. A light must see the whole scene
-//!    within such a view: one among the objects (vertices more than 170° apart from it)
-//!    or on a vertex is refused, located at `lights[k].position`.
+//!    their bounds on memory and depth complexity. A light that sees the scene wider than
+//!    one view holds (a vertex more than 85° from the mean direction: a lamp just over a
+//!    wide floor), or that the scene surrounds (a light in a room, inside a closed mesh),
+//!    sees it through the six faces of a cube around it instead: each face a 90° view of
+//!    the triangles' parts within its pyramid (each triangle clipped to the pyramid, the
+//!    part cut into a fan). Every direction from the light lies in one pyramid, and only
+//!    what lies in that pyramid can hide it, so the lit parts of a triangle are the union
+//!    of its parts' lit parts, exactly. A light on a vertex is refused, located at
+//!    `lights[k].position`; one on a surface's plane off its vertices sees that surface
+//!    edge-on and gives it no light.
 //! 2. **Back to the camera.** Each fragment the light sees lies in its triangle's plane:
 //!    its vertices are mapped to the world on that plane (perspective-correct weights of
 //!    the triangle's corners, as [`crate::shade`] does) and projected by the camera.
@@ -67,7 +74,8 @@ const VIEW_BYTES_PER_TRIANGLE: u64 = 1536;
 const LIT_BYTES_PER_TRIANGLE: u64 = 128;
 
 /// The smallest cosine between a vertex's direction from a light and the light view's
-/// axis: a light must see the scene within a cone under 170°.
+/// axis for one view to hold the scene (a cone under 170°); a light that sees it wider
+/// sees it through a cube's six faces.
 const MIN_COS: f64 = 0.087_155_742_747_658_17; // cos 85°
 
 /// Which shadow-casting lights reach a piece: bit `i` for the `i`-th caster
@@ -169,9 +177,19 @@ pub struct Shadowed {
     pub stats: ShadowStats,
 }
 
-/// A light's view: every triangle of the scene as the light sees it, and what it sees of each.
+/// A light's view of the scene: one pinhole view when the light sees the scene within
+/// one (under 170°), else the six faces of a cube around the light; and, per world
+/// triangle, its parts in them.
 struct LightView {
-    /// The light-view triangles, one per fan triangle of every face of every mesh.
+    views: Vec<View>,
+    /// Per world triangle, its parts: `(view, triangle of the view)`.
+    parts: Vec<Vec<(usize, usize)>>,
+}
+
+/// One pinhole view from a light: the triangles it holds as it sees them, and what it sees
+/// of each.
+struct View {
+    /// The light-view triangles.
     tris: Vec<ScreenTriangle>,
     /// Per light-view triangle, the range of its fragments in `fragments`.
     ranges: Vec<std::ops::Range<usize>>,
@@ -195,7 +213,8 @@ fn world_triangles(scene: &WorldScene) -> Vec<(u32, u32, [DVec3; 3])> {
 }
 
 impl LightView {
-    /// Light `k`'s view of `world`, or why the light cannot see the scene in one view.
+    /// Light `k`'s view of `world` (one view, or a cube's six), or why the light cannot
+    /// cast shadows (on a vertex; a cube's views over the memory budget).
     fn new(
         spec: &WorldSpec,
         k: usize,
@@ -226,18 +245,16 @@ impl LightView {
             }
             sum += d / length;
         }
-        let Some(axis) = sum.try_normalize() else {
-            return refuse("the scene surrounds it: it sees vertices in every direction; move it outside the objects, or set \"shadows\": false for it".into());
+        let one = sum.try_normalize().and_then(|axis| {
+            let widest = corners()
+                .map(|p| (p - light).normalize().dot(axis))
+                .fold(1.0f64, f64::min);
+            (widest >= MIN_COS).then_some((axis, widest))
+        });
+        let Some((axis, widest)) = one else {
+            // the scene around it, or wider than one view holds: the six faces of a cube
+            return LightView::cube(spec, k, world, threads);
         };
-        let widest = corners()
-            .map(|p| (p - light).normalize().dot(axis))
-            .fold(1.0f64, f64::min);
-        if widest < MIN_COS {
-            return refuse(format!(
-                "it sees the scene's vertices up to {:.1}° from their mean direction (at most 85°: one view must hold them all); move it outside the objects, or set \"shadows\": false for it",
-                widest.clamp(-1.0, 1.0).acos().to_degrees()
-            ));
-        }
         let up = if axis.x.abs() < 0.5 {
             DVec3::X
         } else {
@@ -271,6 +288,171 @@ impl LightView {
                 },
             })
             .collect();
+        let view = View::of(tris, threads);
+        Ok(LightView {
+            parts: (0..world.len()).map(|j| vec![(0, j)]).collect(),
+            views: vec![view],
+        })
+    }
+
+    /// Light `k`'s view of `world` through the six faces of a cube around it, each a
+    /// pinhole view of 90° holding the parts of the triangles within its pyramid (the
+    /// triangles clipped to it, each part cut into a fan): every direction from the light
+    /// is in one pyramid, and what the light sees in a direction only the triangles' parts
+    /// in that pyramid can hide.
+    /// Its triangles are counted first, and refused over the memory budget (at
+    /// `lights[k].position`) before any is made.
+    fn cube(
+        spec: &WorldSpec,
+        k: usize,
+        world: &[(u32, u32, [DVec3; 3])],
+        threads: usize,
+    ) -> Result<LightView, SceneError> {
+        let light = DVec3::from_array(spec.lights[k].position);
+        let count: usize = CUBE_FACES
+            .iter()
+            .map(|&(axis, _)| {
+                world
+                    .iter()
+                    .map(|(_, _, c)| {
+                        clip_to_pyramid(&c.map(|p| p - light), axis)
+                            .len()
+                            .saturating_sub(2)
+                    })
+                    .sum::<usize>()
+            })
+            .sum();
+        cwisim_scene::budget::Budget::current()
+            .check_memory(
+                &format!("light {k}'s six views ({count} triangles)"),
+                (count as u64).saturating_mul(VIEW_BYTES_PER_TRIANGLE),
+            )
+            .map_err(|e| {
+                SceneError::at_field(
+                    SceneErrorKind::Limit,
+                    format!("lights[{k}].position"),
+                    e.to_string(),
+                )
+            })?;
+        let mut parts = vec![Vec::new(); world.len()];
+        let mut views = Vec::with_capacity(6);
+        for (f, (axis, up)) in CUBE_FACES.into_iter().enumerate() {
+            let camera = Camera::new(
+                &CameraSpec {
+                    eye: spec.lights[k].position,
+                    target: (light + axis).to_array(),
+                    up: up.to_array(),
+                    // a margin past the pyramid's 90°: its clipped parts lie within
+                    fov_y: 92.0,
+                    near: 0.0,
+                },
+                LIGHT_VIEW_SIDE,
+                LIGHT_VIEW_SIDE,
+            );
+            let mut tris = Vec::new();
+            for (j, &(mesh, face, corners)) in world.iter().enumerate() {
+                let clipped = clip_to_pyramid(&corners.map(|p| p - light), axis);
+                for i in 1..clipped.len().saturating_sub(1) {
+                    let sub = [clipped[0], clipped[i], clipped[i + 1]].map(|d| d + light);
+                    parts[j].push((f, tris.len()));
+                    tris.push(ScreenTriangle {
+                        points: sub.map(|p| camera.project(p)),
+                        inv_depth: sub.map(|p| 1.0 / camera.depth(p)),
+                        intensity: [Vector::default(); 3],
+                        mesh,
+                        face,
+                        surface: Surface {
+                            world: sub,
+                            normals: [DVec3::ZERO; 3],
+                            uv: [[0.0; 2]; 3],
+                        },
+                    });
+                }
+            }
+            views.push(View::of(tris, threads));
+        }
+        Ok(LightView { views, parts })
+    }
+
+    /// Triangles in the view(s).
+    fn triangles(&self) -> usize {
+        self.views.iter().map(|v| v.tris.len()).sum()
+    }
+
+    /// Fragments the light sees.
+    fn fragments(&self) -> usize {
+        self.views.iter().map(|v| v.fragments.len()).sum()
+    }
+
+    /// How the light sees world triangle `j`: wholly (`Some(true)`), not at all
+    /// (`Some(false)`), or in part (`None`).
+    fn whole(&self, j: usize) -> Option<bool> {
+        let mut seen = self.parts[j].iter().map(|&(v, t)| self.views[v].whole(t));
+        let first = seen.next().unwrap_or(Some(false));
+        if seen.all(|w| w == first) {
+            first
+        } else {
+            None
+        }
+    }
+
+    /// What the light sees of world triangle `j`, as contours on the camera's screen.
+    fn lit_on_screen(&self, j: usize, camera: &Camera) -> Shape {
+        self.parts[j]
+            .iter()
+            .flat_map(|&(v, t)| self.views[v].lit_on_screen(t, camera))
+            .collect()
+    }
+}
+
+/// The faces of the cube around a light: each face's axis, and the up of its view.
+const CUBE_FACES: [(DVec3, DVec3); 6] = [
+    (DVec3::X, DVec3::Y),
+    (DVec3::NEG_X, DVec3::Y),
+    (DVec3::Y, DVec3::Z),
+    (DVec3::NEG_Y, DVec3::Z),
+    (DVec3::Z, DVec3::Y),
+    (DVec3::NEG_Z, DVec3::Y),
+];
+
+/// The part of the triangle `d` (corners relative to the light) within the pyramid of the
+/// cube face whose axis is `axis` (the points whose component along it is at least the
+/// magnitude of each other component), as a convex polygon (empty: none of it).
+fn clip_to_pyramid(d: &[DVec3; 3], axis: DVec3) -> Vec<DVec3> {
+    let (a, others) = match axis {
+        a if a.x != 0.0 => (a, [DVec3::Y, DVec3::Z]),
+        a if a.y != 0.0 => (a, [DVec3::X, DVec3::Z]),
+        a => (a, [DVec3::X, DVec3::Y]),
+    };
+    let mut poly: Vec<DVec3> = d.to_vec();
+    for o in others {
+        for sign in [1.0, -1.0] {
+            // keep a·p − sign·o·p ≥ 0
+            let side = |p: DVec3| a.dot(p) - sign * o.dot(p);
+            let mut out = Vec::with_capacity(poly.len() + 1);
+            for i in 0..poly.len() {
+                let (p, q) = (poly[i], poly[(i + 1) % poly.len()]);
+                let (sp, sq) = (side(p), side(q));
+                if sp >= 0.0 {
+                    out.push(p);
+                }
+                if (sp > 0.0 && sq < 0.0) || (sp < 0.0 && sq > 0.0) {
+                    out.push(p + (q - p) * (sp / (sp - sq)));
+                }
+            }
+            poly = out;
+            if poly.len() < 3 {
+                return Vec::new();
+            }
+        }
+    }
+    poly
+}
+
+impl View {
+    /// The view of the light-view triangles `tris`: what the light sees of each, found on
+    /// `threads` threads.
+    fn of(tris: Vec<ScreenTriangle>, threads: usize) -> View {
         let (fragments, _) = exact_fragments_on(&tris, 1, threads);
         let mut ranges = vec![0..0; tris.len()];
         let mut start = 0;
@@ -284,11 +466,11 @@ impl LightView {
             ranges[source] = start..end;
             start = end;
         }
-        Ok(LightView {
+        View {
             tris,
             ranges,
             fragments,
-        })
+        }
     }
 
     /// How the light sees light-view triangle `j`: wholly (`Some(true)`), not at all
@@ -392,8 +574,8 @@ pub struct ShadowTest {
 impl ShadowTest {
     /// The lit parts of the camera's triangles `tris` (made by [`crate::project::project`]
     /// of `scene` under `shading`) for every light of `casters`; the lights' views run on
-    /// `threads` threads (0: one per core). A light that cannot see the scene in one view
-    /// is refused at `lights[k].position` (see the [module docs](self)).
+    /// `threads` threads (0: one per core). A light on a vertex is refused at
+    /// `lights[k].position` (see the [module docs](self)).
     pub fn new(
         scene: &WorldScene,
         shading: Shading,
@@ -458,8 +640,8 @@ impl ShadowTest {
             .collect();
         for &k in &casters.lights {
             let view = LightView::new(spec, k, &world, threads)?;
-            test.light_triangles += view.tris.len() as u64;
-            test.light_fragments += view.fragments.len() as u64;
+            test.light_triangles += view.triangles() as u64;
+            test.light_fragments += view.fragments() as u64;
             for (reach, j) in test.reach.iter_mut().zip(&light_index) {
                 reach.push(match j.map(|j| (j, view.whole(j))) {
                     // not a face of the scene's meshes: nothing in the light's view to
@@ -893,18 +1075,204 @@ mod tests {
     }
 
     #[test]
-    fn lights_that_cannot_see_the_scene_in_one_view_are_refused_where_they_are() {
-        // inside the box: the scene surrounds it
-        let w = scene(r#"[{"position": [0, 0.7, 0], "intensity": 0.8, "shadows": true}]"#);
-        let e = cut(&w, None).unwrap_err();
-        assert_eq!(e.field.as_deref(), Some("lights[0].position"), "{e}");
-        assert!(e.to_string().contains("move it outside the objects"), "{e}");
-        // on a vertex of the box
+    fn a_light_on_a_vertex_is_refused_where_it_is() {
         let w = scene(r#"[{"position": [0.5, 1.2, 0.5], "intensity": 0.8, "shadows": true}]"#);
         let e = cut(&w, None).unwrap_err();
+        assert_eq!(e.field.as_deref(), Some("lights[0].position"), "{e}");
         assert!(e.to_string().contains("on a vertex of the scene"), "{e}");
-        // the same lights without shadows draw as before
+        // the same light without shadows draws as before
         assert!(cut(&w, Some(false)).is_ok());
+    }
+
+    /// Whether the segment from `p` to `light` meets triangle `t` strictly between its
+    /// ends (Möller–Trumbore): the independent reference, a ray cast.
+    fn blocks(p: DVec3, light: DVec3, t: &[DVec3; 3]) -> bool {
+        let dir = light - p;
+        let (e1, e2) = (t[1] - t[0], t[2] - t[0]);
+        let h = dir.cross(e2);
+        let a = e1.dot(h);
+        if a.abs() < 1e-14 {
+            return false;
+        }
+        let f = 1.0 / a;
+        let s = p - t[0];
+        let u = f * s.dot(h);
+        let q = s.cross(e1);
+        let v = f * dir.dot(q);
+        let along = f * e2.dot(q);
+        u >= 0.0 && v >= 0.0 && u + v <= 1.0 && along > 1e-9 && along < 1.0 - 1e-9
+    }
+
+    /// Every piece of the scene `w` cut by its one light is lit exactly where a ray cast
+    /// from a point inside it to the light meets no triangle; how many pieces were
+    /// checked, lit and shadowed.
+    fn agrees_with_a_ray_cast(w: &WorldScene) -> (usize, usize, usize) {
+        let (tris, _) = project(w, Shading::Flat).unwrap();
+        let (fragments, _) = crate::visibility::exact_fragments(&tris, 1);
+        let s = shadowed(
+            w,
+            Shading::Flat,
+            &tris,
+            fragments,
+            &casters(&w.spec, None).unwrap(),
+            1,
+        )
+        .unwrap();
+        let light = DVec3::from_array(w.spec.lights[0].position);
+        let world: Vec<[DVec3; 3]> = world_triangles(w).into_iter().map(|t| t.2).collect();
+        let (mut checked, mut lit, mut dark) = (0, 0, 0);
+        for (f, set) in s.fragments.iter().zip(&s.lit) {
+            let v = &f.polygon.vertices;
+            // a point well inside the piece: its largest fan triangle's centroid
+            let Some((a, b, c)) = (1..v.len() - 1)
+                .map(|i| (v[0], v[i], v[i + 1]))
+                .max_by(|x, y| area(&[x.0, x.1, x.2]).total_cmp(&area(&[y.0, y.1, y.2])))
+            else {
+                continue;
+            };
+            if area(&[a, b, c]) < 1e-2 {
+                continue;
+            }
+            let p = [(a[0] + b[0] + c[0]) / 3.0, (a[1] + b[1] + c[1]) / 3.0];
+            let t = &tris[f.source];
+            let (wts, sum) = t.perspective_weights(p).unwrap();
+            let q = (wts[0] * t.surface.world[0]
+                + wts[1] * t.surface.world[1]
+                + wts[2] * t.surface.world[2])
+                / sum;
+            let shadowed = world.iter().any(|t| blocks(q, light, t));
+            assert_eq!(
+                set.has(0),
+                !shadowed,
+                "the piece at {p:?} (world {q}) of {f:?}"
+            );
+            checked += 1;
+            if shadowed {
+                dark += 1;
+            } else {
+                lit += 1;
+            }
+        }
+        (checked, lit, dark)
+    }
+
+    /// A floor `side` units across at `y = 0`, a camera at `eye` looking at `target`, a
+    /// light at `light` casting shadows, and more `meshes` (JSON).
+    fn wide_scene(
+        side: f64,
+        eye: [f64; 3],
+        target: [f64; 3],
+        light: [f64; 3],
+        meshes: &str,
+    ) -> WorldScene {
+        let h = side / 2.0;
+        let text = format!(
+            r#"{{"kind": "world", "width": 160, "height": 120, "channels": 1,
+"camera": {{"eye": {eye:?}, "target": {target:?}, "fov_y": 50}},
+"ambient": 0.2, "lights": [{{"position": {light:?}, "intensity": 0.8, "shadows": true}}],
+"meshes": [
+  {{"material": {{"k_a": 0.5, "k_d": 0.7, "k_s": 0, "n": 1}},
+    "vertices": [[-{h}, 0, -{h}], [-{h}, 0, {h}], [{h}, 0, {h}], [{h}, 0, -{h}]], "faces": [[0, 1, 2, 3]]}}{meshes}
+]}}"#
+        );
+        crate::scene::parse_world(&text, None).unwrap()
+    }
+
+    /// A caster triangle (JSON mesh) with corners `c`.
+    fn caster(c: [[f64; 3]; 3]) -> String {
+        format!(
+            r#", {{"material": {{"k_a": 0.5, "k_d": 0.7, "k_s": 0, "n": 1}}, "vertices": {c:?}, "faces": [[0, 1, 2]]}}"#
+        )
+    }
+
+    #[test]
+    fn a_light_just_above_a_wide_floor_casts_the_analytic_shadow_of_a_triangle() {
+        // the light 1 above a floor 40 across sees it up to 88° from straight down: one
+        // view cannot hold it; the caster's shadow straddles two faces of the cube
+        let light = [0.0, 1.0, 0.0];
+        let c = [[0.3, 0.5, -0.2], [1.0, 0.5, 0.1], [0.4, 0.5, 0.6]];
+        let w = wide_scene(40.0, [12.0, 25.0, 0.0], [1.5, 0.0, 0.2], light, &caster(c));
+        assert_eq!(views(&w), 6);
+        let (checked, lit, dark) = agrees_with_a_ray_cast(&w);
+        assert!(checked > 3 && lit > 0 && dark > 0, "{checked} {lit} {dark}");
+        // the shadow on the floor: the caster's corners projected from the light onto
+        // y = 0 (twice as far: it is half way down), then by the camera; seen whole (the
+        // caster does not hide it from this eye)
+        let camera = Camera::new(&w.spec.camera, 160, 120);
+        let shadow: Vec<Pt> = c
+            .iter()
+            .map(|&[x, y, z]| {
+                let k = light[1] / (light[1] - y);
+                camera.project(DVec3::new(k * x, 0.0, k * z))
+            })
+            .collect();
+        let (tris, _) = project(&w, Shading::Flat).unwrap();
+        let (fragments, _) = crate::visibility::exact_fragments(&tris, 1);
+        let s = shadowed(
+            &w,
+            Shading::Flat,
+            &tris,
+            fragments,
+            &casters(&w.spec, None).unwrap(),
+            1,
+        )
+        .unwrap();
+        let floor_dark: f64 = s
+            .fragments
+            .iter()
+            .zip(&s.lit)
+            .filter(|(f, l)| tris[f.source].mesh == 0 && !l.has(0))
+            .map(|(f, _)| area(&f.polygon.vertices))
+            .sum();
+        let expect = area(&shadow);
+        assert!(
+            (floor_dark - expect).abs() <= 1e-9 * expect.max(1.0),
+            "shadow {floor_dark} px², analytic {expect} px²"
+        );
+    }
+
+    #[test]
+    fn a_light_surrounded_by_casters_on_all_sides_shadows_exactly() {
+        // six triangles around the light (above, below, and on four sides), over a floor
+        let light = [0.0, 2.0, 0.0];
+        let around = [
+            caster([[-0.3, 2.6, -0.2], [0.3, 2.6, -0.2], [0.0, 2.6, 0.3]]),
+            caster([[-0.3, 1.5, -0.2], [0.3, 1.5, -0.2], [0.0, 1.5, 0.3]]),
+            caster([[0.6, 1.8, -0.3], [0.6, 2.3, 0.0], [0.6, 1.8, 0.3]]),
+            caster([[-0.6, 1.8, -0.3], [-0.6, 2.3, 0.0], [-0.6, 1.8, 0.3]]),
+            caster([[-0.3, 1.8, 0.6], [0.3, 1.8, 0.6], [0.0, 2.3, 0.6]]),
+            caster([[-0.3, 1.8, -0.6], [0.3, 1.8, -0.6], [0.0, 2.3, -0.6]]),
+        ]
+        .concat();
+        let w = wide_scene(12.0, [0.0, 9.0, 7.0], [0.0, 0.0, 0.0], light, &around);
+        assert_eq!(views(&w), 6);
+        let (checked, lit, dark) = agrees_with_a_ray_cast(&w);
+        assert!(
+            checked >= 8 && lit > 0 && dark > 0,
+            "{checked} {lit} {dark}"
+        );
+    }
+
+    #[test]
+    fn a_light_inside_a_closed_box_lights_its_inside_and_shadows_all_outside() {
+        // the box of `scene`, the light inside it: drawn through the cube's six views
+        let w = scene(r#"[{"position": [0, 0.7, 0], "intensity": 0.8, "shadows": true}]"#);
+        assert_eq!(views(&w), 6);
+        let (tris, _) = project(&w, Shading::Flat).unwrap();
+        let s = cut(&w, None).unwrap();
+        // the floor, all outside the box, is dark; the box's faces are lit (from inside:
+        // the geometry decides, the lighting formula then gives them no diffuse term)
+        for (f, l) in s.fragments.iter().zip(&s.lit) {
+            assert_eq!(l.has(0), tris[f.source].mesh == 1, "{f:?}");
+        }
+        assert!(agrees_with_a_ray_cast(&w).0 > 0);
+    }
+
+    /// The views light 0 of `w` sees the scene through: 1, or a cube's 6.
+    fn views(w: &WorldScene) -> usize {
+        LightView::new(&w.spec, 0, &world_triangles(w), 1)
+            .map(|v| v.views.len())
+            .unwrap()
     }
 
     #[test]
