@@ -4,12 +4,17 @@
 use crate::error::RtlError;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Mutex;
 
 /// The process groups of the tools running now (each tool is started as the leader of a
 /// group of its own, so that what it starts — Verilator's make and compilers — is in it):
 /// what [`stop_children`] kills.
 static RUNNING: Mutex<Vec<u32>> = Mutex::new(Vec::new());
+
+/// Set by [`stop_children`]: the command is being interrupted, and the tools it kills die
+/// of that, not of a fault.
+static STOPPING: AtomicBool = AtomicBool::new(false);
 
 /// Runs `command` to its end, as the leader of a new process group registered in
 /// [`RUNNING`] while it runs; its output.
@@ -29,13 +34,22 @@ fn output_of(command: &mut Command) -> std::io::Result<Output> {
     if let Ok(mut running) = RUNNING.lock() {
         running.retain(|&p| p != pid);
     }
+    if STOPPING.load(Ordering::SeqCst) {
+        // killed by `stop_children`: the interrupting thread ends the process (its own
+        // exit status and message); reporting the tool's death as a failure would race it
+        loop {
+            std::thread::park();
+        }
+    }
     out
 }
 
 /// Kills every tool running now, with whatever it started (its process group): for a
 /// command interrupted by a signal, so that no simulator or synthesizer outlives it.
 /// Safe to call from a signal handler's thread; does nothing when none runs.
+/// A thread whose tool is killed so waits for the process to end rather than report it.
 pub fn stop_children() {
+    STOPPING.store(true, Ordering::SeqCst);
     let Ok(running) = RUNNING.lock() else {
         return;
     };
