@@ -120,7 +120,7 @@ pub enum IncrementArg {
     #[default]
     Direct,
     /// The paper's XX += SL along an edge: drifts, and flips a pixel where a crossing
-    /// falls on a sample (docs/ERRATA.md, B1).
+    /// falls on a sample (docs/ERRATA.md, BR1).
     Paper,
 }
 

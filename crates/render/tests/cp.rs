@@ -204,7 +204,7 @@ fn the_papers_increment_flips_a_pixel_where_a_crossing_hits_a_centre() {
     assert!(stats.increments > 0);
 }
 
-/// `--nocapture` prints the measurement quoted in docs/ERRATA.md (B1).
+/// `--nocapture` prints the measurement quoted in docs/ERRATA.md (BR1).
 #[test]
 fn the_papers_increment_measured_on_random_polygons() {
     use rand_core::Rng;

@@ -1,6 +1,7 @@
-//! Scan segments: the visible parts of one strip's pieces, found along the strip (the
-//! paper's Steps 4–5, "scan segments" of the subpatches meeting a scanline, with the box
-//! filter's exact areas kept).
+//! The slab sweep: the visible parts of one strip's pieces, found along the strip — an
+//! exact two-dimensional slab decomposition of straight-sided pieces, in the place of
+//! Nishita's Steps 4–5 (their "scan segments" are one-dimensional spans compared on each
+//! sub-scanline; docs/ERRATA.md ND6), with the box filter's exact areas kept.
 //!
 //! Every piece of a strip lies between its two row lines, so along the strip the pieces
 //! are compared slab by slab rather than pair by pair with polygon booleans:
