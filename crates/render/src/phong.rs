@@ -150,6 +150,7 @@ impl FramePlan for PhongFrame<'_> {
 
     fn emit_rows(&self, rows: Range<u32>, sink: &mut dyn TraceWrite) -> io::Result<Counters> {
         let channels = self.screen.channel_count();
+        let rows_done = rows.clone();
         let mut stats = SpanStats::default();
         let (mut filled, mut instructions) = (0u64, 0u64);
         let mut result = Ok(());
@@ -195,6 +196,7 @@ impl FramePlan for PhongFrame<'_> {
             }
         });
         result?;
+        self.surfaces.rows_done(rows_done);
         Ok(counters(filled, &stats, instructions))
     }
 }

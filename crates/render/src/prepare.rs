@@ -10,8 +10,9 @@ use cwisim_scene::{SceneError, ScreenScene, Shading, Vector};
 use cwisim_world::face::ScreenTriangle;
 use cwisim_world::shade::PhongShader;
 use cwisim_world::shadow::{self, Casters, LightSet, ShadowStats, ShadowTest};
-use cwisim_world::texture::TextureFilter;
+use cwisim_world::texture::{RowRelease, TextureFilter};
 use cwisim_world::{AnyScene, ProjectStats, Visibility, VisibilityStats};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// Screen-space polygons, ready to scan-convert, and what making them did.
@@ -65,6 +66,9 @@ pub struct PhongSurfaces {
     pub shadows: Option<PolygonLights>,
     /// How a pixel reads a texture.
     pub filter: TextureFilter,
+    /// With textures: each dropped after the last row its triangles reach
+    /// ([`Self::rows_done`]).
+    pub release: Option<Arc<RowRelease>>,
 }
 
 /// Which lights reach each polygon of a scene drawn with shadows.
@@ -79,12 +83,24 @@ pub struct PolygonLights {
 impl PhongSurfaces {
     /// Per-pixel shading without shadows.
     pub fn new(triangles: Vec<ScreenTriangle>, sources: Vec<usize>, shader: PhongShader) -> Self {
+        let release = shader
+            .textured()
+            .then(|| Arc::new(RowRelease::of_triangles(shader.texture_store(), &triangles)));
         PhongSurfaces {
             triangles,
             sources,
             shader,
             shadows: None,
             filter: TextureFilter::Box,
+            release,
+        }
+    }
+
+    /// Rows `rows` are emitted: the textures no later row reads are dropped (decoded
+    /// again if a later frame reads them).
+    pub fn rows_done(&self, rows: std::ops::Range<u32>) {
+        if let Some(r) = &self.release {
+            r.rows_done(rows);
         }
     }
 

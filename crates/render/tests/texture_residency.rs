@@ -35,6 +35,11 @@ fn large_checkers(text: &str) -> String {
 /// first, outside the measure), the decodes of its textures, and the textures resident
 /// after.
 fn draw(text: &str, renderer: &str, threads: usize) -> (usize, u64, bool) {
+    // one measure at a time: the allocator counts every test's allocations
+    static ONE: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    let _one = ONE
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
     let scene = parse_any(text, None).expect("a valid scene");
     let AnyScene::World(w) = &scene else {
         panic!("a world scene")
@@ -64,17 +69,30 @@ fn draw(text: &str, renderer: &str, threads: usize) -> (usize, u64, bool) {
 }
 
 #[test]
-fn woo_chall_holds_three_of_textures4_s_four_textures_at_once_and_none_after() {
+fn every_renderer_holds_three_of_textures4_s_four_textures_at_once_and_none_after() {
     let text = large_checkers(embedded("textures4").expect("embedded").text);
-    for threads in [1, 2] {
-        let (peak, loads, resident) = draw(&text, "woo-chall", threads);
-        // every texture decoded once; three resident at the peak: at least their bytes,
-        // and less than a fourth's more (the frame's own rows take a few MB)
-        assert_eq!(loads, 4, "{threads} thread(s)");
-        assert!(!resident, "every texture dropped after its last row");
+    let runs = registry::REGISTRY
+        .iter()
+        // nishita draws no scene without patches; refine redraws the textured polygons
+        // phase after phase, and keeps a texture to the end of a phase's frame
+        .filter(|e| e.textures && e.name != "nishita" && e.name != "refine")
+        .map(|e| (e.name, 1))
+        .chain([("woo-chall", 2), ("vanrij", 2)]);
+    for (renderer, threads) in runs {
+        let (peak, loads, resident) = draw(&text, renderer, threads);
+        // every texture decoded (once a frame); three resident at the peak: at least
+        // their bytes, and less than a fourth's more (the frame's own rows take a few MB)
+        assert!(
+            loads >= 4,
+            "{renderer} on {threads} thread(s): {loads} decodes"
+        );
+        assert!(
+            !resident,
+            "{renderer}: every texture dropped after its last row"
+        );
         assert!(
             (3 * TEXTURE..3 * TEXTURE + TEXTURE / 2).contains(&peak),
-            "{threads} thread(s): peak {peak} B, a texture {TEXTURE} B"
+            "{renderer} on {threads} thread(s): peak {peak} B, a texture {TEXTURE} B"
         );
     }
 }
@@ -110,7 +128,7 @@ fn a_texture_only_hidden_surfaces_use_is_never_decoded_by_any_renderer() {
     );
     for entry in registry::REGISTRY.iter().filter(|e| e.textures) {
         let (peak, loads, _) = draw(&shown, entry.name, 1);
-        assert_eq!(loads, 1, "{} did not decode a shown texture", entry.name);
+        assert!(loads >= 1, "{} did not decode a shown texture", entry.name);
         assert!(peak >= TEXTURE, "{}: peak {peak} B", entry.name);
     }
 }

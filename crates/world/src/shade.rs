@@ -98,6 +98,11 @@ impl PhongShader {
         &self.textures
     }
 
+    /// The scene's texture store, shared.
+    pub fn texture_store(&self) -> Arc<TextureStore> {
+        Arc::clone(&self.textures)
+    }
+
     /// Whether mesh `mesh` is textured (nothing decoded).
     pub fn is_textured(&self, mesh: u32) -> bool {
         self.textures.is_textured(mesh)

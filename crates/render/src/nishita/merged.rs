@@ -263,6 +263,9 @@ impl FramePlan for MergedFrame<'_> {
             self.emit_chunk(start..end, sink, &mut slots, &mut unpacked, &mut tally)?;
             start = end;
         }
+        if let Some(surfaces) = &self.phong {
+            surfaces.rows_done(rows);
+        }
         Ok(counters(&tally))
     }
 }

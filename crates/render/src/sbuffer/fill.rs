@@ -662,6 +662,7 @@ impl Scan<'_> {
             Rule::Claim => true,
             Rule::Paint => false,
         };
+        let release = self.scene.texture_release();
         for row in 0..height {
             let mut list = Vec::new();
             let mut counts = RowCounts::default();
@@ -751,6 +752,9 @@ impl Scan<'_> {
             }));
             rows.push(list);
             row_counts.push(counts);
+            if let Some(r) = &release {
+                r.rows_done(row..row + 1);
+            }
         }
         let critical = self
             .list

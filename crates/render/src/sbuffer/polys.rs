@@ -20,6 +20,7 @@ use cwisim_scene::{Polygon, SceneError, Shading, Vector};
 use cwisim_world::face::ScreenTriangle;
 use cwisim_world::shade::PhongShader;
 use cwisim_world::shadow::{LightSet, LineLights, ShadowTest};
+use cwisim_world::texture::RowRelease;
 use cwisim_world::{AnyScene, ProjectStats};
 use std::time::{Duration, Instant};
 
@@ -215,6 +216,13 @@ impl Polys {
             load_time: loaded.load_time,
             transform_time: start.elapsed() - shadow_time,
         })
+    }
+
+    /// With textures: their release after the last row their triangles reach.
+    pub fn texture_release(&self) -> Option<RowRelease> {
+        let (shader, tris) = (self.shader.as_ref()?, self.triangles.as_ref()?);
+        self.textured
+            .then(|| RowRelease::of_triangles(shader.texture_store(), tris))
     }
 
     /// The array it draws into.

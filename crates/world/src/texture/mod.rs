@@ -24,7 +24,7 @@
 
 pub mod store;
 
-pub use store::TextureStore;
+pub use store::{RowRelease, TextureStore};
 
 use crate::scene::PerChannel;
 use cwisim_scene::{SceneError, SceneErrorKind};

@@ -245,6 +245,109 @@ impl TextureStore {
     }
 }
 
+/// A frame's textures dropped after the last pixel row their triangles reach, for a
+/// renderer whose rows are emitted in bands (in any order, on any thread): each band says
+/// when it is done ([`RowRelease::rows_done`]), and once every row up to a texture's last
+/// is done, the store drops its texels. A frame's last row done starts the count again for
+/// the next frame (a texture used again is decoded again).
+#[derive(Debug)]
+pub struct RowRelease {
+    store: Arc<TextureStore>,
+    /// `(last row, mesh)` of every textured mesh drawn, by last row.
+    last: Vec<(u32, u32)>,
+    state: Mutex<Rows>,
+}
+
+/// Which rows are done, and how far without a gap.
+#[derive(Debug)]
+struct Rows {
+    done: Vec<bool>,
+    /// Every row before it is done.
+    prefix: usize,
+    /// `last[..released]` are dropped.
+    released: usize,
+}
+
+impl RowRelease {
+    /// The release of `store`'s textures for a frame of triangles `spans`: each its mesh
+    /// and the largest `y` it reaches (pixel row `⌊y⌋`).
+    pub fn new(
+        store: Arc<TextureStore>,
+        spans: impl IntoIterator<Item = (u32, f64)>,
+    ) -> RowRelease {
+        let mut last: Vec<Option<u32>> = vec![None; store.len()];
+        for (mesh, y) in spans {
+            if !store.is_textured(mesh) || !y.is_finite() {
+                continue;
+            }
+            let row = y.floor().clamp(0.0, f64::from(u32::MAX - 1)) as u32;
+            let slot = &mut last[mesh as usize];
+            *slot = Some(slot.map_or(row, |r| r.max(row)));
+        }
+        let mut last: Vec<(u32, u32)> = last
+            .into_iter()
+            .enumerate()
+            .filter_map(|(k, r)| r.map(|r| (r, k as u32)))
+            .collect();
+        last.sort_unstable();
+        let rows = last.last().map_or(0, |l| l.0 as usize + 1);
+        RowRelease {
+            store,
+            last,
+            state: Mutex::new(Rows {
+                done: vec![false; rows],
+                prefix: 0,
+                released: 0,
+            }),
+        }
+    }
+
+    /// The release of `store`'s textures for a frame of the projected triangles `tris`.
+    pub fn of_triangles(
+        store: Arc<TextureStore>,
+        tris: &[crate::face::ScreenTriangle],
+    ) -> RowRelease {
+        RowRelease::new(
+            store,
+            tris.iter().map(|t| {
+                let bottom = t
+                    .points
+                    .iter()
+                    .map(|p| p[1])
+                    .fold(f64::NEG_INFINITY, f64::max);
+                (t.mesh, bottom)
+            }),
+        )
+    }
+
+    /// Rows `rows` are emitted: the textures whose last row is now behind every row done
+    /// are dropped.
+    pub fn rows_done(&self, rows: std::ops::Range<u32>) {
+        let Ok(mut state) = self.state.lock() else {
+            return;
+        };
+        let n = state.done.len();
+        let (a, b) = ((rows.start as usize).min(n), (rows.end as usize).min(n));
+        state.done[a..b].iter_mut().for_each(|d| *d = true);
+        while state.prefix < n && state.done[state.prefix] {
+            state.prefix += 1;
+        }
+        while let Some(&(row, mesh)) = self.last.get(state.released) {
+            if (row as usize) >= state.prefix {
+                break;
+            }
+            self.store.release(mesh);
+            state.released += 1;
+        }
+        if state.prefix == n {
+            // the frame's rows all done: the next frame counts again
+            state.done.iter_mut().for_each(|d| *d = false);
+            state.prefix = 0;
+            state.released = 0;
+        }
+    }
+}
+
 impl Slot {
     /// The texels, decoded if no other thread did meanwhile; whether this call decoded.
     /// An error is located in the scene (`file`, the line and column of the image's name).
@@ -372,6 +475,35 @@ mod tests {
         assert_eq!(store.load(0).expect_err("still cut short"), first);
         assert_eq!(store.loads(), 0);
         let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn a_texture_is_dropped_once_every_row_up_to_its_last_is_done_in_any_order() {
+        let specs = vec![
+            Some((checker(2), "a".into())),
+            Some((checker(2), "b".into())),
+            None,
+        ];
+        let store = Arc::new(TextureStore::new(specs, 1, None, &|e| e).expect("a store"));
+        // mesh 0 reaches row 3, mesh 1 row 7, mesh 2 is not textured
+        let release = RowRelease::new(Arc::clone(&store), [(0, 1.5), (0, 3.2), (1, 7.9), (2, 9.0)]);
+        store.load(0).expect("decoded");
+        store.load(1).expect("decoded");
+        // bands out of order: rows 4–7 first, then 0–3
+        release.rows_done(4..8);
+        assert!(
+            store.is_resident(0) && store.is_resident(1),
+            "rows 0-3 not done"
+        );
+        release.rows_done(0..4);
+        assert!(!store.is_resident(0) && !store.is_resident(1));
+        assert_eq!(store.frees(), 2);
+        // the next frame counts again
+        store.load(0).expect("decoded again");
+        release.rows_done(0..2);
+        assert!(store.is_resident(0), "row 3 not done yet");
+        release.rows_done(2..4);
+        assert!(!store.is_resident(0));
     }
 
     fn crc(bytes: &[u8]) -> u32 {
