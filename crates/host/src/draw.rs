@@ -339,6 +339,10 @@ pub struct DrawArgs {
         help_heading = "Bézier patches (nishita)"
     )]
     pub flatness: f64,
+    /// Nishita's §5: a subpatch whose corner normals differ by more than ANGLE degrees is
+    /// divided again [default: off, the flatness alone decides].
+    #[arg(long, value_name = "ANGLE", help_heading = "Bézier patches (nishita)")]
+    pub normal_angle: Option<f64>,
     /// Pixel rows per band of subpatches (the paper: three or four).
     #[arg(
         long,
@@ -437,6 +441,7 @@ impl Default for DrawArgs {
             unset: UnsetArg::Host,
             root_tolerance: 1e-3,
             flatness: 0.5,
+            normal_angle: None,
             band: 4,
             subscan: 1,
             gouraud_threshold: Threshold::Above(DEFAULT_GOURAUD_THRESHOLD),
@@ -502,6 +507,7 @@ impl DrawArgs {
             unset: self.unset.into(),
             root_tolerance: self.root_tolerance,
             flatness: self.flatness,
+            normal_angle: self.normal_angle,
             band: self.band,
             subscan: self.subscan,
             gouraud_threshold: self.gouraud_threshold,

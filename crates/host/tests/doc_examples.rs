@@ -173,6 +173,12 @@ const LONG: &[&str] = &[
     "docs/REPRODUCTION.md: render teapot --renderer nishita -o f.png",
     // the plain and the textured teapot by nishita: 2 × 40 s debug, 2 s release
     "docs/REPRODUCTION.md: --renderer nishita --threads 1",
+    // the fine reference and four nishita teapots with the normal test: 15–30 s release
+    "docs/REPRODUCTION.md: --tessellate 64 --shading phong --shade-tolerance 0 -o ref.png",
+    "docs/REPRODUCTION.md: --normal-angle $a",
+    // the diff of the one-sided and the two-sided teapot, which the long renders make
+    // (`--renderer nishita --threads 1`, below)
+    "docs/REPRODUCTION.md: diff two-sided.npy one-sided.npy",
     // still-life through the S-buffer with its shadows: 20 s debug, 0.2 s release
     "docs/REPRODUCTION.md: render still-life --renderer sbuffer",
     // eight refinements of the pot: 15 s debug, 2 s release

@@ -345,6 +345,7 @@ fn example(s: Setting, shading: bool) -> Vec<&'static str> {
         Setting::Unset => vec!["--unset", "eval0", "--shading", "flat", "--samples", "1"],
         Setting::RootTolerance => vec!["--root-tolerance", "0.2"],
         Setting::Flatness => vec!["--flatness", "4"],
+        Setting::NormalAngle => vec!["--normal-angle", "45"],
         Setting::Band => vec!["--band", "1"],
         Setting::Subscan => vec!["--subscan", "3"],
         Setting::GouraudThreshold => vec!["--gouraud-threshold", "all"],

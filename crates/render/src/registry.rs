@@ -252,6 +252,7 @@ pub const REGISTRY: &[Entry] = &[
             Setting::ShadeTolerance,
             Setting::RootTolerance,
             Setting::Flatness,
+            Setting::NormalAngle,
             Setting::Band,
             Setting::Subscan,
             Setting::TextureFilter,

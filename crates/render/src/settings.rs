@@ -90,6 +90,9 @@ pub struct Settings {
     /// Nishita: how far (pixels) a subpatch's projected control points may lie from the
     /// bilinear interpolation of its projected corners.
     pub flatness: f64,
+    /// Nishita §5: a subpatch whose corner normals differ by more than this angle
+    /// (degrees) is divided again (`None`: off, flatness alone decides).
+    pub normal_angle: Option<f64>,
     /// Nishita: pixel rows per band of subpatches.
     pub band: u32,
     /// Nishita: sub-scanlines per pixel row: roots at every `1/subscan` of a row.
@@ -158,6 +161,8 @@ pub enum Setting {
     RootTolerance,
     /// [`Settings::flatness`].
     Flatness,
+    /// [`Settings::normal_angle`].
+    NormalAngle,
     /// [`Settings::band`].
     Band,
     /// [`Settings::subscan`].
@@ -176,7 +181,7 @@ pub enum Setting {
 
 impl Setting {
     /// Every setting, in the order of the command line's drawing flags.
-    pub const ALL: [Setting; 26] = [
+    pub const ALL: [Setting; 27] = [
         Setting::Shading,
         Setting::Aa,
         Setting::Visibility,
@@ -196,6 +201,7 @@ impl Setting {
         Setting::Unset,
         Setting::RootTolerance,
         Setting::Flatness,
+        Setting::NormalAngle,
         Setting::Band,
         Setting::Subscan,
         Setting::GouraudThreshold,
@@ -227,6 +233,7 @@ impl Setting {
             Setting::Unset => "--unset",
             Setting::RootTolerance => "--root-tolerance",
             Setting::Flatness => "--flatness",
+            Setting::NormalAngle => "--normal-angle",
             Setting::Band => "--band",
             Setting::Subscan => "--subscan",
             Setting::GouraudThreshold => "--gouraud-threshold",
@@ -294,6 +301,12 @@ impl Setting {
             Setting::Unset => s.unset = value.parse()?,
             Setting::RootTolerance => s.root_tolerance = parse(value, number)?,
             Setting::Flatness => s.flatness = parse(value, number)?,
+            Setting::NormalAngle => {
+                s.normal_angle = match value.trim().to_ascii_lowercase().as_str() {
+                    "off" => None,
+                    v => Some(parse(v, "a number of degrees or off")?),
+                }
+            }
             Setting::Band => s.band = parse(value, count)?,
             Setting::Subscan => s.subscan = parse(value, count)?,
             Setting::GouraudThreshold => s.gouraud_threshold = value.parse()?,
@@ -533,6 +546,7 @@ impl Default for Settings {
             unset: Unset::Host,
             root_tolerance: 1e-3,
             flatness: 0.5,
+            normal_angle: None,
             band: 4,
             subscan: 1,
             gouraud_threshold: Threshold::Above(DEFAULT_GOURAUD_THRESHOLD),
@@ -561,6 +575,10 @@ pub const MAX_ROOT_TOLERANCE: f64 = 1.0;
 pub const MAX_BAND: u32 = 4096;
 /// The most sub-scanlines per row.
 pub const MAX_SUBSCAN: u32 = 64;
+/// The smallest `--normal-angle`, degrees: below it subpatches would be divided to the
+/// deepest level everywhere a surface curves at all.
+pub const MIN_NORMAL_ANGLE: f64 = 0.5;
+
 /// The finest flatness, pixels.
 pub const MIN_FLATNESS: f64 = 1e-3;
 
@@ -605,6 +623,13 @@ impl Settings {
                 "--flatness must be a finite number of pixels ≥ {MIN_FLATNESS}, found {}",
                 self.flatness
             ));
+        }
+        if let Some(a) = self.normal_angle {
+            if !(MIN_NORMAL_ANGLE..=180.0).contains(&a) {
+                return Err(format!(
+                    "--normal-angle must be between {MIN_NORMAL_ANGLE} and 180 degrees, or off, found {a}"
+                ));
+            }
         }
         if !(1..=MAX_BAND).contains(&self.band) {
             return Err(format!(

@@ -69,6 +69,7 @@ fn band_clipping_is_conservative() {
         tolerance: settings.root_tolerance,
         flatness: settings.flatness,
         subscan: 1,
+        normal_cos: None,
     };
     let patches = cwisim_world::mesh::placed_patches(&w.spec.meshes[0])
         .unwrap()
@@ -500,4 +501,75 @@ fn resolved_fragments_are_held_without_spare_room() {
             "keep {keep}: threads 1 and 3 differ"
         );
     }
+}
+
+#[test]
+fn the_normal_difference_test_off_or_never_passed_draws_today_s_image_and_on_divides_more() {
+    let size = 48;
+    let draw = |normal_angle: Option<f64>| {
+        let settings = Settings {
+            shading: Shading::Phong,
+            normal_angle,
+            ..Settings::default()
+        };
+        let loaded = LoadedScene::built("teapot", AnyScene::World(teapot(size)));
+        let r = (registry::find("nishita").unwrap().build)(loaded, &settings).unwrap();
+        let h = r.header();
+        let mut sink = ImageSink::new(h.width as usize, h.channel_count(), 1 << 30);
+        let out = render(&*r, &ArrayConfig::default(), 1, &mut sink, Taps::default()).unwrap();
+        let subpatches: u64 = ["subpatches_front", "subpatches_back", "subpatches_twisted"]
+            .iter()
+            .map(|c| out.counters.get(c).unwrap())
+            .sum();
+        (sink.finish().unwrap().data, subpatches, ())
+    };
+    let (off, off_subpatches, _) = draw(None);
+    // an angle no two normals can pass: the image of the test left off, bit for bit
+    let (never, never_subpatches, _) = draw(Some(180.0));
+    assert!(off
+        .iter()
+        .zip(&never)
+        .all(|(a, b)| a.to_bits() == b.to_bits()));
+    assert_eq!(off_subpatches, never_subpatches);
+    let (_, on_subpatches, _) = draw(Some(60.0));
+    assert!(
+        on_subpatches > off_subpatches,
+        "{on_subpatches} subpatches at 60°, {off_subpatches} off"
+    );
+}
+
+/// A cell of control points `points` (a whole patch).
+fn cell(points: [[glam::DVec3; 4]; 4]) -> cwisim_render::nishita::band::Cell {
+    cwisim_render::nishita::band::Cell {
+        patch: 0,
+        level: 0,
+        index: (0, 0),
+        points,
+    }
+}
+
+#[test]
+fn a_cell_s_corner_normals_are_apart_as_far_as_the_surface_turns() {
+    use glam::DVec3;
+    // a quarter cylinder: the arc (1, 0) → (0, 1) along each row, rows along z; its
+    // corner normals turn through 90°
+    let k = 0.552_284_75;
+    let arc = [[1.0, 0.0], [1.0, k], [k, 1.0], [0.0, 1.0]];
+    let quarter = std::array::from_fn(|r| {
+        std::array::from_fn(|c| DVec3::new(arc[c][0], arc[c][1], r as f64 / 3.0))
+    });
+    let q = cell(quarter);
+    assert!(q.normals_apart(80f64.to_radians().cos()));
+    assert!(!q.normals_apart(100f64.to_radians().cos()));
+    // flat: no two normals apart, even at 1°
+    let flat = cell(std::array::from_fn(|r| {
+        std::array::from_fn(|c| DVec3::new(c as f64, r as f64, 0.0))
+    }));
+    assert!(!flat.normals_apart(1f64.to_radians().cos()));
+    // a corner where both edges collapse has no normal; the others still count
+    let mut cone = quarter;
+    cone[0] = [DVec3::ZERO; 4];
+    let c = cell(cone);
+    assert!(c.normals_apart(80f64.to_radians().cos()));
+    assert!(!c.normals_apart(-1.0));
 }

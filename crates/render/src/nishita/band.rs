@@ -44,6 +44,9 @@ pub struct Params {
     pub flatness: f64,
     /// Sub-scanlines per pixel row: strips `1/subscan` of a row high.
     pub subscan: u32,
+    /// §5's second test: the cosine of the largest angle a subpatch's corner normals may
+    /// make with one another before it is divided again (`None`: not tested).
+    pub normal_cos: Option<f64>,
 }
 
 impl Params {
@@ -171,6 +174,41 @@ fn half(c: [DVec3; 4]) -> ([DVec3; 4], [DVec3; 4]) {
 }
 
 impl Cell {
+    /// Nishita's §5 test: whether two of the cell's corner normals make an angle whose
+    /// cosine is below `cos` ("when the difference between the normal vectors at both
+    /// endpoints is greater than a threshold, the subpatch is divided again"). A corner
+    /// normal is the cross product of the tangents along the cell's two edges there (the
+    /// next control point along an edge that collapses at the corner); a corner where
+    /// both collapse has none, and is left out.
+    pub fn normals_apart(&self, cos: f64) -> bool {
+        let p = &self.points;
+        let normal = |r: usize, c: usize| -> Option<DVec3> {
+            let (dr, dc) = (
+                if r == 0 { 1i32 } else { -1 },
+                if c == 0 { 1i32 } else { -1 },
+            );
+            let at = |k: i32, l: i32| p[(r as i32 + k * dr) as usize][(c as i32 + l * dc) as usize];
+            let corner = p[r][c];
+            // along the row (u) and down the column (v), signed toward +u and +v
+            let tangent = |pick: &dyn Fn(i32) -> DVec3, sign: f64| {
+                (1..4)
+                    .map(|k| (pick(k) - corner) * sign)
+                    .find(|t| t.length_squared() > 0.0)
+            };
+            let u = tangent(&|k| at(0, k), f64::from(dc))?;
+            let v = tangent(&|k| at(k, 0), f64::from(dr))?;
+            u.cross(v).try_normalize()
+        };
+        let normals: Vec<DVec3> = [(0, 0), (0, 3), (3, 0), (3, 3)]
+            .into_iter()
+            .filter_map(|(r, c)| normal(r, c))
+            .collect();
+        normals
+            .iter()
+            .enumerate()
+            .any(|(i, a)| normals[i + 1..].iter().any(|b| a.dot(*b) < cos))
+    }
+
     /// The whole patch.
     pub fn root(patch: u32, p: &Patch) -> Cell {
         Cell {
@@ -765,6 +803,13 @@ pub fn subpatches(
         for (c, f) in cells.iter().zip(facings.iter_mut()) {
             let flat = flatness(view, c);
             if flat > params.flatness {
+                done = false;
+                break;
+            }
+            if params
+                .normal_cos
+                .is_some_and(|cos| c.level < MAX_LEVEL && c.normals_apart(cos))
+            {
                 done = false;
                 break;
             }

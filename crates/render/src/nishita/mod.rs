@@ -131,6 +131,7 @@ impl<'w> PatchScene<'w> {
             tolerance: settings.root_tolerance,
             flatness: settings.flatness,
             subscan: settings.subscan,
+            normal_cos: settings.normal_angle.map(|a| a.to_radians().cos()),
         };
         let lighting = Lighting {
             ambient: w.spec.ambient.clone(),
@@ -690,8 +691,12 @@ impl Renderer for Nishita {
             ),
             None => String::new(),
         };
+        let normals = match s.normal_angle {
+            Some(a) => format!(", divided again where corner normals differ by over {a}°"),
+            None => String::new(),
+        };
         format!(
-            "{}{merged}; roots to {:e} of u/v, flatness {} px, bands of {} rows, {} sub-scanline(s) per row",
+            "{}{merged}; roots to {:e} of u/v, flatness {} px{normals}, bands of {} rows, {} sub-scanline(s) per row",
             self.inner.settings_phrase(),
             s.root_tolerance,
             s.flatness,
@@ -764,7 +769,7 @@ impl Renderer for Nishita {
                 rows.push((
                     "visibility",
                     format!(
-                        "scan segments, strip by strip: {} visible fragments of {} pieces ({} wholly hidden); {} slabs, {} cut where edges cross, {} where surfaces cross; {} slivers dropped, {:.1e} px² in all",
+                        "slab sweep, strip by strip: {} visible fragments of {} pieces ({} wholly hidden); {} slabs, {} cut where edges cross, {} where surfaces cross; {} slivers dropped, {:.1e} px² in all",
                         g.fragments, g.pieces, g.hidden, g.slabs, g.edge_crossings, g.depth_crossings, g.slivers, g.sliver_area
                     ),
                 ));
