@@ -33,7 +33,7 @@ pub enum RtlError {
         message: String,
     },
     /// An HDL tool is not installed.
-    #[error("`{tool}` was not found on the PATH: install it with crates/rtl/tools/install-hdl.sh (Debian's iverilog, verilator and yosys)")]
+    #[error("`{tool}` was not found on the PATH: install it with crates/rtl/tools/install-hdl.sh (Debian's iverilog, verilator, yosys, nextpnr-ice40 and fpga-icestorm)")]
     ToolMissing {
         /// The program.
         tool: String,
