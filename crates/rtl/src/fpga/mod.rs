@@ -5,10 +5,12 @@
 //! clock the routed design reaches, and how many processors of the format fit the device.
 //! The devices are a table ([`device`]).
 
+pub mod cosim;
 pub mod device;
 pub mod report;
 pub mod shell;
 
+pub use cosim::{cosimulate_shell, Netlist, ShellAgreement, ShellMismatch};
 pub use device::{device, devices, Device};
 pub use report::{Cells, Hierarchy, Pnr};
 pub use shell::{Shell, INPUT_LATENCY, OUTPUT_LATENCY, SHELL_MODULE};

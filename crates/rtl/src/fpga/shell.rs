@@ -5,9 +5,14 @@
 //!
 //! * **In**: `s_data` carries [`Shell::beat_bits`] bits of the instruction word per beat
 //!   (`s_valid` and `s_ready`, a beat is taken in a cycle when both are high), least
-//!   significant first, [`Shell::beats`] beats a word. The word is presented to the array
-//!   ([`crate::verilog::ARRAY_MODULE`]'s `in_valid`) in the cycle after its last beat is
-//!   taken, and held until the bus takes it; `s_ready` is low while it is held.
+//!   significant first, [`Shell::beats`] beats a word. A complete word waits in a staging
+//!   register (`s_ready` low) until the hold register, which offers it to the array
+//!   ([`crate::verilog::ARRAY_MODULE`]'s `in_valid`) until the bus takes it, is free: the
+//!   next word's beats come in while the bus issues the last. The array is held in reset
+//!   until the first word is in the hold register: its cycle 0 (the stepped engine's) is
+//!   the shell's cycle [`Shell::start_cycle`] when the beats come one a cycle from the
+//!   shell's cycle 0 (the first after reset), [`INPUT_LATENCY`] cycles after the first
+//!   word's last beat.
 //! * **Out**: each scanline, one value (one channel of one processor's output register,
 //!   processor-major) per cycle on `m_data` with `m_valid`, `m_last` on its last value —
 //!   the first [`OUTPUT_LATENCY`] cycles after the Refresh token arrives at the last
@@ -32,8 +37,9 @@ pub const SHELL_MODULE: &str = "cwisim_fpga";
 pub const OUTPUT_LATENCY: u64 = 3;
 
 /// Cycles from the cycle whose clock edge takes an instruction word's last beat to the
-/// cycle the array sees it (`in_valid`).
-pub const INPUT_LATENCY: u64 = 1;
+/// first cycle the array sees it (`in_valid`), when the hold register is free: one in
+/// the staging register, one in the hold register.
+pub const INPUT_LATENCY: u64 = 2;
 
 /// The shell of one design, with its input port's width.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -72,6 +78,30 @@ impl Shell {
     /// Beats per instruction word.
     pub fn beats(&self, d: &Design) -> u32 {
         Shell::word_bits(d).div_ceil(self.beat_bits)
+    }
+
+    /// The shell's cycle that is the array's cycle 0 when the first word's beats come one a
+    /// cycle from the shell's cycle 0: its last beat's cycle and [`INPUT_LATENCY`]. The
+    /// scanline the stepped engine has leave the last processor with its Refresh
+    /// arriving there at cycle `a` comes out from the shell's cycle `start_cycle + a +`
+    /// [`OUTPUT_LATENCY`], as long as the beats keep up with the bus.
+    pub fn start_cycle(&self, d: &Design) -> u64 {
+        u64::from(self.beats(d)) - 1 + INPUT_LATENCY
+    }
+
+    /// `machine` with every opcode's word cost (`opcode_cycles`) raised to at least the
+    /// beats of a word: a machine whose bus the shell's input port keeps up with, so that
+    /// the array through the shell runs cycle for cycle as the stepped engine says (with a
+    /// narrower port the bus can wait for a word, and the port's bandwidth becomes part
+    /// of the timing).
+    pub fn paced(&self, d: &Design, machine: &cwisim_xproc::Machine) -> cwisim_xproc::Machine {
+        let mut m = machine.clone();
+        let beats = self.beats(d);
+        for op in cwisim_isa::Opcode::ALL {
+            let c = m.opcode_cycles.get(*op);
+            m.opcode_cycles.set(*op, c.max(beats));
+        }
+        m
     }
 
     /// Bits of one output value (the accumulator's format).
@@ -133,37 +163,53 @@ impl Shell {
             k * b - 1
         ));
         v.line(&format!("    reg [{}:0] beat;", kb - 1));
-        v.line("    reg full;          // the word is complete: offered to the array");
-        v.line("    wire take;         // the array's bus takes it this cycle");
-        v.line("    assign s_ready = !full;");
+        v.line("    reg staged;        // `word` is complete, waiting for the hold register");
+        v.line(&format!(
+            "    reg [{}:0] hold;   // the word offered to the array",
+            iw - 1
+        ));
+        v.line("    reg held;");
+        v.line("    reg started;       // the first word reached the array: it runs from then on");
+        v.line("    wire take;         // the array's bus takes the held word this cycle");
+        v.line("    wire move = staged && (!held || take);");
+        v.line("    assign s_ready = !staged;");
         v.line("    always @(posedge clk) begin");
         v.line("        if (rst) begin");
         v.line(&format!("            beat <= {kb}'d0;"));
-        v.line("            full <= 1'b0;");
-        v.line("        end else if (s_valid && !full) begin");
+        v.line("            staged <= 1'b0;");
+        v.line("            held <= 1'b0;");
+        v.line("            started <= 1'b0;");
+        v.line("        end else begin");
+        v.line("            if (s_valid && !staged) begin");
         if k == 1 {
-            v.line("            full <= 1'b1;");
+            v.line("                staged <= 1'b1;");
         } else {
             v.line(&format!(
-                "            beat <= (beat == {kb}'d{}) ? {kb}'d0 : beat + {kb}'d1;",
+                "                beat <= (beat == {kb}'d{}) ? {kb}'d0 : beat + {kb}'d1;",
                 k - 1
             ));
             v.line(&format!(
-                "            if (beat == {kb}'d{}) full <= 1'b1;",
+                "                if (beat == {kb}'d{}) staged <= 1'b1;",
                 k - 1
             ));
         }
-        v.line("        end else if (take) full <= 1'b0;");
+        v.line("            end else if (move) staged <= 1'b0;");
+        v.line("            if (move) begin");
+        v.line("                held <= 1'b1;");
+        v.line("                started <= 1'b1;");
+        v.line("            end else if (take) held <= 1'b0;");
+        v.line("        end");
         v.line("    end");
         v.line("    always @(posedge clk) begin");
         if k == 1 {
-            v.line("        if (s_valid && !full) word <= s_data;");
+            v.line("        if (s_valid && !staged) word <= s_data;");
         } else {
             v.line(&format!(
-                "        if (s_valid && !full) word <= {{s_data, word[{}:{b}]}};",
+                "        if (s_valid && !staged) word <= {{s_data, word[{}:{b}]}};",
                 k * b - 1
             ));
         }
+        v.line(&format!("        if (move) hold <= word[{}:0];", iw - 1));
         v.line("    end");
         if k * b > iw {
             v.line(&format!(
@@ -174,14 +220,15 @@ impl Shell {
         v.blank();
         v.line(&format!("    wire [{}:0] refresh_at;", w - 1));
         v.line(&format!("    wire [{}:0] out_flat;", wa * n * w - 1));
+        v.line("    wire unused_refresh_at = ^refresh_at;");
         let mut conns = vec![
             ".clk(clk)".to_string(),
-            ".rst(rst)".into(),
-            ".in_valid(full)".into(),
+            ".rst(rst || !started)".into(),
+            ".in_valid(held)".into(),
         ];
         let mut at = 0;
         for (name, bits) in Shell::word_fields(d) {
-            conns.push(format!(".in_{name}(word[{}:{at}])", at + bits - 1));
+            conns.push(format!(".in_{name}(hold[{}:{at}])", at + bits - 1));
             at += bits;
         }
         conns.push(".in_take(take)".into());
