@@ -14,12 +14,13 @@ const WIDE: &str = "fixed:I=8.24,dI=4.28,ddI=2.30,acc=10.24";
 
 /// The design of `trace` in `fmt`, on the default machine paced for `shell`'s port.
 fn paced(
+    base: Machine,
     fmt: &str,
     header: &cwisim_isa::TraceHeader,
     instrs: &[cwisim_isa::Instruction],
     shell: &Shell,
 ) -> (cwisim_rtl::Design, Machine) {
-    let machine = Machine::default();
+    let machine = base;
     let d = design_for(format(fmt), header, instrs, &machine);
     let machine = shell.paced(&d, &machine);
     (design_for(format(fmt), header, instrs, &machine), machine)
@@ -27,7 +28,7 @@ fn paced(
 
 fn shell_cosim(name: &str, fmt: &str, shell: &Shell) -> fpga::ShellAgreement {
     let (header, instrs) = trace(name);
-    let (d, machine) = paced(fmt, &header, &instrs, shell);
+    let (d, machine) = paced(Machine::default(), fmt, &header, &instrs, shell);
     let dir = scratch(&format!("shell-{name}"));
     match cosimulate_shell(&d, shell, &header, &instrs, &machine, &Netlist::Rtl, &dir).unwrap() {
         Ok(a) => a,
@@ -64,12 +65,12 @@ fn a_small_design_places_routes_and_its_netlist_computes_the_same_scanlines() {
     }
     let (header, instrs) = trace("gouraud");
     let shell = Shell::default();
-    let (d, machine) = paced(
-        "fixed:I=2.15,dI=1.16,ddI=1.16,acc=2.12",
-        &header,
-        &instrs,
-        &shell,
-    );
+    // a slow clock: a short line period, few cycles for the gate-level simulation
+    let slow = Machine::default()
+        .with_overrides(&["clock_hz=1e6".to_string()])
+        .unwrap();
+    let fmt = "fixed:I=2.15,dI=1.16,ddI=1.16,acc=2.12";
+    let (d, machine) = paced(slow, fmt, &header, &instrs, &shell);
     let up5k = fpga::device("ice40-up5k").unwrap();
     let dir = scratch("pnr");
     let r = fpga::place_and_route(&d, &shell, &up5k, &dir, &mut |_| {}).unwrap();
@@ -99,14 +100,24 @@ fn a_small_design_places_routes_and_its_netlist_computes_the_same_scanlines() {
         Err(m) => panic!("the routed netlist: {m} (files in {})", sim.display()),
     }
     // too large: said with the numbers, not an internal error
-    let wide =
-        cwisim_rtl::Design::new(d.format, d.opcodes.clone(), 400, 1, d.timing.clone()).unwrap();
-    let e = fpga::place_and_route(&wide, &shell, &up5k, &scratch("too-large"), &mut |_| {})
-        .unwrap_err();
+    let hx1k = fpga::device("ice40-hx1k").unwrap();
+    let e =
+        fpga::place_and_route(&d, &shell, &hx1k, &scratch("too-large"), &mut |_| {}).unwrap_err();
     assert!(matches!(e, RtlError::DoesNotFit { .. }), "{e}");
     let text = e.to_string();
     assert!(
-        text.contains("logic cells") && text.contains("5280"),
+        text.contains("logic cells") && text.contains("has 1280"),
         "{text}"
     );
+    assert!(!text.contains('\n'), "{text}");
+    // too many pins: a port wider than the package
+    let e = fpga::place_and_route(
+        &d,
+        &Shell { beat_bits: 40 },
+        &up5k,
+        &scratch("pins"),
+        &mut |_| {},
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("I/O pins"), "{e}");
 }
