@@ -48,6 +48,7 @@ fn golden_traces_come_through_the_shell_at_a_fixed_latency() {
         "preload",
         "rgb",
         "visibility",
+        "order",
     ] {
         let a = shell_cosim(name, WIDE, &Shell::default());
         assert!(a.scanlines > 0 && a.values > 0, "{name}: {a:?}");
