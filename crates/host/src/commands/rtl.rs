@@ -199,6 +199,47 @@ pub(crate) fn scene_area(
     area::synthesize(&design, dir.path()).map_err(rtl_error)
 }
 
+/// The device `--fpga` names, with its tools on the PATH: checked before any work.
+pub(crate) fn fpga_device(name: &str) -> Result<fpga::Device, CliError> {
+    let d = fpga::device(name).map_err(rtl_error)?;
+    require_tools(fpga::PROGRAMS)?;
+    Ok(d)
+}
+
+/// `processors` processors (at most the width) of `format` for the opcodes of the stream
+/// `renderer` emits, placed and routed on `device` in a temporary directory: what
+/// `fit --area --fpga` prints, with the stream's width.
+pub(crate) fn scene_fpga(
+    renderer: &dyn cwisim_render::Renderer,
+    machine: &cwisim_xproc::Machine,
+    format: cwisim_xproc::FixedFormat,
+    device: &fpga::Device,
+    processors: u32,
+) -> Result<(fpga::FpgaReport, u32), CliError> {
+    let (mut reader, _) = crate::input::emitted(renderer, false)?;
+    let header = *reader.header();
+    let trace = read_all(&mut *reader)?;
+    let timing = BusTiming::new(machine, &header).map_err(rtl_error)?;
+    let design = Design::new(
+        format,
+        opcodes_used(&trace),
+        processors.min(header.width),
+        header.channel_count(),
+        timing,
+    )
+    .map_err(rtl_error)?;
+    let dir = WorkDir::new(None, "fpga")?;
+    let r = fpga::place_and_route(
+        &design,
+        &fpga::Shell::default(),
+        device,
+        dir.path(),
+        &mut |_| {},
+    )
+    .map_err(rtl_error)?;
+    Ok((r, header.width))
+}
+
 /// Refuses, before any work, a run whose tools are not installed: `programs`, each on the
 /// PATH.
 pub(crate) fn require_tools(programs: &[&str]) -> Result<(), CliError> {
@@ -219,11 +260,7 @@ pub fn run(args: &RtlArgs, stdout: &mut dyn Write, progress: bool) -> Result<(),
         require_tools(&["yosys"])?;
     }
     let device = match &args.fpga {
-        Some(name) => {
-            let d = fpga::device(name).map_err(rtl_error)?;
-            require_tools(fpga::PROGRAMS)?;
-            Some(d)
-        }
+        Some(name) => Some(fpga_device(name)?),
         None => None,
     };
     if args.watch.is_some() && args.cosim.is_none() && args.testbench.is_none() {

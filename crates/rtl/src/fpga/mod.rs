@@ -199,10 +199,17 @@ pub fn place_and_route(
             what: "logic cells".into(),
             needed: used,
             there: there.min(device.cells),
-            hint: format!(
-                "; about {fit} processors of this format fit (this array has {})",
-                d.width
-            ),
+            hint: if fit == 0 {
+                format!(
+                    "; not one processor of this format fits beside the shell and the bus (this array has {})",
+                    d.width
+                )
+            } else {
+                format!(
+                    "; about {fit} processors of this format fit (this array has {}: --fpga-processors {fit})",
+                    d.width
+                )
+            },
         });
     }
     let (ram, ram_there) = packed.used("ICESTORM_RAM")?;
