@@ -51,7 +51,7 @@ pub struct FpgaReport {
     pub shell: Cells,
     /// The array's cells (every other module: bus, display timing, processors).
     pub array: Cells,
-    /// One processor's cells (module [`PROCESSOR_MODULE`]).
+    /// One processor's cells (module [`PROCESSOR_MODULE`] with its adders).
     pub processor: Cells,
     /// Logic cells the placed design uses (nextpnr's ICESTORM_LC).
     pub logic_cells: u64,
@@ -172,11 +172,9 @@ pub fn place_and_route(
     let shell_cells = h.modules.get(SHELL_MODULE).cloned().unwrap_or_default();
     let processor = h
         .modules
-        .iter()
-        .filter(|(m, _)| {
-            m.as_str() == PROCESSOR_MODULE || m.ends_with(&format!("\\{PROCESSOR_MODULE}"))
-        })
-        .map(|(_, c)| c.clone())
+        .keys()
+        .filter(|m| m.as_str() == PROCESSOR_MODULE || m.ends_with(&format!("\\{PROCESSOR_MODULE}")))
+        .map(|m| h.with_submodules(m))
         .max_by_key(Cells::cell_estimate)
         .ok_or_else(|| RtlError::Parse {
             what: "yosys stat".into(),

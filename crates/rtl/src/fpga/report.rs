@@ -59,8 +59,28 @@ impl Cells {
 pub struct Hierarchy {
     /// Each module's own primitive cells (`SB_*`).
     pub modules: BTreeMap<String, Cells>,
+    /// Each module's instances of other modules: module → (submodule → count).
+    pub instances: BTreeMap<String, BTreeMap<String, u64>>,
     /// The whole design's primitive cells, every instance counted.
     pub total: Cells,
+}
+
+impl Hierarchy {
+    /// The primitive cells of one instance of `module`, its submodules' included.
+    pub fn with_submodules(&self, module: &str) -> Cells {
+        let mut out = self.modules.get(module).cloned().unwrap_or_default();
+        if let Some(subs) = self.instances.get(module) {
+            for (sub, n) in subs {
+                if sub == module || !self.modules.contains_key(sub) {
+                    continue;
+                }
+                for (t, c) in self.with_submodules(sub).by_type {
+                    *out.by_type.entry(t).or_default() += c * n;
+                }
+            }
+        }
+        out
+    }
 }
 
 /// Reads Yosys's `stat` output (after `synth_ice40 -noflatten`).
@@ -81,6 +101,21 @@ pub fn parse_stat(text: &str) -> Result<Hierarchy, RtlError> {
             continue;
         }
         if !t.starts_with("SB_") {
+            // an instance of another module: `name   count`
+            if let (Some(c), false) = (&current, t.contains(':')) {
+                let mut words = t.split_whitespace();
+                if let (Some(name), Some(Ok(n)), None) = (
+                    words.next(),
+                    words.next().map(str::parse::<u64>),
+                    words.next(),
+                ) {
+                    *h.instances
+                        .entry(c.clone())
+                        .or_default()
+                        .entry(name.to_string())
+                        .or_default() += n;
+                }
+            }
             continue;
         }
         let mut words = t.split_whitespace();
@@ -206,6 +241,12 @@ mod tests {
         assert_eq!(h.modules["cwisim_xproc"].carries(), 4);
         assert_eq!(h.total.luts(), 23);
         assert_eq!(h.total.minus(&h.modules["cwisim_fpga"]).luts(), 20);
+        // the processor with its adders
+        let text =
+            "=== add ===\n     SB_CARRY 7\n\n=== cwisim_xproc ===\n     SB_LUT4 10\n     add 2\n";
+        let h = parse_stat(text).unwrap();
+        assert_eq!(h.with_submodules("cwisim_xproc").carries(), 14);
+        assert_eq!(h.with_submodules("cwisim_xproc").luts(), 10);
         assert!(parse_stat("nothing").is_err());
         assert!(parse_stat("=== a ===\n SB_LUT4 x\n").is_err());
     }
