@@ -1,7 +1,7 @@
 //! docs/HARDWARE.md's FPGA table: for each scene and error budget, the format `fit` finds
 //! (`cwisim rtl --max-error`), 16 processors of it placed and routed on each device
-//! (`cwisim rtl --fpga DEVICE --fpga-processors 16`), and the scene replayed at the clock
-//! the routed design reaches. Runs the `cwisim` binary (`CWISIM_BIN`, or
+//! (`cwisim rtl --fpga DEVICE --fpga-processors 16`; as many as fit when 16 do not), and
+//! the scene replayed at the clock the routed design reaches. Runs the `cwisim` binary (`CWISIM_BIN`, or
 //! target/release/cwisim) once per row and prints a Markdown table; minutes per row.
 //!
 //! ```sh
@@ -64,32 +64,48 @@ fn main() {
     }
     let dir = std::env::temp_dir().join(format!("cwisim-fpga-table-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("a scratch directory");
-    println!("| scene | error budget | format | device | cells (16 processors) | fmax MHz | processors per device | devices for the width | late scanlines at fmax |");
-    println!("| --- | --- | --- | --- | ---: | ---: | ---: | ---: | ---: |");
+    println!("| scene | error budget | format | device | processors placed | logic cells | fmax MHz | processors per device | devices for the width | late scanlines at fmax |");
+    println!("| --- | --- | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: |");
     for (scene, budget) in &rows {
         for device in &devices {
-            let out = Command::new(&bin)
-                .args([
-                    "rtl",
-                    "--for",
-                    scene,
-                    "--max-error",
-                    budget,
-                    "-o",
-                    "design.v",
-                    "--fpga",
-                    device,
-                    "--fpga-processors",
-                    PROCESSORS,
-                ])
-                .current_dir(&dir)
-                .output()
-                .expect("run cwisim");
+            let run = |processors: &str| {
+                Command::new(&bin)
+                    .args([
+                        "rtl",
+                        "--for",
+                        scene,
+                        "--max-error",
+                        budget,
+                        "-o",
+                        "design.v",
+                        "--fpga",
+                        device,
+                        "--fpga-processors",
+                        processors,
+                    ])
+                    .current_dir(&dir)
+                    .output()
+                    .expect("run cwisim")
+            };
+            let mut out = run(PROCESSORS);
+            let mut placed = PROCESSORS.to_string();
+            if !out.status.success() {
+                // too large: as many as the device holds, as the error says
+                let err = String::from_utf8_lossy(&out.stderr).into_owned();
+                if let Some(p) = err
+                    .split("--fpga-processors ")
+                    .nth(1)
+                    .and_then(|r| r.split(')').next())
+                {
+                    placed = p.to_string();
+                    out = run(p);
+                }
+            }
             let text = String::from_utf8_lossy(&out.stdout);
             if !out.status.success() {
                 let err = String::from_utf8_lossy(&out.stderr);
                 println!(
-                    "| {scene} | {budget} | | {device} | {} | | | | |",
+                    "| {scene} | {budget} | | {device} | | {} | | | | |",
                     err.trim().trim_start_matches("error: ")
                 );
                 continue;
@@ -123,7 +139,7 @@ fn main() {
                 .map(|s| s.trim_end_matches(" late"))
                 .unwrap_or("?");
             println!(
-                "| {scene} | {budget} | `{format}` | {device} | {cells} | {fmax} | {per_device} | {devices_for_width} | {late} |"
+                "| {scene} | {budget} | `{format}` | {device} | {placed} | {cells} | {fmax} | {per_device} | {devices_for_width} | {late} |"
             );
         }
     }

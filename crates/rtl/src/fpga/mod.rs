@@ -32,7 +32,8 @@ pub const SEED: u64 = 1;
 pub enum FpgaStage {
     /// Yosys's `synth_ice40`.
     Synthesize,
-    /// nextpnr packing the cells into the device's logic cells (do they fit?).
+    /// The same design at half the width synthesized and packed: the cells a processor
+    /// adds.
     Pack,
     /// nextpnr placing, routing and timing the design.
     Route,
@@ -60,7 +61,7 @@ pub struct FpgaReport {
     /// The maximum clock frequency nextpnr's timing analysis gives the routed design, MHz.
     pub fmax_mhz: f64,
     /// How many processors of this format fit the device, with the shell and the bus
-    /// (an estimate: [`processors_that_fit`]).
+    /// (from two widths packed: [`processors_that_fit`]).
     pub fit: u64,
 }
 
@@ -72,24 +73,36 @@ impl FpgaReport {
     }
 }
 
-/// How many processors fit `cells` logic cells, for a design of `width` processors that
-/// packs into `used` cells: the Yosys estimate of one processor ([`Cells::cell_estimate`]
-/// of `processor`) scaled by what nextpnr packed against what Yosys estimated for the
-/// whole (`total`); what is not the processors' (shell, bus, display timing) counted once.
-pub fn processors_that_fit(
-    cells: u64,
-    used: u64,
-    width: u32,
-    total: &Cells,
-    processor: &Cells,
-) -> u64 {
-    let est = total.cell_estimate().max(1) as f64;
-    let per = processor.cell_estimate() as f64 * used as f64 / est;
-    if per <= 0.0 {
+/// How many processors fit `cells` logic cells, from the cells two arrays of the same
+/// design pack into: `used` for `width` processors, `used_half` for `half` (fewer): the
+/// cells of a processor are the difference per processor (its share of the bus's chain
+/// included), the rest (shell, bus, display timing) counted once.
+pub fn processors_that_fit(cells: u64, used: u64, width: u32, used_half: u64, half: u32) -> u64 {
+    if half >= width || used <= used_half {
         return 0;
     }
+    let per = (used - used_half) as f64 / f64::from(width - half);
     let fixed = (used as f64 - per * f64::from(width)).max(0.0);
     ((cells as f64 - fixed) / per).floor().max(0.0) as u64
+}
+
+/// Synthesizes and packs design `d` in `shell` for `device` in `dir`: Yosys's hierarchy
+/// and nextpnr's packing.
+fn synthesize_and_pack(
+    d: &Design,
+    shell: &Shell,
+    device: &Device,
+    dir: &Path,
+) -> Result<(Hierarchy, Pnr), RtlError> {
+    write_file(&dir.join("design.v"), &verilog::design(d))?;
+    write_file(&dir.join("shell.v"), &shell.verilog(d))?;
+    run("yosys", &["-q", "-p", &yosys_script()], dir)?;
+    let h = report::parse_stat(&read_output("yosys", &dir.join("stat.txt"))?)?;
+    let args = nextpnr_args(device, true);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let log = run("nextpnr-ice40", &args, dir)?;
+    write_file(&dir.join("pack.log"), &log)?;
+    Ok((h, report::parse_nextpnr(&log)?))
 }
 
 fn write_file(path: &Path, text: &str) -> Result<(), RtlError> {
@@ -164,11 +177,8 @@ pub fn place_and_route(
         });
     }
     let dir = &dir.canonicalize().map_err(|e| RtlError::io(dir, e))?;
-    write_file(&dir.join("design.v"), &verilog::design(d))?;
-    write_file(&dir.join("shell.v"), &shell.verilog(d))?;
     stage(FpgaStage::Synthesize);
-    run("yosys", &["-q", "-p", &yosys_script()], dir)?;
-    let h = report::parse_stat(&read_output("yosys", &dir.join("stat.txt"))?)?;
+    let (h, packed) = synthesize_and_pack(d, shell, device, dir)?;
     let shell_cells = h.modules.get(SHELL_MODULE).cloned().unwrap_or_default();
     let processor = h
         .modules
@@ -182,15 +192,23 @@ pub fn place_and_route(
             message: format!("no module {PROCESSOR_MODULE}"),
         })?;
     let array = h.total.minus(&shell_cells);
-
-    stage(FpgaStage::Pack);
-    let args = nextpnr_args(device, true);
-    let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    let log = run("nextpnr-ice40", &args, dir)?;
-    write_file(&dir.join("pack.log"), &log)?;
-    let packed = report::parse_nextpnr(&log)?;
     let (used, there) = packed.used("ICESTORM_LC")?;
-    let fit = processors_that_fit(device.cells, used, d.width, &h.total, &processor);
+
+    // the same design at half the width (twice the width for one processor), packed:
+    // the cells a processor adds
+    stage(FpgaStage::Pack);
+    let other = if d.width >= 2 { d.width / 2 } else { 2 };
+    let mut od = d.clone();
+    od.width = other;
+    let odir = dir.join(format!("width-{other}"));
+    std::fs::create_dir_all(&odir).map_err(|e| RtlError::io(&odir, e))?;
+    let (_, opacked) = synthesize_and_pack(&od, shell, device, &odir)?;
+    let (oused, _) = opacked.used("ICESTORM_LC")?;
+    let fit = if other < d.width {
+        processors_that_fit(device.cells, used, d.width, oused, other)
+    } else {
+        processors_that_fit(device.cells, oused, other, used, d.width)
+    };
     if used > there.min(device.cells) {
         return Err(RtlError::DoesNotFit {
             device: device.name.clone(),
@@ -304,18 +322,12 @@ mod tests {
     use super::*;
 
     #[test]
-    fn processors_that_fit_scale_the_estimate() {
-        let mut total = Cells::default();
-        total.by_type.insert("SB_LUT4".into(), 1100);
-        let mut p = Cells::default();
-        p.by_type.insert("SB_LUT4".into(), 100);
-        // 10 processors of 100 and 100 more, packed as estimated: (1000 - 100) / 100
-        assert_eq!(processors_that_fit(1000, 1100, 10, &total, &p), 9);
-        // packed into twice the cells: (1000 - 200) / 200
-        assert_eq!(processors_that_fit(1000, 2200, 10, &total, &p), 4);
-        assert_eq!(
-            processors_that_fit(1000, 1100, 10, &total, &Cells::default()),
-            0
-        );
+    fn processors_that_fit_follow_the_cells_a_processor_adds() {
+        // 16 processors in 3400 cells, 8 in 1800: 200 a processor, 200 for the rest
+        assert_eq!(processors_that_fit(7680, 3400, 16, 1800, 8), 37);
+        assert_eq!(processors_that_fit(1280, 3400, 16, 1800, 8), 5);
+        assert_eq!(processors_that_fit(100, 3400, 16, 1800, 8), 0);
+        assert_eq!(processors_that_fit(7680, 3400, 16, 3400, 8), 0);
+        assert_eq!(processors_that_fit(7680, 3400, 8, 1800, 16), 0);
     }
 }
