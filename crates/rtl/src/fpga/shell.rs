@@ -90,16 +90,18 @@ impl Shell {
     }
 
     /// `machine` with every opcode's word cost (`opcode_cycles`) raised to at least the
-    /// beats of a word: a machine whose bus the shell's input port keeps up with, so that
+    /// beats of a word and one (the port's best: a word every beats + 1 cycles): a machine whose bus the shell's input port keeps up with, so that
     /// the array through the shell runs cycle for cycle as the stepped engine says (with a
     /// narrower port the bus can wait for a word, and the port's bandwidth becomes part
     /// of the timing).
     pub fn paced(&self, d: &Design, machine: &cwisim_xproc::Machine) -> cwisim_xproc::Machine {
         let mut m = machine.clone();
-        let beats = self.beats(d);
+        // a word every beats + 1 cycles at best: its beats, and a cycle staged before the
+        // hold register takes it
+        let cycles = self.beats(d) + 1;
         for op in cwisim_isa::Opcode::ALL {
             let c = m.opcode_cycles.get(*op);
-            m.opcode_cycles.set(*op, c.max(beats));
+            m.opcode_cycles.set(*op, c.max(cycles));
         }
         m
     }
