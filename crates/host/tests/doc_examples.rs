@@ -203,7 +203,6 @@ const LONG: &[&str] = &[
     "cwisim --help: --fpga ice40-up5k",
     "docs/HARDWARE.md: --fpga ice40-up5k",
     "docs/HARDWARE.md: --fpga ice40-hx8k",
-    "docs/HARDWARE.md: --area --fpga",
 ];
 
 /// Whether a command of a document is [`LONG`].
