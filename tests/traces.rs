@@ -61,3 +61,38 @@ fn examples_use_every_opcode() {
     let missing: Vec<&Opcode> = Opcode::ALL.iter().filter(|op| !seen.contains(op)).collect();
     assert!(missing.is_empty(), "no example uses {missing:?}");
 }
+
+/// The pairs of opcodes whose order matters (`docs/ISA.md`: a mask lasts to the next Eval
+/// or Refresh, a lock and a preload to the Refresh, Acc_mode toggles): each must follow
+/// the other directly in some example, so that a design that got one of them wrong — an
+/// `Eval0` that ignored the mask — fails a golden co-simulation, not only a random one.
+#[test]
+fn examples_pin_every_pair_of_opcodes_whose_order_matters() {
+    use Opcode::*;
+    let pairs = [
+        (Dis, Eval0),
+        (Dis, Eval1),
+        (Dis, Dis),
+        (Dis, Refresh),
+        (Eval0, Eval0),
+        (Eval0, Eval1),
+        (Eval1, Eval0),
+        (SetI, Refresh),
+        (SetI, Eval2),
+        (AccMode, Eval1),
+        (Eval1, AccMode),
+    ];
+    let mut seen = BTreeSet::new();
+    for trace in example_traces() {
+        let mut reader = FileReader::open(&trace).unwrap();
+        let instrs = read_all(&mut reader).unwrap();
+        for w in instrs.windows(2) {
+            seen.insert((w[0].op, w[1].op));
+        }
+    }
+    let missing: Vec<_> = pairs.iter().filter(|p| !seen.contains(p)).collect();
+    assert!(
+        missing.is_empty(),
+        "no example has {missing:?} in this order"
+    );
+}

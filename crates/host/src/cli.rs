@@ -217,12 +217,21 @@ opcodes a trace or scene uses (--for TRACE|SCENE; all fourteen without it). With
 --timing stepped --numeric fixed:…): every scanline bit for bit, every scanline's overflow events and \
 ready cycle, and the cycle every token arrives at the watched processors (--watch); the first \
 difference is printed with its scanline, processor, cycle and instruction (exit status 4). --area \
-synthesizes one processor in Yosys and prints its cells, flip-flops and NAND2 estimate. The tools \
-are Debian's iverilog, verilator and yosys (crates/rtl/tools/install-hdl.sh installs them). The \
-Verilog is the same byte for byte for the same settings. docs/HARDWARE.md describes the design.\n\n\
+synthesizes one processor in Yosys and prints its cells, flip-flops and NAND2 estimate.\n\n\
+--fpga DEVICE (ice40-hx8k, ice40-up5k, ice40-hx1k) wraps the array in an I/O shell that fits the \
+package's pins (instruction words in 8-bit beats, scanline values out one a cycle) and places and \
+routes it with Yosys's synth_ice40 and nextpnr-ice40: it prints the logic cells, flip-flops, carries \
+and RAM blocks (the shell's apart from the array's), the maximum clock from nextpnr's timing \
+analysis, how many processors of the design fit one device, and, with --for, the scene replayed at \
+that clock (--set clock_hz=…) with its late scanlines. --fpga-processors P places P processors of \
+the design (the whole width rarely fits); a design too large says so with the cells it needs. The \
+tools are Debian's iverilog, verilator, yosys, nextpnr-ice40 and fpga-icestorm \
+(crates/rtl/tools/install-hdl.sh installs them). The Verilog is the same byte for byte for the same \
+settings. docs/HARDWARE.md describes the design.\n\n\
 Examples:\n  cwisim rtl --numeric fixed:I=12.20,dI=4.28,ddI=1.36 --width 64 -o xproc.v --area\n  \
 cwisim rtl --for traces/gouraud.cwt --numeric fixed:I=8.24,dI=4.28,ddI=2.30 -o g.v --cosim icarus\n  \
-cwisim rtl --for pot --max-error 1/512 -o pot_xproc.v --area",
+cwisim rtl --for pot --max-error 1/512 -o pot_xproc.v --area\n  \
+cwisim rtl --for traces/gouraud.cwt --numeric fixed:I=2.15,dI=1.16,ddI=1.16,acc=2.12 -o g.v --fpga ice40-up5k",
         after_help = AFTER_HELP
     )]
     Rtl(rtl::RtlArgs),

@@ -110,7 +110,7 @@ const SKIPPED: &[(&str, &str)] = &[
     ),
     (
         "crates/rtl/tools/install-hdl.sh",
-        "installs Debian's iverilog, verilator and yosys (apt-get); .ci/run runs it before the tests",
+        "installs Debian's iverilog, verilator, yosys, nextpnr-ice40 and fpga-icestorm (apt-get); .ci/run runs it before the tests",
     ),
     (
         "verilator ",
@@ -204,6 +204,11 @@ const LONG: &[&str] = &[
     "docs/HARDWARE.md: --cosim icarus --work-dir run1",
     "docs/HARDWARE.md: cwisim rtl --for pot --max-error 1/512 -o pot_xproc.v --area",
     "docs/HARDWARE.md: cwisim fit pot --max-error 1/512 --area",
+    // place and route (nextpnr-ice40): 16 processors, 20 s debug; the pot's fit and 8
+    // processors, a minute
+    "cwisim --help: --fpga ice40-up5k",
+    "docs/HARDWARE.md: --fpga ice40-up5k",
+    "docs/HARDWARE.md: --fpga ice40-hx8k",
 ];
 
 /// Whether a command of a document is [`LONG`].

@@ -81,6 +81,18 @@ fn bad_settings_are_one_line_errors_and_write_nothing() {
             ],
             "needs a scene",
         ),
+        (
+            vec![
+                "rtl",
+                "--numeric",
+                FORMAT,
+                "-o",
+                "x.v",
+                "--fpga",
+                "ice40-hx9k",
+            ],
+            "unknown FPGA `ice40-hx9k`: the known ones are ice40-hx1k, ice40-hx8k, ice40-up5k",
+        ),
     ] {
         let out = cwisim(&dir, &args);
         let (_, err) = text(&out);
@@ -182,4 +194,112 @@ fn fit_reports_the_area_of_the_format_it_finds() {
         cells(area),
         cells(rtl.lines().find(|l| l.starts_with("area")).unwrap())
     );
+}
+
+#[test]
+fn fpga_without_its_tools_names_the_script() {
+    let dir = scratch("rtl-fpga-no-tools");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_cwisim"))
+        .args([
+            "rtl",
+            "--numeric",
+            FORMAT,
+            "-o",
+            "x.v",
+            "--fpga",
+            "ice40-up5k",
+        ])
+        .current_dir(&dir)
+        .env("PATH", dir.join("no-tools-here"))
+        .output()
+        .unwrap();
+    let (_, err) = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("crates/rtl/tools/install-hdl.sh") && err.contains("nextpnr-ice40"),
+        "{err}"
+    );
+    assert!(!dir.join("x.v").exists());
+}
+
+#[test]
+fn fpga_reports_a_placed_design_and_refuses_one_too_large() {
+    if std::env::var("CWISIM_SKIP_HDL_TESTS").is_ok_and(|v| v == "1") {
+        eprintln!("SKIPPED: cwisim rtl --fpga (CWISIM_SKIP_HDL_TESTS=1)");
+        return;
+    }
+    let dir = scratch("rtl-fpga");
+    let g = trace("gouraud.cwt");
+    let small = "fixed:I=2.15,dI=1.16,ddI=1.16,acc=2.12";
+    // too large: one line with the numbers, exit 2, nothing written
+    let out = cwisim(
+        &dir,
+        &[
+            "rtl",
+            "--for",
+            &g,
+            "--numeric",
+            small,
+            "-o",
+            "x.v",
+            "--fpga",
+            "ice40-hx1k",
+        ],
+    );
+    let (_, err) = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("does not fit the ice40-hx1k") && err.contains("the device has 1280"),
+        "{err}"
+    );
+    assert!(!dir.join("x.v").exists());
+    // 4 processors of it on the UP5K, the scene replayed at the clock reached
+    let out = cwisim_ok(
+        &dir,
+        &[
+            "rtl",
+            "--for",
+            &g,
+            "--numeric",
+            small,
+            "-o",
+            "x.v",
+            "--fpga",
+            "ice40-up5k",
+            "--fpga-processors",
+            "4",
+        ],
+    );
+    let line = |label: &str| {
+        out.lines()
+            .find(|l| l.starts_with(label))
+            .unwrap_or_else(|| panic!("no {label} line: {out}"))
+            .to_string()
+    };
+    assert!(
+        line("fpga").contains("ice40-up5k (sg48): 4 processor(s)"),
+        "{out}"
+    );
+    assert!(
+        line("shell").contains("LUTs") && line("array").contains("carries"),
+        "{out}"
+    );
+    let fmax: f64 = line("fmax")
+        .split_whitespace()
+        .nth(1)
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("{out}"));
+    assert!(fmax > 1.0, "{out}");
+    let clock = format!("--set clock_hz={}", (fmax * 1000.0).floor() as u64 * 1000);
+    assert!(
+        line("at fmax").contains(&clock) && line("at fmax").contains("of 6 scanline(s) late"),
+        "{out}"
+    );
+    assert!(
+        line("fits").contains("devices") || line("fits").contains("device(s)"),
+        "{out}"
+    );
+    assert!(dir.join("x.v").is_file());
 }

@@ -32,8 +32,31 @@ pub enum RtlError {
         /// What is wrong.
         message: String,
     },
+    /// `--fpga` names a device the table does not have.
+    #[error("unknown FPGA `{name}`: the known ones are {known}")]
+    UnknownDevice {
+        /// The name given.
+        name: String,
+        /// The names known, comma-separated.
+        known: String,
+    },
+    /// The design is larger than the device (not an internal error: a smaller array or
+    /// a larger device).
+    #[error("the design does not fit the {device}: it needs {needed} {what}, the device has {there}{hint}")]
+    DoesNotFit {
+        /// The device.
+        device: String,
+        /// What runs out (`logic cells`, `I/O pins`, `RAM blocks`).
+        what: String,
+        /// How many the design needs.
+        needed: u64,
+        /// How many the device has.
+        there: u64,
+        /// What would fit, if known (`; about 12 processors of this format fit`).
+        hint: String,
+    },
     /// An HDL tool is not installed.
-    #[error("`{tool}` was not found on the PATH: install it with crates/rtl/tools/install-hdl.sh (Debian's iverilog, verilator and yosys)")]
+    #[error("`{tool}` was not found on the PATH: install it with crates/rtl/tools/install-hdl.sh (Debian's iverilog, verilator, yosys, nextpnr-ice40 and fpga-icestorm)")]
     ToolMissing {
         /// The program.
         tool: String,

@@ -14,6 +14,8 @@
 //! * [`dump`], [`compare`] — what the simulation did, and the first difference.
 //! * [`cosim`] — all of it in one call, with either simulator ([`tools`] runs them).
 //! * [`area`] — Yosys's `synth` statistics and a NAND2-equivalent estimate.
+//! * [`fpga`] — the array in an I/O shell, placed and routed on an iCE40 by Yosys and
+//!   nextpnr: its cells, the shell's apart, its maximum clock, the processors that fit.
 //!
 //! ```
 //! use cwisim_isa::TraceHeader;
@@ -38,6 +40,7 @@ pub mod cosim;
 pub mod design;
 pub mod dump;
 pub mod error;
+pub mod fpga;
 pub mod reference;
 pub mod stimulus;
 pub mod tools;

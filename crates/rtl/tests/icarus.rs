@@ -41,6 +41,7 @@ fn golden_traces_agree_bit_and_cycle_for_cycle() {
         "flat",
         "gouraud",
         "negative",
+        "order",
         "periodic",
         "preload",
         "rgb",

@@ -36,6 +36,11 @@ pub struct FitArgs {
     /// equivalents.
     #[arg(long)]
     pub area: bool,
+    /// With --area: also place and route an array of 8 processors of the format on this
+    /// FPGA (`cwisim rtl --fpga`: ice40-hx8k, ice40-up5k, ice40-hx1k) and print its
+    /// maximum clock and the processors that fit one device.
+    #[arg(long, value_name = "DEVICE", requires = "area")]
+    pub fpga: Option<String>,
     /// Threads: the scene's exact visibility, then the candidate formats, replayed on N
     /// threads at once (0: one per core); the format found, its figures and the count of
     /// replays are the same at any N.
@@ -79,6 +84,10 @@ pub(crate) fn parse_error_budget(s: &str) -> Result<f64, String> {
     }
 }
 
+/// The processors `fit --area --fpga` places: enough for the shell's and the bus's share
+/// to be small, few enough for a minute of place and route.
+const FIT_FPGA_PROCESSORS: u32 = 8;
+
 /// Runs `cwisim fit`.
 pub fn run(args: &FitArgs, stdout: &mut dyn Write, progress: bool) -> Result<(), CliError> {
     cwisim_scene::budget::check_threads(args.threads).map_err(CliError::Usage)?;
@@ -86,6 +95,10 @@ pub fn run(args: &FitArgs, stdout: &mut dyn Write, progress: bool) -> Result<(),
         // Yosys, before the search
         super::rtl::require_tools(&["yosys"])?;
     }
+    let device = match &args.fpga {
+        Some(name) => Some(super::rtl::fpga_device(name)?),
+        None => None,
+    };
     let machine = args.machine.load()?;
     let stage = crate::progress::Stage::new(progress, "fit: drawing the scene");
     let drawn = args.draw.draw_on(args.scene.as_deref(), args.threads)?;
@@ -178,6 +191,33 @@ pub fn run(args: &FitArgs, stdout: &mut dyn Write, progress: bool) -> Result<(),
             format!(
                 "one processor: {} cells ({} flip-flops, {} logic), about {:.0} NAND2 equivalents (Yosys synth; docs/HARDWARE.md)",
                 a.total, a.flip_flops, a.logic, a.nand2
+            ),
+        )
+        .and_then(|()| out.flush())
+        .map_err(CliError::Stdout)?;
+    }
+    if let Some(device) = &device {
+        let stage = crate::progress::Stage::new(progress, "fit: placing and routing 8 processors");
+        let (r, width) = super::rtl::scene_fpga(
+            &*drawn.renderer,
+            &machine,
+            fit.format,
+            device,
+            FIT_FPGA_PROCESSORS,
+        )?;
+        drop(stage);
+        w(
+            out,
+            "fpga",
+            format!(
+                "{} processors on the {}: {} of {} logic cells, fmax {:.2} MHz (nextpnr-ice40); about {} processors fit one device, {} for the width of {width}",
+                r.width,
+                device.name,
+                r.logic_cells,
+                device.cells,
+                r.fmax_mhz,
+                r.fit,
+                if r.fit == 0 { "none".to_string() } else { format!("{} device(s)", u64::from(width).div_ceil(r.fit)) }
             ),
         )
         .and_then(|()| out.flush())

@@ -13,8 +13,8 @@ use clap::Args;
 use cwisim_isa::{io::read_all, TraceHeader};
 use cwisim_rtl::verilog::{self, Watch};
 use cwisim_rtl::{
-    all_opcodes, area, cosimulate_with, opcodes_used, BusTiming, CosimStage, Design, RtlError,
-    Simulator,
+    all_opcodes, area, cosimulate_with, fpga, opcodes_used, BusTiming, CosimStage, Design,
+    RtlError, Simulator,
 };
 use cwisim_study::fit::fit_scene;
 use cwisim_xproc::numeric::Overflow;
@@ -87,6 +87,20 @@ pub struct RtlArgs {
     /// Synthesize one processor in Yosys and print its cells, flip-flops and NAND2 estimate.
     #[arg(long)]
     pub area: bool,
+    /// Place and route the array on this FPGA (ice40-hx8k, ice40-up5k, ice40-hx1k) in an
+    /// I/O shell that fits its pins: Yosys synth_ice40, nextpnr-ice40; prints the logic
+    /// cells (the shell's apart), flip-flops, carries, RAM blocks, the maximum clock, the
+    /// processors that fit, and with --for the late scanlines at that clock.
+    #[arg(long, value_name = "DEVICE")]
+    pub fpga: Option<String>,
+    /// With --fpga: place an array of P processors of this design (its format and
+    /// opcodes) instead of the whole width, e.g. as many as the device holds.
+    #[arg(long, value_name = "P", requires = "fpga")]
+    pub fpga_processors: Option<u32>,
+    /// With --fpga: keep the flow's files (Verilog, netlists, nextpnr's logs and
+    /// bitstream) in this new directory; otherwise a temporary one.
+    #[arg(long, value_name = "DIR", requires = "fpga")]
+    pub fpga_dir: Option<PathBuf>,
     /// The machine model (the bus and display timing built into the design).
     #[command(flatten)]
     pub machine: MachineArgs,
@@ -110,6 +124,20 @@ fn cosim_stage_message(sim: Simulator, stage: CosimStage) -> String {
             format!("rtl: co-simulating: {name} simulating {cycles} cycles")
         }
         CosimStage::Compare => "rtl: co-simulating: comparing the dump".to_string(),
+    }
+}
+
+/// What the progress spinner says while `--fpga` is at `stage`.
+fn fpga_stage_message(device: &fpga::Device, stage: fpga::FpgaStage) -> String {
+    match stage {
+        fpga::FpgaStage::Synthesize => "rtl: fpga: yosys synth_ice40".to_string(),
+        fpga::FpgaStage::Pack => {
+            format!("rtl: fpga: nextpnr-ice40 packing for the {}", device.name)
+        }
+        fpga::FpgaStage::Route => format!(
+            "rtl: fpga: nextpnr-ice40 placing and routing on the {} (a minute or more)",
+            device.name
+        ),
     }
 }
 
@@ -137,6 +165,8 @@ fn rtl_error(e: RtlError) -> CliError {
         RtlError::Budget(e) => CliError::Budget(e),
         RtlError::Io { path, source } => CliError::write(path, source),
         e @ (RtlError::Settings(_)
+        | RtlError::UnknownDevice { .. }
+        | RtlError::DoesNotFit { .. }
         | RtlError::Numeric(_)
         | RtlError::Trace { .. }
         | RtlError::ToolMissing { .. }) => CliError::Usage(e.to_string()),
@@ -169,6 +199,47 @@ pub(crate) fn scene_area(
     area::synthesize(&design, dir.path()).map_err(rtl_error)
 }
 
+/// The device `--fpga` names, with its tools on the PATH: checked before any work.
+pub(crate) fn fpga_device(name: &str) -> Result<fpga::Device, CliError> {
+    let d = fpga::device(name).map_err(rtl_error)?;
+    require_tools(fpga::PROGRAMS)?;
+    Ok(d)
+}
+
+/// `processors` processors (at most the width) of `format` for the opcodes of the stream
+/// `renderer` emits, placed and routed on `device` in a temporary directory: what
+/// `fit --area --fpga` prints, with the stream's width.
+pub(crate) fn scene_fpga(
+    renderer: &dyn cwisim_render::Renderer,
+    machine: &cwisim_xproc::Machine,
+    format: cwisim_xproc::FixedFormat,
+    device: &fpga::Device,
+    processors: u32,
+) -> Result<(fpga::FpgaReport, u32), CliError> {
+    let (mut reader, _) = crate::input::emitted(renderer, false)?;
+    let header = *reader.header();
+    let trace = read_all(&mut *reader)?;
+    let timing = BusTiming::new(machine, &header).map_err(rtl_error)?;
+    let design = Design::new(
+        format,
+        opcodes_used(&trace),
+        processors.min(header.width),
+        header.channel_count(),
+        timing,
+    )
+    .map_err(rtl_error)?;
+    let dir = WorkDir::new(None, "fpga")?;
+    let r = fpga::place_and_route(
+        &design,
+        &fpga::Shell::default(),
+        device,
+        dir.path(),
+        &mut |_| {},
+    )
+    .map_err(rtl_error)?;
+    Ok((r, header.width))
+}
+
 /// Refuses, before any work, a run whose tools are not installed: `programs`, each on the
 /// PATH.
 pub(crate) fn require_tools(programs: &[&str]) -> Result<(), CliError> {
@@ -188,6 +259,10 @@ pub fn run(args: &RtlArgs, stdout: &mut dyn Write, progress: bool) -> Result<(),
     if args.area {
         require_tools(&["yosys"])?;
     }
+    let device = match &args.fpga {
+        Some(name) => Some(fpga_device(name)?),
+        None => None,
+    };
     if args.watch.is_some() && args.cosim.is_none() && args.testbench.is_none() {
         return Err(CliError::Usage(
             "--watch chooses the processors whose token arrivals --cosim compares and --testbench writes: give one of them".into(),
@@ -307,6 +382,107 @@ pub fn run(args: &RtlArgs, stdout: &mut dyn Write, progress: bool) -> Result<(),
                 a.total, a.flip_flops, a.logic, a.nand2
             ),
         )?;
+    }
+    if let Some(device) = &device {
+        let placed = match args.fpga_processors {
+            None => design.clone(),
+            Some(p) => Design::new(
+                design.format,
+                design.opcodes.clone(),
+                p,
+                design.channels,
+                design.timing.clone(),
+            )
+            .map_err(|e| CliError::Usage(format!("--fpga-processors {p}: {e}")))?,
+        };
+        let dir = WorkDir::new(args.fpga_dir.as_deref(), "fpga")?;
+        let stage = crate::progress::Stage::new(progress, "rtl: fpga");
+        let shell = fpga::Shell::default();
+        let r = fpga::place_and_route(&placed, &shell, device, dir.path(), &mut |now| {
+            stage.message(&fpga_stage_message(device, now))
+        })
+        .map_err(rtl_error)?;
+        drop(stage);
+        drop(dir);
+        let (shell_c, array_c, proc_c) = (&r.shell, &r.array, &r.processor);
+        say(
+            out,
+            "fpga",
+            format!(
+                "{} ({}): {} processor(s) in the shell: {} of {} logic cells, {} of {} RAM blocks, {} of {} pins (nextpnr-ice40, seed {})",
+                device.name,
+                device.package,
+                r.width,
+                r.logic_cells,
+                device.cells,
+                r.ram_blocks,
+                device.ram,
+                r.pins,
+                device.io,
+                fpga::SEED
+            ),
+        )?;
+        for (label, c) in [
+            ("array", array_c),
+            ("shell", shell_c),
+            ("processor", proc_c),
+        ] {
+            say(
+                out,
+                label,
+                format!(
+                    "{} LUTs, {} flip-flops, {} carries, {} RAM blocks (Yosys synth_ice40)",
+                    c.luts(),
+                    c.flip_flops(),
+                    c.carries(),
+                    c.ram()
+                ),
+            )?;
+        }
+        say(
+            out,
+            "fmax",
+            format!(
+                "{:.2} MHz (nextpnr-ice40's timing analysis of the routed design)",
+                r.fmax_mhz
+            ),
+        )?;
+        let full = design.width;
+        say(
+            out,
+            "fits",
+            format!(
+                "about {} processors of this design on one {}; {} device(s) for the full width of {}",
+                r.fit,
+                device.name,
+                if r.fit == 0 {
+                    "no number of".to_string()
+                } else {
+                    u64::from(full).div_ceil(r.fit).to_string()
+                },
+                full
+            ),
+        )?;
+        let clock = r.clock_hz();
+        match &trace {
+            Some(t) => {
+                let rep = fpga::replay_at(&header, t, &machine, design.format, clock)
+                    .map_err(rtl_error)?;
+                say(
+                    out,
+                    "at fmax",
+                    format!(
+                        "--set clock_hz={clock}: line period {} cycles, {} of {} scanline(s) late",
+                        rep.line_period, rep.late, rep.lines
+                    ),
+                )?;
+            }
+            None => say(
+                out,
+                "at fmax",
+                format!("replay a scene at it with --set clock_hz={clock}"),
+            )?,
+        }
     }
     if let (Some(sim), Some(trace)) = (args.cosim, &trace) {
         let sim = sim_of(sim);

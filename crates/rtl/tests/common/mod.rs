@@ -19,9 +19,16 @@ pub fn hdl_tools(test: &str) -> bool {
         return false;
     }
     let all = || {
-        ["iverilog", "vvp", "verilator", "yosys"]
-            .iter()
-            .all(|t| tools::find(t).is_some())
+        [
+            "iverilog",
+            "vvp",
+            "verilator",
+            "yosys",
+            "nextpnr-ice40",
+            "icepack",
+        ]
+        .iter()
+        .all(|t| tools::find(t).is_some())
     };
     if all() {
         return true;
@@ -33,9 +40,9 @@ pub fn hdl_tools(test: &str) -> bool {
         return true;
     }
     panic!(
-        "{test} needs iverilog, verilator and yosys, and {} could not install them ({status:?}): \
-install Debian's iverilog, verilator and yosys packages, or set CWISIM_SKIP_HDL_TESTS=1 to skip \
-the HDL tests",
+        "{test} needs iverilog, verilator, yosys and nextpnr-ice40, and {} could not install them \
+({status:?}): install Debian's iverilog, verilator, yosys, nextpnr-ice40 and fpga-icestorm packages, \
+or set CWISIM_SKIP_HDL_TESTS=1 to skip the HDL tests",
         script.display()
     );
 }
