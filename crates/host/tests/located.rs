@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{cwisim, scratch, text};
+use common::{cwisim, png_chunk, scratch, text};
 use std::path::Path;
 
 /// Runs `cwisim ARGS` in `dir`: exit 2 and the one line of standard error.
@@ -105,18 +105,6 @@ fn obj_texture_coordinates_are_range_checked_as_inline_ones_are() {
         stderr.contains("m.obj:5:1: expected texture coordinates within ±1e9"),
         "{stderr}"
     );
-}
-
-/// A PNG chunk: length, type, data, CRC.
-fn png_chunk(kind: &[u8; 4], data: &[u8]) -> Vec<u8> {
-    let mut c = (data.len() as u32).to_be_bytes().to_vec();
-    c.extend_from_slice(kind);
-    c.extend_from_slice(data);
-    let mut crc = crc32fast::Hasher::new();
-    crc.update(kind);
-    crc.update(data);
-    c.extend_from_slice(&crc.finalize().to_be_bytes());
-    c
 }
 
 #[test]

@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{scratch, text};
+use common::{png_chunk, scratch, text};
 use std::path::Path;
 use std::process::{Command, Output};
 
@@ -16,18 +16,6 @@ fn cwisim_env(dir: &Path, env: &[(&str, &str)], args: &[&str]) -> Output {
         .current_dir(dir)
         .output()
         .expect("run the cwisim binary")
-}
-
-/// A PNG chunk: length, type, data, CRC.
-fn png_chunk(kind: &[u8; 4], data: &[u8]) -> Vec<u8> {
-    let mut c = (data.len() as u32).to_be_bytes().to_vec();
-    c.extend_from_slice(kind);
-    c.extend_from_slice(data);
-    let mut crc = crc32fast::Hasher::new();
-    crc.update(kind);
-    crc.update(data);
-    c.extend_from_slice(&crc.finalize().to_be_bytes());
-    c
 }
 
 /// The peak resident memory of the children waited for so far, bytes (Linux: KiB).

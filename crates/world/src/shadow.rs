@@ -262,31 +262,10 @@ impl LightView {
         };
         // a margin of 1° past the widest vertex on every side
         let half = widest.acos() + 1f64.to_radians();
-        let camera = Camera::new(
-            &CameraSpec {
-                eye: spec.lights[k].position,
-                target: (light + axis).to_array(),
-                up: up.to_array(),
-                fov_y: 2.0 * half.to_degrees(),
-                near: 0.0,
-            },
-            LIGHT_VIEW_SIDE,
-            LIGHT_VIEW_SIDE,
-        );
+        let camera = light_camera(light, axis, up, 2.0 * half.to_degrees());
         let tris: Vec<ScreenTriangle> = world
             .iter()
-            .map(|&(mesh, face, world)| ScreenTriangle {
-                points: world.map(|p| camera.project(p)),
-                inv_depth: world.map(|p| 1.0 / camera.depth(p)),
-                intensity: [Vector::default(); 3],
-                mesh,
-                face,
-                surface: Surface {
-                    world,
-                    normals: [DVec3::ZERO; 3],
-                    uv: [[0.0; 2]; 3],
-                },
-            })
+            .map(|&(mesh, face, world)| light_triangle(&camera, mesh, face, world))
             .collect();
         let view = View::of(tris, threads);
         Ok(LightView {
@@ -337,36 +316,15 @@ impl LightView {
         let mut parts = vec![Vec::new(); world.len()];
         let mut views = Vec::with_capacity(6);
         for (f, (axis, up)) in CUBE_FACES.into_iter().enumerate() {
-            let camera = Camera::new(
-                &CameraSpec {
-                    eye: spec.lights[k].position,
-                    target: (light + axis).to_array(),
-                    up: up.to_array(),
-                    // a margin past the pyramid's 90°: its clipped parts lie within
-                    fov_y: 92.0,
-                    near: 0.0,
-                },
-                LIGHT_VIEW_SIDE,
-                LIGHT_VIEW_SIDE,
-            );
+            // a margin past the pyramid's 90°: its clipped parts lie within
+            let camera = light_camera(light, axis, up, 92.0);
             let mut tris = Vec::new();
             for (j, &(mesh, face, corners)) in world.iter().enumerate() {
                 let clipped = clip_to_pyramid(&corners.map(|p| p - light), axis);
                 for i in 1..clipped.len().saturating_sub(1) {
                     let sub = [clipped[0], clipped[i], clipped[i + 1]].map(|d| d + light);
                     parts[j].push((f, tris.len()));
-                    tris.push(ScreenTriangle {
-                        points: sub.map(|p| camera.project(p)),
-                        inv_depth: sub.map(|p| 1.0 / camera.depth(p)),
-                        intensity: [Vector::default(); 3],
-                        mesh,
-                        face,
-                        surface: Surface {
-                            world: sub,
-                            normals: [DVec3::ZERO; 3],
-                            uv: [[0.0; 2]; 3],
-                        },
-                    });
+                    tris.push(light_triangle(&camera, mesh, face, sub));
                 }
             }
             views.push(View::of(tris, threads));
@@ -402,6 +360,37 @@ impl LightView {
             .iter()
             .flat_map(|&(v, t)| self.views[v].lit_on_screen(t, camera))
             .collect()
+    }
+}
+
+/// A square pinhole view of `fov_y` degrees from the light at `light` along `axis`.
+fn light_camera(light: DVec3, axis: DVec3, up: DVec3, fov_y: f64) -> Camera {
+    Camera::new(
+        &CameraSpec {
+            eye: light.to_array(),
+            target: (light + axis).to_array(),
+            up: up.to_array(),
+            fov_y,
+            near: 0.0,
+        },
+        LIGHT_VIEW_SIDE,
+        LIGHT_VIEW_SIDE,
+    )
+}
+
+/// The world triangle `world` (of mesh `mesh`, face `face`) as `camera` at a light sees it.
+fn light_triangle(camera: &Camera, mesh: u32, face: u32, world: [DVec3; 3]) -> ScreenTriangle {
+    ScreenTriangle {
+        points: world.map(|p| camera.project(p)),
+        inv_depth: world.map(|p| 1.0 / camera.depth(p)),
+        intensity: [Vector::default(); 3],
+        mesh,
+        face,
+        surface: Surface {
+            world,
+            normals: [DVec3::ZERO; 3],
+            uv: [[0.0; 2]; 3],
+        },
     }
 }
 

@@ -219,13 +219,6 @@ impl TextureStore {
         was
     }
 
-    /// Drops every texture's texels.
-    pub fn release_all(&self) {
-        for k in 0..self.slots.len() {
-            self.release(k as u32);
-        }
-    }
-
     /// Decodes so far, over every texture.
     pub fn loads(&self) -> u64 {
         self.slots
@@ -280,7 +273,10 @@ impl RowRelease {
             if !store.is_textured(mesh) || !y.is_finite() {
                 continue;
             }
-            let row = y.floor().clamp(0.0, f64::from(u32::MAX - 1)) as u32;
+            // a triangle may reach far below the image (nothing clips it there): no frame
+            // has more rows than a trace, so neither does the count of rows done
+            let bottom = cwisim_isa::MAX_LINES - 1;
+            let row = y.floor().clamp(0.0, f64::from(bottom)) as u32;
             let slot = &mut last[mesh as usize];
             *slot = Some(slot.map_or(row, |r| r.max(row)));
         }
@@ -504,6 +500,17 @@ mod tests {
         assert!(store.is_resident(0), "row 3 not done yet");
         release.rows_done(2..4);
         assert!(!store.is_resident(0));
+    }
+
+    #[test]
+    fn a_triangle_far_below_the_image_counts_no_more_rows_than_a_frame_has() {
+        let store = Arc::new(
+            TextureStore::new(vec![Some((checker(2), "a".into()))], 1, None, &|e| e)
+                .expect("a store"),
+        );
+        let release = RowRelease::new(Arc::clone(&store), [(0, 1e15)]);
+        let rows = release.state.lock().expect("unpoisoned").done.len();
+        assert_eq!(rows, cwisim_isa::MAX_LINES as usize);
     }
 
     fn crc(bytes: &[u8]) -> u32 {
