@@ -171,8 +171,15 @@ const LONG: &[&str] = &[
     // 35 s release in all; and the defaults' one, 2 s release
     "docs/REPRODUCTION.md: --renderer nishita --root-tolerance $t --flatness $f",
     "docs/REPRODUCTION.md: render teapot --renderer nishita -o f.png",
-    // the plain and the textured teapot by nishita: 2 × 40 s debug, 2 s release
+    // the plain and the textured teapot by nishita: 2 × 40 s debug, 2 s release; and
+    // teapot-floor without and with its shadows, 2–4 s release each
     "docs/REPRODUCTION.md: --renderer nishita --threads 1",
+    // teapot-floor by nishita (4 s release, 11 s at flatness 0.125) and by vanrij at four
+    // tessellations (1 s release in all), and their differences
+    "docs/REPRODUCTION.md: render teapot-floor --renderer nishita --npy",
+    "docs/REPRODUCTION.md: --renderer vanrij --tessellate $n",
+    "docs/REPRODUCTION.md: --renderer nishita --flatness 0.125",
+    "docs/REPRODUCTION.md: diff nishita-fine.npy vanrij-64.npy",
     // the fine reference and four nishita teapots with the normal test: 15–30 s release
     "docs/REPRODUCTION.md: --tessellate 64 --shading phong --shade-tolerance 0 -o ref.png",
     "docs/REPRODUCTION.md: --normal-angle $a",

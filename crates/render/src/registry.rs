@@ -255,6 +255,7 @@ pub const REGISTRY: &[Entry] = &[
             Setting::NormalAngle,
             Setting::Band,
             Setting::Subscan,
+            Setting::Shadows,
             Setting::TextureFilter,
         ],
         draws: "it cuts Bézier patches into pieces at most a row high, which no Eval0 claim could cover, and box-filters the exact visible ones as vanrij does",

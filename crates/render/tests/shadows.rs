@@ -371,8 +371,8 @@ mod analytic {
     }
 }
 
-/// A renderer that does not draw shadows refuses a scene whose lights cast them, naming
-/// the one that does; `--shadows` that would change nothing is refused.
+/// Every renderer draws the shadows a scene's lights cast (`nishita` on its patches too);
+/// `--shadows` that would change nothing is refused.
 #[test]
 fn shadows_that_would_be_dropped_or_a_flag_that_changes_nothing_are_refused() {
     // still-life as embedded (its main light casting shadows), and with none casting
@@ -390,17 +390,14 @@ fn shadows_that_would_be_dropped_or_a_flag_that_changes_nothing_are_refused() {
         1,
     );
     assert_ne!(casting_teapot, teapot);
-    let e = build("nishita", &casting_teapot, &Settings::default()).unwrap_err();
-    assert_eq!(
-        e.to_string(),
-        "nishita does not draw shadows on Bézier patches yet (the paper's §7), and the scene's lights[0] casts them: use --renderer vanrij (exact shadow polygons on the patches tessellated, --tessellate), or set \"shadows\": false",
-    );
+    // nishita draws shadows on its patches (§7): a casting light, or --shadows on
+    assert!(build("nishita", &casting_teapot, &Settings::default()).is_ok());
     assert!(build("nishita", teapot, &Settings::default()).is_ok());
     let on = Settings {
         shadows: Some(true),
         ..Settings::default()
     };
-    assert!(build("nishita", teapot, &on).is_err());
+    assert!(build("nishita", teapot, &on).is_ok());
     // on a scene without patches it draws the polygons as vanrij does, shadows and all
     for name in RENDERERS.into_iter().chain(["refine", "nishita"]) {
         assert!(build(name, casting, &Settings::default()).is_ok(), "{name}");

@@ -50,6 +50,11 @@ impl Camera {
         }
     }
 
+    /// The focal length in pixels: a pixel at depth `d` is `d / focal` world units wide.
+    pub fn focal(&self) -> f64 {
+        self.focal
+    }
+
     /// The depth of `p`: its distance in front of the camera along the view direction.
     pub fn depth(&self, p: DVec3) -> f64 {
         (p - self.eye).dot(self.forward)

@@ -221,48 +221,11 @@ impl LightView {
         world: &[(u32, u32, [DVec3; 3])],
         threads: usize,
     ) -> Result<LightView, SceneError> {
-        let light = DVec3::from_array(spec.lights[k].position);
-        let place = format!("lights[{k}].position");
-        let refuse = |why: String| {
-            Err(SceneError::at_field(
-                SceneErrorKind::Geometry,
-                place.clone(),
-                format!("light {k} at {light} casts shadows, but {why}"),
-            ))
-        };
-        let corners = || world.iter().flat_map(|(_, _, p)| p.iter().copied());
-        let scale = corners()
-            .map(|p| (p - light).length())
-            .fold(0.0f64, f64::max);
-        let mut sum = DVec3::ZERO;
-        for p in corners() {
-            let d = p - light;
-            let length = d.length();
-            if length.is_nan() || length <= 1e-9 * scale {
-                return refuse(format!(
-                    "it is on a vertex of the scene ({p}): a light on a surface lights it edge-on; move it off the surface"
-                ));
-            }
-            sum += d / length;
-        }
-        let one = sum.try_normalize().and_then(|axis| {
-            let widest = corners()
-                .map(|p| (p - light).normalize().dot(axis))
-                .fold(1.0f64, f64::min);
-            (widest >= MIN_COS).then_some((axis, widest))
-        });
-        let Some((axis, widest)) = one else {
+        let corners: Vec<DVec3> = world.iter().flat_map(|(_, _, p)| *p).collect();
+        let Some(camera) = one_view(spec, k, &corners, LIGHT_VIEW_SIDE)? else {
             // the scene around it, or wider than one view holds: the six faces of a cube
             return LightView::cube(spec, k, world, threads);
         };
-        let up = if axis.x.abs() < 0.5 {
-            DVec3::X
-        } else {
-            DVec3::Y
-        };
-        // a margin of 1° past the widest vertex on every side
-        let half = widest.acos() + 1f64.to_radians();
-        let camera = light_camera(light, axis, up, 2.0 * half.to_degrees());
         let tris: Vec<ScreenTriangle> = world
             .iter()
             .map(|&(mesh, face, world)| light_triangle(&camera, mesh, face, world))
@@ -317,7 +280,7 @@ impl LightView {
         let mut views = Vec::with_capacity(6);
         for (f, (axis, up)) in CUBE_FACES.into_iter().enumerate() {
             // a margin past the pyramid's 90°: its clipped parts lie within
-            let camera = light_camera(light, axis, up, 92.0);
+            let camera = light_camera(light, axis, up, 92.0, LIGHT_VIEW_SIDE);
             let mut tris = Vec::new();
             for (j, &(mesh, face, corners)) in world.iter().enumerate() {
                 let clipped = clip_to_pyramid(&corners.map(|p| p - light), axis);
@@ -363,8 +326,65 @@ impl LightView {
     }
 }
 
-/// A square pinhole view of `fov_y` degrees from the light at `light` along `axis`.
-fn light_camera(light: DVec3, axis: DVec3, up: DVec3, fov_y: f64) -> Camera {
+/// Light `k`'s one pinhole view (square, `side` units a side) holding every point of
+/// `points` with a margin of 1°, looking along their mean direction; `None` when one view
+/// cannot hold them (a point more than 85° from that direction, or points all around the
+/// light), and a refusal located at `lights[k].position` when the light is on one of them.
+pub fn one_view(
+    spec: &WorldSpec,
+    k: usize,
+    points: &[DVec3],
+    side: u32,
+) -> Result<Option<Camera>, SceneError> {
+    let light = DVec3::from_array(spec.lights[k].position);
+    let scale = points
+        .iter()
+        .map(|p| (*p - light).length())
+        .fold(0.0f64, f64::max);
+    let mut sum = DVec3::ZERO;
+    for &p in points {
+        let d = p - light;
+        let length = d.length();
+        if length.is_nan() || length <= 1e-9 * scale {
+            return Err(SceneError::at_field(
+                SceneErrorKind::Geometry,
+                format!("lights[{k}].position"),
+                format!(
+                    "light {k} at {light} casts shadows, but it is on a vertex of the scene ({p}): a light on a surface lights it edge-on; move it off the surface"
+                ),
+            ));
+        }
+        sum += d / length;
+    }
+    let Some(axis) = sum.try_normalize() else {
+        return Ok(None);
+    };
+    let widest = points
+        .iter()
+        .map(|p| (*p - light).normalize().dot(axis))
+        .fold(1.0f64, f64::min);
+    if widest < MIN_COS {
+        return Ok(None);
+    }
+    let up = if axis.x.abs() < 0.5 {
+        DVec3::X
+    } else {
+        DVec3::Y
+    };
+    // a margin of 1° past the widest point on every side
+    let half = widest.acos() + 1f64.to_radians();
+    Ok(Some(light_camera(
+        light,
+        axis,
+        up,
+        2.0 * half.to_degrees(),
+        side,
+    )))
+}
+
+/// A square pinhole view, `side` units a side, of `fov_y` degrees from the light at
+/// `light` along `axis`.
+fn light_camera(light: DVec3, axis: DVec3, up: DVec3, fov_y: f64, side: u32) -> Camera {
     Camera::new(
         &CameraSpec {
             eye: light.to_array(),
@@ -373,13 +393,13 @@ fn light_camera(light: DVec3, axis: DVec3, up: DVec3, fov_y: f64) -> Camera {
             fov_y,
             near: 0.0,
         },
-        LIGHT_VIEW_SIDE,
-        LIGHT_VIEW_SIDE,
+        side,
+        side,
     )
 }
 
 /// The world triangle `world` (of mesh `mesh`, face `face`) as `camera` at a light sees it.
-fn light_triangle(camera: &Camera, mesh: u32, face: u32, world: [DVec3; 3]) -> ScreenTriangle {
+pub fn light_triangle(camera: &Camera, mesh: u32, face: u32, world: [DVec3; 3]) -> ScreenTriangle {
     ScreenTriangle {
         points: world.map(|p| camera.project(p)),
         inv_depth: world.map(|p| 1.0 / camera.depth(p)),
@@ -498,7 +518,7 @@ impl View {
 /// The world point of light-view triangle `t` at its screen point `q`
 /// (perspective-correct, [`ScreenTriangle::perspective_weights`]; a triangle the light
 /// sees has area and lies in front of it, so they exist — its centroid otherwise).
-fn world_at(t: &ScreenTriangle, q: Pt) -> DVec3 {
+pub fn world_at(t: &ScreenTriangle, q: Pt) -> DVec3 {
     let ([w0, w1, w2], sum) = t.perspective_weights(q).unwrap_or(([1.0; 3], 3.0));
     let s = &t.surface.world;
     (w0 * s[0] + w1 * s[1] + w2 * s[2]) / sum
@@ -506,7 +526,7 @@ fn world_at(t: &ScreenTriangle, q: Pt) -> DVec3 {
 
 /// How a light reaches one camera triangle.
 #[derive(Clone, Debug, PartialEq)]
-enum Reach {
+pub enum Reach {
     /// All of it.
     All,
     /// None of it.
@@ -514,6 +534,27 @@ enum Reach {
     /// The parts it sees, on the camera's screen (disjoint simple polygons, positive),
     /// with each one's bounding box `[x0, y0, x1, y1]`.
     Parts(Shape, Vec<[f64; 4]>),
+    /// All of it but these parts, on the camera's screen (disjoint simple polygons,
+    /// positive), with each one's bounding box.
+    Unlit(Shape, Vec<[f64; 4]>),
+}
+
+impl Reach {
+    /// The parts `lit` (disjoint simple polygons on the camera's screen, either
+    /// orientation) a light reaches of a triangle.
+    pub fn parts(lit: Vec<Vec<[f64; 2]>>) -> Reach {
+        let shape: Shape = lit.into_iter().map(positive).collect();
+        let boxes = boxes(&shape);
+        Reach::Parts(shape, boxes)
+    }
+
+    /// All of a triangle but the parts `unlit` (disjoint simple polygons on the camera's
+    /// screen, either orientation).
+    pub fn unlit(unlit: Vec<Vec<[f64; 2]>>) -> Reach {
+        let shape: Shape = unlit.into_iter().map(positive).collect();
+        let boxes = boxes(&shape);
+        Reach::Unlit(shape, boxes)
+    }
 }
 
 /// The bounding box `[x0, y0, x1, y1]` of each contour.
@@ -574,26 +615,13 @@ impl ShadowTest {
     ) -> Result<ShadowTest, SceneError> {
         let spec = &scene.spec;
         let camera = Camera::new(&spec.camera, scene.width(), scene.height());
-        let mut test = ShadowTest {
-            casters: casters.clone(),
-            reach: vec![Vec::with_capacity(casters.lights.len()); tris.len()],
-            centroids: tris
-                .iter()
-                .map(|t| {
-                    (shading == Shading::Flat)
-                        .then(|| face_centroid(&scene.meshes[t.mesh as usize], t.face as usize))
-                })
-                .collect(),
-            lighting: Lighting {
-                ambient: spec.ambient.clone(),
-                lights: spec.lights.clone(),
-                channels: scene.channels(),
-            },
-            materials: spec.meshes.iter().map(|m| m.material.clone()).collect(),
-            eye: camera.eye,
-            light_triangles: 0,
-            light_fragments: 0,
-        };
+        let mut test = ShadowTest::with_reach(
+            scene,
+            shading,
+            tris,
+            casters,
+            vec![Vec::with_capacity(casters.lights.len()); tris.len()],
+        );
         if casters.is_empty() {
             return Ok(test);
         }
@@ -649,6 +677,41 @@ impl ShadowTest {
         Ok(test)
     }
 
+    /// The test of the camera's triangles `tris` (of `scene`, shaded under `shading`) with
+    /// the lit parts `reach` found elsewhere: per triangle, one [`Reach`] per light of
+    /// `casters`, in their order (`nishita` finds them from the light's own scan of the
+    /// patches). Its counts of the lights' triangles and fragments start at zero.
+    pub fn with_reach(
+        scene: &WorldScene,
+        shading: Shading,
+        tris: &[ScreenTriangle],
+        casters: &Casters,
+        reach: Vec<Vec<Reach>>,
+    ) -> ShadowTest {
+        let spec = &scene.spec;
+        let camera = Camera::new(&spec.camera, scene.width(), scene.height());
+        ShadowTest {
+            casters: casters.clone(),
+            reach,
+            centroids: tris
+                .iter()
+                .map(|t| {
+                    (shading == Shading::Flat)
+                        .then(|| face_centroid(&scene.meshes[t.mesh as usize], t.face as usize))
+                })
+                .collect(),
+            lighting: Lighting {
+                ambient: spec.ambient.clone(),
+                lights: spec.lights.clone(),
+                channels: scene.channels(),
+            },
+            materials: spec.meshes.iter().map(|m| m.material.clone()).collect(),
+            eye: camera.eye,
+            light_triangles: 0,
+            light_fragments: 0,
+        }
+    }
+
     /// The lights that cast shadows.
     pub fn casters(&self) -> &Casters {
         &self.casters
@@ -663,6 +726,9 @@ impl ShadowTest {
                 Reach::All => true,
                 Reach::Nothing => false,
                 Reach::Parts(parts, boxes) => parts.iter().zip(boxes).any(|(c, b)| {
+                    b[0] <= p[0] && p[0] <= b[2] && b[1] <= p[1] && p[1] <= b[3] && inside(c, p)
+                }),
+                Reach::Unlit(parts, boxes) => !parts.iter().zip(boxes).any(|(c, b)| {
                     b[0] <= p[0] && p[0] <= b[2] && b[1] <= p[1] && p[1] <= b[3] && inside(c, p)
                 }),
             };
@@ -685,7 +751,7 @@ impl ShadowTest {
             .map(|r| match r {
                 Reach::All => LineReach::All,
                 Reach::Nothing => LineReach::Nothing,
-                Reach::Parts(parts, boxes) => {
+                Reach::Parts(parts, boxes) | Reach::Unlit(parts, boxes) => {
                     let mut xs = Vec::new();
                     for (c, b) in parts.iter().zip(boxes) {
                         if y < b[1] || y > b[3] {
@@ -702,7 +768,7 @@ impl ShadowTest {
                         comparisons.set(comparisons.get() + 1);
                         a.total_cmp(b)
                     });
-                    LineReach::Crossings(xs)
+                    LineReach::Crossings(xs, matches!(r, Reach::Unlit(..)))
                 }
             })
             .collect();
@@ -721,7 +787,7 @@ impl ShadowTest {
             match reach {
                 Reach::All => {}
                 Reach::Nothing => set = set.without(i),
-                Reach::Parts(..) => return None,
+                Reach::Parts(..) | Reach::Unlit(..) => return None,
             }
         }
         Some(set)
@@ -752,9 +818,9 @@ pub struct LineLights {
 enum LineReach {
     All,
     Nothing,
-    /// Where the line crosses the lit parts' edges, sorted: lit where an odd number of
-    /// them lie to the right.
-    Crossings(Vec<f64>),
+    /// Where the line crosses the lit (or, `true`, the unlit) parts' edges, sorted: lit
+    /// where an odd (even) number of them lie to the right.
+    Crossings(Vec<f64>, bool),
 }
 
 impl LineLights {
@@ -765,7 +831,7 @@ impl LineLights {
         self.reach
             .iter()
             .map(|r| match r {
-                LineReach::Crossings(xs) => xs.len() as u64,
+                LineReach::Crossings(xs, _) => xs.len() as u64,
                 _ => 0,
             })
             .sum()
@@ -783,7 +849,9 @@ impl LineLights {
             let lit = match r {
                 LineReach::All => true,
                 LineReach::Nothing => false,
-                LineReach::Crossings(xs) => (xs.len() - xs.partition_point(|&v| v <= x)) % 2 == 1,
+                LineReach::Crossings(xs, unlit) => {
+                    ((xs.len() - xs.partition_point(|&v| v <= x)) % 2 == 1) != *unlit
+                }
             };
             if !lit {
                 set = set.without(i);
@@ -826,7 +894,21 @@ pub fn shadowed(
     casters: &Casters,
     threads: usize,
 ) -> Result<Shadowed, SceneError> {
+    let test = ShadowTest::new(scene, shading, tris, casters, threads)?;
+    Ok(shadowed_by(scene, tris, fragments, &test))
+}
+
+/// Cuts the camera's `fragments` of the screen triangles `tris` into the pieces each set
+/// of `test`'s lights reaches, shaded accordingly: [`shadowed`] with lit parts found
+/// elsewhere ([`ShadowTest::with_reach`]).
+pub fn shadowed_by(
+    scene: &WorldScene,
+    tris: &[ScreenTriangle],
+    fragments: Vec<Fragment>,
+    test: &ShadowTest,
+) -> Shadowed {
     let channels = scene.channels();
+    let casters = &test.casters;
     let mut stats = ShadowStats {
         lights: casters.lights.len() as u64,
         fragments_in: fragments.len() as u64,
@@ -835,13 +917,12 @@ pub fn shadowed(
     if casters.is_empty() {
         stats.pieces = fragments.len() as u64;
         let lit = vec![LightSet::ALL; fragments.len()];
-        return Ok(Shadowed {
+        return Shadowed {
             fragments,
             lit,
             stats,
-        });
+        };
     }
-    let test = ShadowTest::new(scene, shading, tris, casters, threads)?;
     stats.light_triangles = test.light_triangles;
     stats.light_fragments = test.light_fragments;
     let grid = grid_for(tris.iter().flat_map(|t| t.points));
@@ -872,17 +953,19 @@ pub fn shadowed(
                         piece.1 = piece.1.without(i);
                     }
                 }
-                Reach::Parts(lit, _) => {
+                Reach::Parts(parts, _) | Reach::Unlit(parts, _) => {
+                    // the lit parts: what the parts listed are (lit) or what they leave
+                    let (lit, unlit) = match reach {
+                        Reach::Parts(..) => (OverlayRule::Intersect, OverlayRule::Difference),
+                        _ => (OverlayRule::Difference, OverlayRule::Intersect),
+                    };
                     let mut next = Vec::with_capacity(pieces.len() * 2);
                     for (contour, set) in pieces {
                         let subject = vec![positive(contour)];
-                        for (rule, set) in [
-                            (OverlayRule::Intersect, set),
-                            (OverlayRule::Difference, set.without(i)),
-                        ] {
+                        for (rule, set) in [(lit, set), (unlit, set.without(i))] {
                             stats.booleans += 1;
                             let mut contours = Vec::new();
-                            for shape in overlay(&grid, &subject, lit, rule) {
+                            for shape in overlay(&grid, &subject, parts, rule) {
                                 settle(&grid, shape, MAX_CUT_DEPTH, &mut contours, &mut losses);
                             }
                             next.extend(contours.into_iter().map(|c| (c, set)));
@@ -926,7 +1009,7 @@ pub fn shadowed(
     stats.dropped_slivers = losses.dropped.len() as u64;
     stats.dropped_area = losses.dropped.iter().sum();
     out.stats = stats;
-    Ok(out)
+    out
 }
 
 #[cfg(test)]

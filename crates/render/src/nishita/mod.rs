@@ -30,6 +30,7 @@ pub mod band;
 pub mod classify;
 pub mod merged;
 pub mod resolve;
+pub mod shadow;
 
 use crate::error::RenderError;
 use crate::prepare::{PhongSurfaces, PolygonScene};
@@ -54,7 +55,7 @@ use std::ops::Range;
 use std::time::{Duration, Instant};
 
 /// The registry's one line about it.
-pub const ABOUT: &str = "Nishita, Kaneda & Nakamae: Bézier patches scan-converted directly — subpatches per band (--band, --flatness), Bézier clipping of their edges at every row line (--root-tolerance, --subscan), straight-sided pieces box-filtered exactly, exact visibility, Gouraud or Phong";
+pub const ABOUT: &str = "Nishita, Kaneda & Nakamae: Bézier patches scan-converted directly — subpatches per band (--band, --flatness), Bézier clipping of their edges at every row line (--root-tolerance, --subscan), straight-sided pieces box-filtered exactly, exact visibility, Gouraud or Phong, shadows from the light's own scan of the patches (§7)";
 
 /// The histogram counters' names: roots by iterations (the last: that many or more).
 const HISTOGRAM_NAMES: [&str; HISTOGRAM] = [
@@ -113,6 +114,8 @@ pub struct PatchScene<'w> {
     w: &'w WorldScene,
     camera: Camera,
     view: View,
+    /// The rows of its image.
+    rows: u32,
     params: Params,
     lighting: Lighting,
     meshes: Vec<(usize, Vec<cwisim_world::bezier::Patch>)>,
@@ -179,11 +182,35 @@ impl<'w> PatchScene<'w> {
             w,
             camera,
             view,
+            rows: w.height(),
             params,
             lighting,
             meshes,
             facings,
         })
+    }
+
+    /// The same patches seen by `camera` (a light's view, `side` rows), their facings not
+    /// yet known.
+    pub fn seen_from(&self, camera: Camera, side: u32) -> PatchScene<'w> {
+        PatchScene {
+            w: self.w,
+            camera,
+            view: View { camera },
+            rows: side,
+            params: self.params,
+            lighting: self.lighting.clone(),
+            meshes: self.meshes.clone(),
+            facings: self.meshes.iter().map(|_| Facings::default()).collect(),
+        }
+    }
+
+    /// Every control point of every patch.
+    pub fn control_points(&self) -> impl Iterator<Item = DVec3> + '_ {
+        self.meshes
+            .iter()
+            .flat_map(|(_, p)| p.iter())
+            .flat_map(|p| p.points.iter().flatten().copied())
     }
 
     /// The scene's intensity channels.
@@ -198,7 +225,7 @@ impl<'w> PatchScene<'w> {
 
     /// The bands of rows: `(top, rows)`, top to bottom.
     pub fn bands(&self, band: u32) -> Vec<(u32, u32)> {
-        let height = self.w.height();
+        let height = self.rows;
         let mut out = Vec::new();
         let mut top = 0;
         while top < height {
@@ -256,7 +283,11 @@ impl<'w> PatchScene<'w> {
 /// The pieces of every Bézier mesh of `w`, band by band (rows `0..height`; within a
 /// band, mesh by mesh).
 pub fn pieces(w: &WorldScene, settings: &Settings) -> Result<Pieces, RenderError> {
-    let scene = PatchScene::new(w, settings)?;
+    pieces_of(&PatchScene::new(w, settings)?, settings)
+}
+
+/// The pieces of every patch of `scene`, band by band (as [`pieces`]).
+fn pieces_of(scene: &PatchScene, settings: &Settings) -> Result<Pieces, RenderError> {
     let mut out = Pieces {
         patches: scene.patches(),
         ..Pieces::default()
@@ -355,6 +386,8 @@ pub struct Nishita {
     /// strip, [`cwisim_world::sweep`]); `None` when its other meshes share exact visibility with
     /// the pieces.
     segments: Option<cwisim_world::sweep::SegmentStats>,
+    /// What the lights' scans of the patches did, when a light casts shadows on them.
+    light: Option<shadow::LightScanStats>,
 }
 
 /// Whether `w` has a Bézier mesh.
@@ -372,21 +405,6 @@ fn check_smooth(shading: Shading) -> Result<(), RenderError> {
     }
 }
 
-/// Shadows are drawn on a scene without patches (its polygons, as `vanrij` draws them);
-/// on patches (the paper's §7, the light's own scanline over the patches) they are not
-/// yet, and a scene with patches whose lights cast them is refused, naming `vanrij`.
-fn refuse_shadows_on_patches(w: &WorldScene, settings: &Settings) -> Result<(), RenderError> {
-    if !has_patches(w) {
-        return Ok(());
-    }
-    match crate::prepare::world_casters(w, settings)?.lights.first() {
-        None => Ok(()),
-        Some(&k) => Err(RenderError::Usage(format!(
-            "nishita does not draw shadows on Bézier patches yet (the paper's §7), and the scene's lights[{k}] casts them: use --renderer vanrij (exact shadow polygons on the patches tessellated, --tessellate), or set \"shadows\": false"
-        ))),
-    }
-}
-
 impl Nishita {
     /// The renderer of `loaded` under `settings`.
     /// `settings.visibility` is not read (the registry's entry does not list it): the
@@ -399,9 +417,8 @@ impl Nishita {
         };
         let loaded = loaded.drawn_as(settings)?;
         settings.check().map_err(RenderError::Usage)?;
-        if let AnyScene::World(w) = &loaded.scene {
+        if matches!(loaded.scene, AnyScene::World(_)) {
             check_smooth(settings.shading)?;
-            refuse_shadows_on_patches(w, settings)?;
         }
         let w = match &loaded.scene {
             AnyScene::World(w) if has_patches(w) => w.clone(),
@@ -418,9 +435,15 @@ impl Nishita {
                     visibility_time: Duration::ZERO,
                     merged: None,
                     segments: None,
+                    light: None,
                 });
             }
         };
+        // the lights that cast shadows on the patches (§7: the light's own scan)
+        let casters = crate::prepare::world_casters(&w, settings)?;
+        let mut shadows = None;
+        let mut shadow_time = Duration::ZERO;
+        let mut light = None;
         // Phong, or a texture under any shading: lit per pixel
         let phong = settings.shading == Shading::Phong || w.textures.any();
         let shader = || PhongShader::for_shading(&w, settings.shading);
@@ -434,6 +457,7 @@ impl Nishita {
         let mut segments = None;
         let (made, count, polygons, vis, surfaces, geometry_time, visibility_time) = if others
             .is_empty()
+            && casters.is_empty()
         {
             // only patches, exact visibility: band by band (`resolve`)
             let start = Instant::now();
@@ -462,7 +486,8 @@ impl Nishita {
             )
         } else {
             let start = Instant::now();
-            let made = pieces(&w, settings)?;
+            let scene = PatchScene::new(&w, settings)?;
+            let made = pieces_of(&scene, settings)?;
             let geometry_time = start.elapsed();
             let mut tris = made.triangles;
             if !others.is_empty() {
@@ -477,7 +502,31 @@ impl Nishita {
                 project = Some(stats);
             }
             let start = Instant::now();
-            let (polygons, vis, surfaces) = if phong {
+            let (polygons, vis, surfaces) = if !casters.is_empty() {
+                let (fragments, stats) =
+                    cwisim_world::visibility::exact_fragments_on(&tris, channels, settings.threads);
+                let visible = start.elapsed();
+                let mut scan = shadow::LightScanStats::default();
+                let test = shadow::shadow_test(
+                    &w, settings, &scene, &tris, &fragments, &casters, &mut scan,
+                )?;
+                let shadowed = cwisim_world::shadow::shadowed_by(&w, &tris, fragments, &test);
+                shadow_time = start.elapsed().saturating_sub(visible);
+                shadows = Some(shadowed.stats);
+                light = Some(scan);
+                let sources: Vec<usize> = shadowed.fragments.iter().map(|f| f.source).collect();
+                let surfaces = phong.then(|| {
+                    let mut s = PhongSurfaces::new(tris.clone(), sources, shader())
+                        .filtered(settings.texture_filter);
+                    s.shadows = Some(crate::prepare::PolygonLights {
+                        casters: casters.clone(),
+                        lit: shadowed.lit,
+                    });
+                    s
+                });
+                let polygons = shadowed.fragments.into_iter().map(|f| f.polygon).collect();
+                (polygons, Some(stats), surfaces)
+            } else if phong {
                 let (fragments, stats) =
                     cwisim_world::visibility::exact_fragments_on(&tris, channels, settings.threads);
                 let sources = fragments.iter().map(|f| f.source).collect();
@@ -499,7 +548,7 @@ impl Nishita {
                 );
                 (p, s, None)
             };
-            let visibility_time = start.elapsed();
+            let visibility_time = start.elapsed().saturating_sub(shadow_time);
             let made = Pieces {
                 triangles: Vec::new(),
                 facing: Vec::new(),
@@ -527,8 +576,8 @@ impl Nishita {
             load_time: loaded.load_time,
             transform_time: geometry_time,
             visibility_time,
-            shadows: None,
-            shadow_time: std::time::Duration::ZERO,
+            shadows,
+            shadow_time,
             phong: surfaces,
             transparent_meshes: w
                 .spec
@@ -548,6 +597,7 @@ impl Nishita {
             visibility_time,
             merged,
             segments,
+            light,
         })
     }
 
@@ -623,6 +673,13 @@ impl Nishita {
                 .with("segment_edge_crossings", g.edge_crossings)
                 .with("segment_depth_crossings", g.depth_crossings)
                 .with("segment_slivers", g.slivers);
+        }
+        if let Some(l) = &self.light {
+            let b = &l.bands;
+            out = out
+                .with("light_subpatches", b.front + b.back + b.twisted)
+                .with("light_roots", b.clip.roots)
+                .with("light_pieces", l.pieces);
         }
         for (name, n) in HISTOGRAM_NAMES.iter().zip(c.histogram) {
             out.add(name, n);
@@ -774,17 +831,40 @@ impl Renderer for Nishita {
                     ),
                 ));
             }
-            let total =
-                s.subpatch_ns + s.roots_ns + s.pieces_ns + self.visibility_time.as_nanos() as u64;
+            if let Some(l) = &self.light {
+                let b = &l.bands;
+                rows.push((
+                    "light's scan",
+                    format!(
+                        "§7: the patches scanned again from each light casting shadows: {} subpatches, {} roots, {} pieces in its view, {} fragments seen; {} clipped against the camera's pieces they lie in front of",
+                        b.front + b.back + b.twisted,
+                        b.clip.roots,
+                        l.pieces,
+                        l.fragments,
+                        l.clipped
+                    ),
+                ));
+            }
+            let shadows = self.inner.polygons().shadow_time.as_nanos() as u64;
+            let total = s.subpatch_ns
+                + s.roots_ns
+                + s.pieces_ns
+                + self.visibility_time.as_nanos() as u64
+                + shadows;
             let share = |ns: u64| 100.0 * ns as f64 / total.max(1) as f64;
             rows.push((
                 "host time",
                 format!(
-                    "subpatches {:.0}%, roots {:.0}%, pieces {:.0}%, visibility {:.0}%",
+                    "subpatches {:.0}%, roots {:.0}%, pieces {:.0}%, visibility {:.0}%{}",
                     share(s.subpatch_ns),
                     share(s.roots_ns),
                     share(s.pieces_ns),
-                    share(self.visibility_time.as_nanos() as u64)
+                    share(self.visibility_time.as_nanos() as u64),
+                    if self.light.is_some() {
+                        format!(", shadows {:.0}%", share(shadows))
+                    } else {
+                        String::new()
+                    }
                 ),
             ));
         }
@@ -797,12 +877,16 @@ impl Renderer for Nishita {
         if self.patches == 0 {
             return self.inner.stage_times();
         }
-        vec![
+        let mut times = vec![
             ("subpatches", Duration::from_nanos(s.subpatch_ns)),
             ("roots", Duration::from_nanos(s.roots_ns)),
             ("pieces", Duration::from_nanos(s.pieces_ns)),
             ("visibility", self.visibility_time),
-        ]
+        ];
+        if self.light.is_some() {
+            times.push(("shadows", self.inner.polygons().shadow_time));
+        }
+        times
     }
 
     fn scene_json(&self) -> serde_json::Value {
