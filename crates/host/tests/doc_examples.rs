@@ -190,6 +190,8 @@ const LONG: &[&str] = &[
     "docs/REPRODUCTION.md: render still-life --renderer sbuffer",
     // eight refinements of the pot: 15 s debug, 2 s release
     "docs/REPRODUCTION.md: refine pot --sweep",
+    // a session of four refinements of the pot: 0.3 s release
+    "docs/REPRODUCTION.md: refine pot --events",
     // 50–200 s debug, 9–14 s release
     "docs/STUDYING.md: inspect pot -o pot.html",
     "docs/STUDYING.md: inspect pot --size 1024x1024",

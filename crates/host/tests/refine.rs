@@ -320,3 +320,66 @@ fn shadows_on_adds_the_shadow_phase_after_flat() {
         "{stderr}"
     );
 }
+
+/// `--events`: the session's table and timeline; a bad script is a located error, exit 2,
+/// nothing written.
+#[test]
+fn an_event_script_runs_a_session_and_bad_ones_are_located() {
+    let dir = scratch("refine-events");
+    std::fs::write(
+        dir.join("drag.json"),
+        r#"{"unit": "frames", "end": 8, "events": [
+  {"at": 1.5, "camera": {"eye": [1, 3.2, 4.9]}},
+  {"at": 3, "light": 0, "position": [-4, 6, 5]}
+]}"#,
+    )
+    .unwrap();
+    let out = cwisim_ok(
+        &dir,
+        &[
+            "refine",
+            "pot",
+            "--size",
+            "64x64",
+            "--events",
+            "drag.json",
+            "--plot",
+            "s.png",
+        ],
+    );
+    assert!(out.contains("session of pot: 3 run(s)"), "{out}");
+    assert!(out.contains("run 1 at cycle"), "{out}");
+    assert!(out.contains("events[0]: camera eye [1, 3.2, 4.9]"), "{out}");
+    assert!(out.contains("no: interrupted"), "{out}");
+    assert!(read(dir.join("s.png")).starts_with(b"\x89PNG"));
+    for (script, expected) in [
+        (
+            r#"{"unit": "frames", "end": 8, "events": [{"at": 0, "camera": {"fov_y": 30}}]}"#,
+            "bad.json:1:48: events[0].at: an event's time must be after 0",
+        ),
+        (
+            r#"{"unit": "frames", "end": 8, "events": [{"at": 2, "zoom": 3}]}"#,
+            "unknown field `zoom`",
+        ),
+        (
+            r#"{"unit": "frames", "end": 8, "events": [{"at": 9, "camera": {"fov_y": 30}}]}"#,
+            "bad.json:1:48: events[0].at: the event at 9 frames is past the session's end (8)",
+        ),
+    ] {
+        std::fs::write(dir.join("bad.json"), script).unwrap();
+        let o = cwisim(
+            &dir,
+            &["refine", "pot", "--events", "bad.json", "--plot", "bad.png"],
+        );
+        let (_, err) = text(&o);
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        assert!(err.contains(expected), "{err}");
+        assert!(!dir.join("bad.png").exists());
+    }
+    let o = cwisim(
+        &dir,
+        &["refine", "pot", "--events", "drag.json", "--csv", "x.csv"],
+    );
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o).1.contains("--csv is of one refinement"));
+}

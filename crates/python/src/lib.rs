@@ -923,6 +923,7 @@ fn refine<'py>(
     let mut run = interruptible(py, |cancel| {
         let setup = RefineSetup {
             scene: scene.map(Path::new),
+            changes: &[],
             settings,
             phases,
             machine: array.machine,

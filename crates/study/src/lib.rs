@@ -11,7 +11,8 @@
 //!   against the exact image, with the Pareto front; [`tradeoff_plot`] draws it.
 //! * [`refine`] — Bergman et al.'s adaptive refinement measured phase by phase against
 //!   the full-quality image and the naive sequence; [`refine_report`] its table, CSV and
-//!   sweeps, [`refine_plot`] its chart.
+//!   sweeps, [`refine_plot`] its chart; [`refine_session`] an interactive session (a
+//!   script of user events, the refinement restarted at each).
 //! * [`fit`] — the narrowest fixed-point registers within an error budget.
 //! * [`texture_cost`] — what a texture's frequency costs the array, against the filter
 //!   and the span tolerance, with its chart.
@@ -38,6 +39,7 @@ pub mod refine;
 pub mod refine_ids;
 pub mod refine_plot;
 pub mod refine_report;
+pub mod refine_session;
 pub mod texture_cost;
 pub mod tradeoff;
 pub mod tradeoff_plot;

@@ -15,6 +15,7 @@ use cwisim_render::settings::Threshold;
 use cwisim_render::vanrij::VanRij;
 use cwisim_render::{render, ArrayConfig, Renderer, Settings, Source, Taps};
 use cwisim_scene::Shading;
+use cwisim_world::events::Change;
 use cwisim_xproc::{Image, ImageSink, Machine, RunStats, Timing};
 use std::io;
 use std::path::Path;
@@ -54,6 +55,11 @@ pub struct PhaseRow {
     pub psnr: f64,
     /// The frame's display list: its instructions as the host keeps them.
     pub display_list_bytes: u64,
+    /// The cycle, from the run's start, by which the display has shown the frame's last
+    /// scanline: when it was ready, or its deadline if later (the display takes each
+    /// scanline at its deadline, so a frame is never shown sooner than its scanlines'
+    /// periods allow).
+    pub shown_cycles: u64,
 }
 
 /// What one refinement run measured.
@@ -98,6 +104,9 @@ pub struct RefineRun {
 pub struct RefineSetup<'a> {
     /// The scene: a file or an embedded name (`None`: the default).
     pub scene: Option<&'a Path>,
+    /// Changes made to the scene once loaded, in order (an interactive session's events
+    /// so far, [`crate::refine_session`]); empty: the scene as it is.
+    pub changes: &'a [Change],
     /// The drawing settings (thresholds, size, span tolerance).
     pub settings: Settings,
     /// The phases, in order.
@@ -162,6 +171,7 @@ impl TraceWrite for Tap<'_> {
 /// settings' size, tessellation and span tolerance.
 pub fn full_quality(
     scene: Option<&Path>,
+    changes: &[Change],
     settings: &Settings,
     machine: &Machine,
 ) -> Result<Vec<f64>, StudyError> {
@@ -169,7 +179,7 @@ pub fn full_quality(
         shading: Shading::Phong,
         ..*settings
     };
-    let loaded = Source::resolve(scene)?.load_for(&phong)?;
+    let loaded = load(scene, changes, &phong)?;
     let r = VanRij::new(loaded, &phong)?;
     let h = r.header();
     let mut sink = ImageSink::new(
@@ -183,6 +193,21 @@ pub fn full_quality(
     };
     render(&r, &array, settings.threads, &mut sink, Taps::default())?;
     Ok(sink.finish()?.data)
+}
+
+/// The scene `scene` loaded for `settings`, with `changes` made to it (a world scene's).
+fn load(
+    scene: Option<&Path>,
+    changes: &[Change],
+    settings: &Settings,
+) -> Result<cwisim_render::LoadedScene, StudyError> {
+    let mut loaded = Source::resolve(scene)?.load_for(settings)?;
+    if let cwisim_world::AnyScene::World(w) = &mut loaded.scene {
+        for c in changes {
+            c.apply(&mut w.spec);
+        }
+    }
+    Ok(loaded)
 }
 
 /// One pass of the refinement through the array: its frames, statistics, and taps.
@@ -205,7 +230,7 @@ fn pass(
         threads: setup.threads,
         ..*settings
     };
-    let loaded = Source::resolve(setup.scene)?.load_for(settings)?;
+    let loaded = load(setup.scene, setup.changes, settings)?;
     let refine = Refine::with_phases(loaded, settings, &setup.phases)?;
     let h = refine.header();
     let (w, lines, ch) = (h.width as usize, h.lines as usize, h.channel_count());
@@ -286,11 +311,12 @@ fn rows(p: &Pass, reference: &[f64]) -> Vec<PhaseRow> {
         .enumerate()
         .map(|(k, &phase)| {
             let lines = p.stats.lines.iter().filter(|l| l.frame == k as u64);
-            let (busy, worst, late) = lines.fold((0, 0, 0), |(b, w, n), l| {
+            let (busy, worst, late, shown) = lines.fold((0, 0, 0, 0), |(b, w, n, s), l| {
                 (
                     b + l.busy_cycles,
                     w.max(l.busy_cycles),
                     n + u64::from(l.slack < 0),
+                    s.max(l.ready.max(l.deadline)),
                 )
             });
             cumulative += busy;
@@ -307,6 +333,7 @@ fn rows(p: &Pass, reference: &[f64]) -> Vec<PhaseRow> {
                 rms,
                 psnr,
                 display_list_bytes: p.bytes.get(k).copied().unwrap_or(0),
+                shown_cycles: shown,
             }
         })
         .collect()
@@ -322,6 +349,7 @@ pub fn run_refine(
     let reference = || {
         full_quality(
             setup.scene,
+            setup.changes,
             &Settings {
                 threads: setup.threads,
                 ..setup.settings
@@ -452,25 +480,31 @@ pub fn run_refines(
         .iter()
         .map(|_| std::sync::atomic::AtomicU64::new(0))
         .collect();
-    // the full-quality image depends on the drawing, not on the thresholds a sweep
-    // varies: one per drawing, made by the first run that needs it while the others wait
-    let drawing = |s: &Settings| Settings {
-        gouraud_threshold: Threshold::All,
-        phong_angle: Threshold::All,
-        aa_threshold: Threshold::All,
-        threads: 1,
-        ..*s
+    // the full-quality image depends on the drawing and the scene's changes (a
+    // session's events), not on the thresholds a sweep varies: one per drawing, made by
+    // the first run that needs it while the others wait
+    let drawing = |setup: &RefineSetup<'_>| {
+        (
+            Settings {
+                gouraud_threshold: Threshold::All,
+                phong_angle: Threshold::All,
+                aa_threshold: Threshold::All,
+                threads: 1,
+                ..setup.settings
+            },
+            setup.changes.to_vec(),
+        )
     };
     type Slot = std::sync::Mutex<Option<std::sync::Arc<Vec<f64>>>>;
-    let mut references: Vec<(Settings, Slot)> = Vec::new();
+    let mut references: Vec<((Settings, Vec<Change>), Slot)> = Vec::new();
     for setup in setups {
-        let key = drawing(&setup.settings);
+        let key = drawing(setup);
         if !references.iter().any(|(k, _)| *k == key) {
             references.push((key, std::sync::Mutex::new(None)));
         }
     }
     let reference_of = |setup: &RefineSetup<'_>| {
-        let key = drawing(&setup.settings);
+        let key = drawing(setup);
         let (_, slot) = references
             .iter()
             .find(|(k, _)| *k == key)
@@ -479,8 +513,12 @@ pub fn run_refines(
         if let Some(image) = &*slot {
             return Ok(std::sync::Arc::clone(image));
         }
-        let image =
-            std::sync::Arc::new(full_quality(setup.scene, &setup.settings, &setup.machine)?);
+        let image = std::sync::Arc::new(full_quality(
+            setup.scene,
+            setup.changes,
+            &setup.settings,
+            &setup.machine,
+        )?);
         *slot = Some(std::sync::Arc::clone(&image));
         Ok(image)
     };

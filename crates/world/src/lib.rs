@@ -32,6 +32,7 @@ mod boolean;
 pub mod camera;
 pub mod clip;
 pub mod embedded;
+pub mod events;
 pub mod face;
 pub mod lighting;
 pub mod mesh;

@@ -21,6 +21,8 @@ use cwisim_study::refine::{run_refines, RefineRun, RefineSetup};
 use cwisim_study::refine_ids::{encode_id_npy, id_rgb};
 use cwisim_study::refine_plot::render_refine_plot;
 use cwisim_study::refine_report::{csv, write_table, Sweep};
+use cwisim_study::refine_session::{render_session_plot, run_session, write_session};
+use cwisim_world::events::EventScript;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -84,6 +86,13 @@ pub struct RefineArgs {
     /// goes to SCENE-NAME-refine.png in the working directory.
     #[arg(long, value_name = "OUT.png")]
     pub plot: Option<PathBuf>,
+    /// An interactive session: a script of user events (JSON: the camera or a light moved
+    /// at given times, in the display's cycles or frames; docs/RENDERERS.md), the
+    /// refinement restarted from its first phase at each. Prints, per event, the latency to
+    /// each phase's frame and the phase reached before the next event; --plot draws the
+    /// timeline.
+    #[arg(long, value_name = "SCRIPT.json")]
+    pub events: Option<PathBuf>,
     /// Run once per value of one threshold: NAME=V1,V2,… (NAME: gouraud-threshold,
     /// phong-angle, aa-threshold).
     #[arg(long, value_name = "NAME=V1,V2,…")]
@@ -126,7 +135,12 @@ fn default_plot(args: &RefineArgs) -> Result<Option<PathBuf>, CliError> {
         return Ok(args.plot.clone());
     }
     let name = Source::resolve(args.scene.as_deref())?.name();
-    Ok(Some(PathBuf::from(format!("{name}-refine.png"))))
+    let what = if args.events.is_some() {
+        "session"
+    } else {
+        "refine"
+    };
+    Ok(Some(PathBuf::from(format!("{name}-{what}.png"))))
 }
 
 /// Runs `cwisim refine`.
@@ -134,6 +148,7 @@ pub fn run(args: &RefineArgs, stdout: &mut dyn Write, progress: bool) -> Result<
     let plot = default_plot(args)?;
     Io::new()
         .source("scene", args.scene.as_deref())
+        .source("--events", args.events.as_deref())
         .machine(&args.machine)
         .output("--trace", args.trace.as_deref())
         .output("--csv", args.csv.as_deref())
@@ -156,6 +171,22 @@ pub fn run(args: &RefineArgs, stdout: &mut dyn Write, progress: bool) -> Result<
         .as_deref()
         .map(crate::files::trace_output_encoding)
         .transpose()?;
+    if args.events.is_some() {
+        for (flag, given) in [
+            ("--sweep", args.sweep.is_some()),
+            ("--trace", args.trace.is_some()),
+            ("--frames-png", args.frames_png.is_some()),
+            ("--cost-image-dir", args.cost_image_dir.is_some()),
+            ("--ids", args.ids.is_some()),
+            ("--csv", args.csv.is_some()),
+        ] {
+            if given {
+                return Err(CliError::Usage(format!(
+                    "{flag} is of one refinement; --events runs a session of several (its table, and --plot its timeline): drop one of them"
+                )));
+            }
+        }
+    }
     if args.sweep.is_some() {
         for (flag, given) in [
             ("--trace", args.trace.is_some()),
@@ -200,11 +231,17 @@ pub fn run(args: &RefineArgs, stdout: &mut dyn Write, progress: bool) -> Result<
     for (_, s) in &runs {
         s.check().map_err(CliError::Usage)?;
     }
+    if let Some(path) = &args.events {
+        return session(
+            args, path, settings, &phases, machine, plot, stdout, progress,
+        );
+    }
     let setups: Vec<RefineSetup> = runs
         .iter()
         .enumerate()
         .map(|(k, (_, s))| RefineSetup {
             scene: args.scene.as_deref(),
+            changes: &[],
             settings: *s,
             phases: phases.clone(),
             machine: machine.clone(),
@@ -322,6 +359,57 @@ pub fn run(args: &RefineArgs, stdout: &mut dyn Write, progress: bool) -> Result<
     .collect();
     if !written.is_empty() {
         writeln!(stdout, "\nwrote {}", written.join(", ")).map_err(CliError::Stdout)?;
+    }
+    stdout.flush().map_err(CliError::Stdout)
+}
+
+/// `cwisim refine --events SCRIPT`: the session, its table and its timeline.
+#[allow(clippy::too_many_arguments)]
+fn session(
+    args: &RefineArgs,
+    path: &Path,
+    settings: Settings,
+    phases: &[Phase],
+    machine: cwisim_xproc::Machine,
+    plot: Option<PathBuf>,
+    stdout: &mut dyn Write,
+    progress: bool,
+) -> Result<(), CliError> {
+    let loaded = Source::resolve(args.scene.as_deref())?.load_for(&settings)?;
+    let cwisim_world::AnyScene::World(w) = &loaded.scene else {
+        return Err(CliError::Usage(format!(
+            "--events moves a world scene's camera and lights; {} is a screen scene",
+            loaded.source.name()
+        )));
+    };
+    let text = cwisim_scene::read_scene_text(path)?;
+    let script =
+        EventScript::parse(&text, &w.spec).map_err(|e| CliError::Scene(e.in_file(path)))?;
+    let setup = RefineSetup {
+        scene: args.scene.as_deref(),
+        changes: &[],
+        settings,
+        phases: phases.to_vec(),
+        machine,
+        naive: false,
+        cost_maps: false,
+        ids: false,
+        threads: 1,
+        cancel: None,
+    };
+    let bar = std::sync::Mutex::new(Progress::scanlines(0, progress));
+    let report = |lines: u64| {
+        if let Ok(mut bar) = bar.lock() {
+            bar.update(lines);
+        }
+    };
+    let (s, _) = run_session(&setup, &script, args.threads, &report)?;
+    drop(bar);
+    write_session(stdout, &s).map_err(CliError::Stdout)?;
+    if let Some(p) = &plot {
+        let img = render_session_plot(&s).map_err(CliError::Usage)?;
+        write_rgb_png(p, &img)?;
+        writeln!(stdout, "\nwrote {}", p.display()).map_err(CliError::Stdout)?;
     }
     stdout.flush().map_err(CliError::Stdout)
 }
