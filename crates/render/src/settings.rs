@@ -461,6 +461,10 @@ pub enum SbufferMode {
     /// Study mode: every pixel sent as FILL sets it, an overwritten run undone by a
     /// negated draw (`Acc_mode`), so the array's work follows the pixels set.
     Overdraw,
+    /// Barkan & Gordon's §5.2 transparency: per sample of the line, the list of the
+    /// transparent polygons not blocked by an opaque one, nearest first, ending at the
+    /// nearest opaque polygon (or the background, opaque at z = ∞), composited.
+    Transparent,
 }
 
 /// `--order`: the BSP traversal.
@@ -520,7 +524,7 @@ macro_rules! spelled {
     };
 }
 
-spelled!(SbufferMode, "S-buffer mode", Host => "host", Overdraw => "overdraw");
+spelled!(SbufferMode, "S-buffer mode", Host => "host", Overdraw => "overdraw", Transparent => "transparent");
 spelled!(BspOrder, "BSP order", BackToFront => "back-to-front", FrontToBack => "front-to-back");
 spelled!(Unset, "unset-pixel list", Host => "host", Eval0 => "eval0");
 

@@ -16,6 +16,7 @@
 //! the chain's value at `a`: the array, adding the same `dI`, holds exactly the host's
 //! values, whichever run of the span ends up visible.
 
+use super::layers::{composite, LayerLine};
 use super::polys::{Poly, Polys};
 use super::sweep::{edge_value, span_gradient, LineCounts, Sweep};
 use crate::cp::{columns_in, Increment};
@@ -110,6 +111,8 @@ pub(crate) struct DepthLine {
     pub(crate) val: Vec<Vector>,
     /// The gradient of the owner's span (Gouraud; 0 for flat).
     pub(crate) grad: Vec<Vector>,
+    /// With transparency (§5.2): each sample's list down to the nearest opaque polygon.
+    pub(crate) layers: LayerLine,
 }
 
 impl DepthLine {
@@ -124,6 +127,7 @@ impl DepthLine {
         self.val.resize(columns, Vector::default());
         self.grad.clear();
         self.grad.resize(columns, Vector::default());
+        self.layers.reset(columns);
     }
 }
 
@@ -306,6 +310,9 @@ pub(crate) struct Scan<'a> {
     pub(crate) rule: Rule,
     /// `Rule::Nearer` at one sample: send each run as it is set, undoing overwrites.
     pub(crate) overdraw: bool,
+    /// `Rule::Nearer` with §5.2's lists: each sample's transparent polygons down to the
+    /// nearest opaque one, composited.
+    pub(crate) transparent: bool,
     pub(crate) merge: bool,
     pub(crate) shade_tolerance: f64,
 }
@@ -344,6 +351,7 @@ impl Scan<'_> {
         let flat = self.shading == Shading::Flat;
         let mut span_id = 0u32;
         let mut set = Vec::new();
+        let mut slots: Vec<usize> = Vec::new();
         let mut taken = Vec::new();
         let rule = self.rule;
         let shadows = self.scene.shadows.is_some();
@@ -446,7 +454,16 @@ impl Scan<'_> {
                 };
                 let (mut v, span_step) = values(p, first);
                 set.clear();
+                slots.clear();
                 match rule {
+                    Rule::Nearer if self.transparent => {
+                        for c in first..end {
+                            let key = p.key(s.column_x(c), y);
+                            let at = line.layers.insert(c, key, k, p.transmittance);
+                            set.push(at.is_some());
+                            slots.push(at.unwrap_or(0));
+                        }
+                    }
                     Rule::Nearer => {
                         for c in first..end {
                             let key = p.key(s.column_x(c), y);
@@ -520,6 +537,13 @@ impl Scan<'_> {
                     let mut w = v0;
                     for x in start..c {
                         counts.pixels_set += 1;
+                        if self.transparent {
+                            line.layers.set_val(x, slots[x - first], w);
+                            for q in w.iter_mut().zip(&d) {
+                                *q.0 += q.1;
+                            }
+                            continue;
+                        }
                         if line.owner[x] != NONE {
                             counts.pixels_overwritten += 1;
                         }
@@ -617,7 +641,12 @@ impl Scan<'_> {
     }
 
     /// A sub-scanline's samples as `woo-chall`'s emitter takes them: winners and colours.
-    fn subline_of(&self, line: &DepthLine, y: f64, sub: &mut Subline) -> io::Result<()> {
+    /// With transparency each sample's winner is its list's front and its colour the
+    /// list's composite (and the line's owners are set to the fronts, for the counts).
+    fn subline_of(&self, line: &mut DepthLine, y: f64, sub: &mut Subline) -> io::Result<()> {
+        if self.transparent {
+            return self.composite_of(line, y, sub);
+        }
         sub.winners.clone_from(&line.owner);
         sub.rgb.clear();
         for (c, &o) in line.owner.iter().enumerate() {
@@ -630,6 +659,32 @@ impl Scan<'_> {
                     .unwrap_or_default(),
                 _ => line.val[c],
             });
+        }
+        Ok(())
+    }
+
+    /// [`Self::subline_of`] with transparency: the lists composited.
+    fn composite_of(&self, line: &mut DepthLine, y: f64, sub: &mut Subline) -> io::Result<()> {
+        sub.winners.clear();
+        sub.rgb.clear();
+        for c in 0..line.owner.len() {
+            let list = line.layers.list(c);
+            let front = list.first().map_or(NONE, |l| l.owner);
+            line.owner[c] = front;
+            line.span[c] = 0;
+            sub.winners.push(front);
+            let x = self.sampler.column_x(c);
+            sub.rgb.push(composite(list, |l| -> io::Result<Vector> {
+                if self.per_pixel() {
+                    Ok(self
+                        .scene
+                        .phong(&self.list[l.owner as usize], x, y)
+                        .map_err(scene_io)?
+                        .unwrap_or_default())
+                } else {
+                    Ok(l.val)
+                }
+            })?);
         }
         Ok(())
     }
@@ -668,7 +723,7 @@ impl Scan<'_> {
             let mut counts = RowCounts::default();
             let cp_before = sweep.stats;
             let (mut active, mut aet) = (0u64, 0u64);
-            if self.one_sample() {
+            if self.one_sample() && !self.transparent {
                 let y = f64::from(row) + 0.5;
                 let mut sent = RowCounts::default();
                 let lc = {
@@ -718,7 +773,7 @@ impl Scan<'_> {
                         self.fill_line(&mut sweep, j, y, &mut line, &mut unset, None, &mut counts);
                     active = active.max(lc.active);
                     aet = aet.max(lc.aet);
-                    self.subline_of(&line, y, sub)?;
+                    self.subline_of(&mut line, y, sub)?;
                     counts.visible_runs += Scan::count_visible(&line);
                 }
                 let refs: Vec<&Subline> = sublines.iter().collect();

@@ -22,6 +22,7 @@
 //! `docs/RENDERERS.md` says how it reads the paper; `docs/ERRATA.md` what it corrects.
 
 pub mod fill;
+mod layers;
 pub mod polys;
 pub mod sweep;
 
@@ -40,7 +41,7 @@ use polys::Polys;
 use std::time::Duration;
 
 /// The registry's one line about it.
-pub const ABOUT: &str = "Barkan & Gordon's S-buffer: critical-points scan conversion polygon by polygon into a host depth line per scanline (or sub-scanline, --samples), visible runs sent (--sbuffer host|overdraw, --cp-increment)";
+pub const ABOUT: &str = "Barkan & Gordon's S-buffer: critical-points scan conversion polygon by polygon into a host depth line per scanline (or sub-scanline, --samples), visible runs sent (--sbuffer host|overdraw|transparent, --cp-increment)";
 
 /// The S-buffer renderer of a scene.
 pub struct SBuffer {
@@ -78,6 +79,12 @@ impl SBuffer {
                 ));
             }
         }
+        if settings.sbuffer == SbufferMode::Transparent && !polys.transparent() {
+            return Err(RenderError::Usage(format!(
+                "--sbuffer transparent composites the polygons of transparent meshes, and {} has none (no material with a transmittance above 0): use --sbuffer host",
+                polys.source.name()
+            )));
+        }
         Ok(SBuffer {
             polys,
             sampler,
@@ -112,6 +119,7 @@ impl SBuffer {
             increment: self.increment,
             rule: Rule::Nearer,
             overdraw: self.mode == SbufferMode::Overdraw,
+            transparent: self.mode == SbufferMode::Transparent,
             merge: self.merge,
             shade_tolerance: self.shade_tolerance,
         }
@@ -168,6 +176,8 @@ impl Renderer for SBuffer {
                 SbufferMode::Host => "visible runs sent (depth on the host)",
                 SbufferMode::Overdraw =>
                     "every run sent as set, overwrites undone (overdraw study)",
+                SbufferMode::Transparent =>
+                    "per sample a list of the transparent polygons down to the nearest opaque one, composited (§5.2)",
             }
         )
     }
@@ -175,6 +185,12 @@ impl Renderer for SBuffer {
     fn summary_rows(&self, c: &Counters, _stats: &RunStats) -> Vec<(&'static str, String)> {
         let mut rows = self.polys.summary_rows();
         rows.extend(cp_rows(c));
+        if self.mode != SbufferMode::Transparent && self.polys.transparent() {
+            rows.push((
+                "note",
+                "meshes with a transmittance drawn opaque: this mode keeps the nearest surface (--sbuffer transparent composites the layers)".to_string(),
+            ));
+        }
         rows
     }
 
