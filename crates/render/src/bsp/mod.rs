@@ -170,6 +170,7 @@ impl Bsp {
             rule: self.rule(),
             overdraw: false,
             transparent: false,
+            abuffer: false,
             merge: self.merge,
             shade_tolerance: self.shade_tolerance,
         }
