@@ -949,26 +949,32 @@ impl Scan<'_> {
             .iter()
             .map(|p| p.cp.critical_points().len() as u64)
             .sum();
+        let frame = Counters::default()
+            .with("polygons", self.list.len() as u64)
+            .with(
+                "vertices",
+                self.list.iter().map(|p| p.cp.len() as u64).sum(),
+            )
+            .with("critical_points", critical)
+            .with("max_active_polygons", sweep.max_active)
+            .with("max_aet", sweep.max_aet)
+            .with("moveup_steps", sweep.stats.moveup_steps)
+            .with("aet_inserts", sweep.stats.inserts)
+            .with("aet_insert_scans", sweep.stats.insert_scans)
+            .with("aet_deletes", sweep.stats.deletes)
+            .with("cp_recomputes", sweep.stats.recomputes)
+            .with("cp_increments", sweep.stats.increments)
+            .with("buffer_bytes", self.buffer_bytes(max_fragments));
+        let frame = if self.transparent {
+            frame.with("max_layers", line.layers.max_len as u64)
+        } else {
+            frame
+        };
         Ok(SFrame {
             rows,
             row_counts,
             figures: serde_json::Value::from(figures),
-            frame: Counters::default()
-                .with("polygons", self.list.len() as u64)
-                .with(
-                    "vertices",
-                    self.list.iter().map(|p| p.cp.len() as u64).sum(),
-                )
-                .with("critical_points", critical)
-                .with("max_active_polygons", sweep.max_active)
-                .with("max_aet", sweep.max_aet)
-                .with("moveup_steps", sweep.stats.moveup_steps)
-                .with("aet_inserts", sweep.stats.inserts)
-                .with("aet_insert_scans", sweep.stats.insert_scans)
-                .with("aet_deletes", sweep.stats.deletes)
-                .with("cp_recomputes", sweep.stats.recomputes)
-                .with("cp_increments", sweep.stats.increments)
-                .with("buffer_bytes", self.buffer_bytes(max_fragments)),
+            frame,
         })
     }
 }
