@@ -133,6 +133,14 @@ pub enum SbufferArg {
     /// Study mode (f64, one sample): every run sent as FILL sets it, overwrites undone by
     /// negated draws under Acc_mode.
     Overdraw,
+    /// Barkan & Gordon's §5.2 transparency: per sample, the list of the transparent
+    /// polygons in front of the nearest opaque one, composited nearest first (world
+    /// scenes with a material's transmittance above 0).
+    Transparent,
+    /// Barkan & Gordon's §5.2 scanline A-buffer: per pixel a fragment per polygon, its
+    /// coverage mask --samples × --samples bits (at most 8 × 8), resolved nearest first
+    /// as Carpenter resolves a pixel.
+    Abuffer,
 }
 
 /// `--order`.
@@ -171,6 +179,8 @@ impl From<SbufferArg> for SbufferMode {
         match g {
             SbufferArg::Host => SbufferMode::Host,
             SbufferArg::Overdraw => SbufferMode::Overdraw,
+            SbufferArg::Transparent => SbufferMode::Transparent,
+            SbufferArg::Abuffer => SbufferMode::Abuffer,
         }
     }
 }
@@ -310,7 +320,10 @@ pub struct DrawArgs {
     /// updates an edge's intersection from one scanline to the next.
     #[arg(long, value_enum, default_value_t = IncrementArg::Direct, help_heading = "Scanline principle (sbuffer, bsp)")]
     pub cp_increment: IncrementArg,
-    /// What the S-buffer sends the array.
+    /// What the S-buffer keeps per sample and sends the array: the nearest polygon (host),
+    /// every run as set (overdraw), the transparent polygons down to the nearest opaque
+    /// one, composited (transparent), or per pixel a fragment per polygon with a
+    /// --samples × --samples coverage mask (abuffer).
     #[arg(long, value_enum, default_value_t = SbufferArg::Host, help_heading = "Scanline principle (sbuffer, bsp)")]
     pub sbuffer: SbufferArg,
     /// The BSP tree's traversal order.

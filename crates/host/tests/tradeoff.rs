@@ -508,3 +508,65 @@ fn merge_is_budgeted_before_any_part_is_read_and_refuses_what_is_not_a_file() {
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("/dev/null: not a regular file"), "{stderr}");
 }
+
+#[test]
+fn the_a_buffer_s_mask_is_an_axis_its_rows_parse_back_and_bad_modes_are_refused() {
+    let dir = scratch("tradeoff-abuffer");
+    let out = cwisim_ok(
+        &dir,
+        &[
+            "tradeoff",
+            "pot",
+            "--size",
+            "32x32",
+            "--renderers",
+            "sbuffer",
+            "--sbuffer",
+            "host,abuffer",
+            "--numeric",
+            "f64",
+            "--repeat",
+            "1",
+            "--csv",
+            "ab.csv",
+        ],
+    );
+    let (header, rows) = read_csv(&dir.join("ab.csv"));
+    // per shading, the samples axis once for each mode
+    let abuffer: Vec<&CsvRow> = rows
+        .iter()
+        .filter(|r| r.get(&header, "aa") == "abuffer")
+        .collect();
+    assert_eq!(abuffer.len(), 12, "{out}");
+    assert_eq!(rows.len(), 24, "{out}");
+    // its Gouraud error falls from a 2×2 to an 8×8 mask
+    let rms = |l: &str| -> f64 {
+        abuffer
+            .iter()
+            .find(|r| r.get(&header, "shading") == "gouraud" && r.get(&header, "samples") == l)
+            .unwrap()
+            .get(&header, "rms_error")
+            .parse()
+            .unwrap()
+    };
+    assert!(rms("8") < rms("2"), "{out}");
+    // the CSV is read back (a sweep joined from one part)
+    let merged = cwisim_ok(&dir, &["tradeoff", "--merge", "ab.csv"]);
+    assert!(merged.contains("abuffer"), "{merged}");
+    for (args, says) in [
+        (&["--sbuffer", "transparent"][..], "--sbuffer transparent"),
+        (
+            &["--sbuffer", "abuffer", "--renderers", "vanrij"][..],
+            "leaves sbuffer out",
+        ),
+        (&["--sbuffer", "abuffer,abuffer"][..], "at most once"),
+    ] {
+        let out = cwisim(
+            &dir,
+            &[&["tradeoff", "pot", "--size", "16x16"][..], args].concat(),
+        );
+        let (_, stderr) = text(&out);
+        assert_eq!(out.status.code(), Some(2), "{stderr}");
+        assert!(stderr.contains(says), "{stderr}");
+    }
+}

@@ -409,7 +409,7 @@ impl PolygonScene {
             rows.push((
                 "note",
                 format!(
-                    "{} mesh(es) with a transmittance drawn opaque: this renderer keeps the nearest surface (woo-chall composites layers)",
+                    "{} mesh(es) with a transmittance drawn opaque: this renderer keeps the nearest surface (woo-chall and sbuffer --sbuffer transparent composite the layers)",
                     self.transparent_meshes
                 ),
             ));

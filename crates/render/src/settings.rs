@@ -365,6 +365,10 @@ impl Setting {
                 Setting::Order,
                 "--unset is used with --order front-to-back only (back to front paints into a host colour line)",
             ),
+            Setting::MergeSubscanlines if s.sbuffer == SbufferMode::Abuffer => why(
+                Setting::Sbuffer,
+                "--merge-subscanlines is not used with --sbuffer abuffer (the host resolves each pixel's fragments: one pass per row)",
+            ),
             Setting::MergeSubscanlines if s.samples < 2 => why(
                 Setting::Samples,
                 "--merge-subscanlines is used with --samples 2 or more (one sub-scanline per row has nothing to merge)",
@@ -461,6 +465,14 @@ pub enum SbufferMode {
     /// Study mode: every pixel sent as FILL sets it, an overwritten run undone by a
     /// negated draw (`Acc_mode`), so the array's work follows the pixels set.
     Overdraw,
+    /// Barkan & Gordon's §5.2 transparency: per sample of the line, the list of the
+    /// transparent polygons not blocked by an opaque one, nearest first, ending at the
+    /// nearest opaque polygon (or the background, opaque at z = ∞), composited.
+    Transparent,
+    /// Barkan & Gordon's §5.2 scanline A-buffer: per pixel of the one-scanline buffer,
+    /// each polygon's fragment (an `l × l` coverage mask from `--samples l`), resolved
+    /// nearest first as Carpenter resolves a pixel.
+    Abuffer,
 }
 
 /// `--order`: the BSP traversal.
@@ -520,7 +532,7 @@ macro_rules! spelled {
     };
 }
 
-spelled!(SbufferMode, "S-buffer mode", Host => "host", Overdraw => "overdraw");
+spelled!(SbufferMode, "S-buffer mode", Host => "host", Overdraw => "overdraw", Transparent => "transparent", Abuffer => "abuffer");
 spelled!(BspOrder, "BSP order", BackToFront => "back-to-front", FrontToBack => "front-to-back");
 spelled!(Unset, "unset-pixel list", Host => "host", Eval0 => "eval0");
 

@@ -557,6 +557,13 @@ fn transparent_layers_composite_nearest_first() {
             (centre - want).abs() < 1e-12,
             "l = {samples}: {centre} vs {want}"
         );
+        // past the squares behind (the front one is nearer, so larger on the screen:
+        // pixel 6's centre is on it alone), the front over the background, opaque at
+        // z = ∞ and black, lets ½ through
+        if samples == 1 {
+            let alone = img[16 * 32 + 6];
+            assert!((alone - 0.5 * 0.8).abs() < 1e-12, "{alone}");
+        }
         // opaque: the front square alone
         let opaque = image_of("woo-chall", layered_scene(0.0, 0.5), &settings, 1);
         assert!((opaque[16 * 32 + 16] - 0.8).abs() < 1e-12);

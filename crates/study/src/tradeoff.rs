@@ -11,7 +11,7 @@
 //! the array.
 
 use crate::error::StudyError;
-use cwisim_render::settings::Setting as Flag;
+use cwisim_render::settings::{SbufferMode, Setting as Flag};
 use cwisim_render::{
     registry, render, ArrayConfig, PolygonScene, Renderer, Settings, Size, Source, Taps,
 };
@@ -110,6 +110,9 @@ impl Setting {
         let s = &self.settings;
         let mut words = vec![self.renderer.name.to_string(), s.shading.name().to_string()];
         if self.renderer.supersampled {
+            if s.sbuffer == SbufferMode::Abuffer {
+                words.push("abuffer".into());
+            }
             words.push(format!("{}×{} samples", s.samples, s.samples));
         } else if reads(self, Flag::Aa) {
             words.push(s.aa.name().to_string());
@@ -127,6 +130,10 @@ impl Setting {
         words.join(" ")
     }
 }
+
+/// The `aa` column of `sbuffer`'s scanline A-buffer rows (`--sbuffer abuffer`): its
+/// pixels resolved from coverage masks of `samples × samples` bits.
+pub const ABUFFER_AA: &str = "abuffer";
 
 /// Samples per pixel side tried for a supersampling renderer: from point sampling to
 /// 64 samples per pixel, enough to see the error fall as `l` grows.
@@ -153,6 +160,9 @@ pub struct Axes {
     /// visibility, the per-pixel box filter), by the renderers that draw textures, and
     /// measured against its own best image.
     pub textured: bool,
+    /// `sbuffer`'s modes to try at every samples value (empty: its default, `host`);
+    /// `abuffer` rows show it in the `aa` column.
+    pub sbuffer: Vec<SbufferMode>,
 }
 
 /// The root tolerances of a renderer that draws Bézier patches directly (Nishita et
@@ -265,24 +275,31 @@ fn grid_of(
             return;
         }
         if renderer.supersampled {
+            let modes = match renderer.uses.contains(&Flag::Sbuffer) && !axes.sbuffer.is_empty() {
+                true => axes.sbuffer.clone(),
+                false => vec![SbufferMode::Host],
+            };
             for &tessellate in tessellations {
                 for shading in [Shading::Phong, Shading::Gouraud, Shading::Flat] {
                     if shading == Shading::Phong && !axes.world {
                         continue;
                     }
-                    for samples in SAMPLES_AXIS {
-                        for numeric in formats {
-                            out.push(Setting {
-                                renderer,
-                                settings: Settings {
-                                    shading,
-                                    samples,
-                                    size: axes.size,
-                                    tessellate,
-                                    ..Settings::default()
-                                },
-                                numeric: *numeric,
-                            });
+                    for &sbuffer in &modes {
+                        for samples in SAMPLES_AXIS {
+                            for numeric in formats {
+                                out.push(Setting {
+                                    renderer,
+                                    settings: Settings {
+                                        shading,
+                                        samples,
+                                        size: axes.size,
+                                        tessellate,
+                                        sbuffer,
+                                        ..Settings::default()
+                                    },
+                                    numeric: *numeric,
+                                });
+                            }
                         }
                     }
                 }
@@ -649,6 +666,40 @@ impl Plan {
         renderers: &[String],
         formats: &[Numeric],
     ) -> Result<Plan, StudyError> {
+        Plan::with_sbuffer(scene, size, tessellations, shadows, renderers, formats, &[])
+    }
+
+    /// [`Plan::new`] with `sbuffer`'s modes to try (empty: `host` alone): `host` and
+    /// `abuffer` (the scanline A-buffer, its mask the samples axis) are measured against
+    /// the exact image; the others are refused.
+    pub fn with_sbuffer(
+        scene: Option<&Path>,
+        size: Option<Size>,
+        tessellations: &[u32],
+        shadows: &[bool],
+        renderers: &[String],
+        formats: &[Numeric],
+        sbuffer: &[SbufferMode],
+    ) -> Result<Plan, StudyError> {
+        if let Some(m) = sbuffer
+            .iter()
+            .find(|m| !matches!(m, SbufferMode::Host | SbufferMode::Abuffer))
+        {
+            return Err(StudyError::Usage(format!(
+                "--sbuffer {m}: tradeoff tries host and abuffer (they draw the image the exact one measures; overdraw draws host's, transparent composites what the exact image does not)"
+            )));
+        }
+        if (1..sbuffer.len()).any(|k| sbuffer[..k].contains(&sbuffer[k])) {
+            return Err(StudyError::Usage(
+                "--sbuffer: each mode at most once".into(),
+            ));
+        }
+        if !sbuffer.is_empty() && !renderers.is_empty() && !renderers.iter().any(|r| r == "sbuffer")
+        {
+            return Err(StudyError::Usage(
+                "--sbuffer sets sbuffer's modes, and --renderers leaves sbuffer out".into(),
+            ));
+        }
         // a progressive renderer's frames refine one another: one frame against the exact
         // image says nothing of it (its phases are measured by its own summary)
         let entries: Vec<&'static registry::Entry> = if renderers.is_empty() {
@@ -686,6 +737,7 @@ impl Plan {
             },
             patches: probe.has_patches(),
             textured: probe.is_textured(),
+            sbuffer: sbuffer.to_vec(),
         };
         let settings = grid(&entries, &axes, formats);
         let skipped = skipped_renderers(&entries, &axes);
@@ -1183,6 +1235,8 @@ fn row_of(
         },
         aa: if reads(setting, Flag::Aa) {
             s.aa.name()
+        } else if s.sbuffer == SbufferMode::Abuffer {
+            ABUFFER_AA
         } else {
             "-"
         },
@@ -1449,7 +1503,7 @@ fn row_of_fields(f: &[String]) -> Result<Row, String> {
             Some(real(2)?)
         },
         shading: dash_or(3, &shadings)?,
-        aa: dash_or(4, &filters)?,
+        aa: dash_or(4, &[filters.as_slice(), &[ABUFFER_AA]].concat())?,
         samples: optional(5)?.map(|v| small(v, 5)).transpose()?,
         visibility: dash_or(6, &visibilities)?,
         shadows: dash_or(7, &["on", "off"])?,
@@ -2064,7 +2118,18 @@ mod tests {
                     ..Axes::default()
                 },
             ),
+            (
+                "pot",
+                &pot,
+                Axes {
+                    world: true,
+                    size,
+                    sbuffer: vec![SbufferMode::Host, SbufferMode::Abuffer],
+                    ..Axes::default()
+                },
+            ),
         ];
+        let mut abuffer = 0;
         let measured = Measured {
             image: Vec::new(),
             counters: Default::default(),
@@ -2086,7 +2151,12 @@ mod tests {
                     size: axes.size,
                     ..Settings::default()
                 };
-                if row.aa != "-" {
+                if row.aa == ABUFFER_AA {
+                    // the A-buffer's rows: `--sbuffer abuffer`
+                    abuffer += 1;
+                    given.push(Flag::Sbuffer);
+                    parsed.sbuffer = SbufferMode::Abuffer;
+                } else if row.aa != "-" {
                     given.push(Flag::Aa);
                     parsed.aa = row.aa.parse().unwrap();
                 }
@@ -2125,6 +2195,8 @@ mod tests {
             }
         }
         assert!(phong > 0);
+        // sbuffer's A-buffer: three shadings × the samples axis
+        assert_eq!(abuffer, 3 * SAMPLES_AXIS.len());
     }
 
     /// Phong's box filter is coverage × the centre's shade whether asked as `box` or

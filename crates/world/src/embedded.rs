@@ -35,6 +35,11 @@ pub const EMBEDDED: &[Embedded] = &[
         text: include_str!("../scenes/still-life.json"),
     },
     Embedded {
+        name: "glass",
+        about: "world, RGB, 320×240: a red vase behind a glass box (transmittance 0.6) and a blue cone behind a pane (0.5) that overlaps the box; woo-chall and sbuffer --sbuffer transparent composite the layers, the others draw the nearest surface",
+        text: include_str!("../scenes/glass.json"),
+    },
+    Embedded {
         name: "bowl",
         about: "world, RGB: a red ball above a shallow bowl and a blue cone in it; the one light casts shadows, the ball's onto the bowl's curved inside",
         text: include_str!("../scenes/bowl.json"),

@@ -5,7 +5,7 @@
 //!
 
 use super::MachineArgs;
-use crate::draw::ShadowsArg;
+use crate::draw::{SbufferArg, ShadowsArg};
 use crate::error::CliError;
 use crate::files::{write_atomic, Io};
 use crate::output::write_rgb_png;
@@ -43,6 +43,11 @@ pub struct TradeoffArgs {
     /// `cwisim renderers` lists them).
     #[arg(long, value_name = "LIST", value_delimiter = ',')]
     pub renderers: Vec<String>,
+    /// sbuffer's modes to try at every samples value, comma-separated: host (its default,
+    /// depth per sample) and abuffer (the scanline A-buffer: a samples × samples coverage
+    /// mask per pixel, shown as `abuffer` in the aa column) [default: host].
+    #[arg(long, value_enum, value_name = "SBUFFER,…", value_delimiter = ',')]
+    pub sbuffer: Vec<SbufferArg>,
     /// The numeric formats of the array to try: repeat the flag, or separate them with
     /// `;` (a fixed format has commas of its own): f64, f32,
     /// fixed:I=M.N,dI=M.N,ddI=M.N[,acc=M.N][,overflow=wrap|saturate].
@@ -74,7 +79,7 @@ pub struct TradeoffArgs {
         long,
         value_name = "PART.csv",
         num_args = 1..,
-        conflicts_with_all = ["scene", "size", "tessellate", "shadows", "renderers", "numeric", "repeat", "threads", "shard"]
+        conflicts_with_all = ["scene", "size", "tessellate", "shadows", "renderers", "sbuffer", "numeric", "repeat", "threads", "shard"]
     )]
     pub merge: Vec<PathBuf>,
     /// The machine model.
@@ -123,13 +128,16 @@ pub fn run(args: &TradeoffArgs, stdout: &mut dyn Write, progress: bool) -> Resul
     let width = name_width(cwisim_render::registry::REGISTRY.iter().map(|e| e.name));
     let mut bar: Option<Progress> = None;
     let mut failed: Option<std::io::Error> = None;
-    let plan = Plan::new(
+    let modes: Vec<cwisim_render::settings::SbufferMode> =
+        args.sbuffer.iter().map(|&m| m.into()).collect();
+    let plan = Plan::with_sbuffer(
         args.scene.as_deref(),
         args.size,
         &args.tessellate,
         &shadows,
         &args.renderers,
         &formats,
+        &modes,
     )?;
     let groups = match args.shard {
         Some(shard) => shard.groups(plan.groups.len()),

@@ -116,6 +116,7 @@ impl Bsp {
                     flat: p.flat,
                     plane: p.plane,
                     source: p.source,
+                    transmittance: p.transmittance,
                 }
             })
             .collect();
@@ -168,6 +169,8 @@ impl Bsp {
             increment: self.increment,
             rule: self.rule(),
             overdraw: false,
+            transparent: false,
+            abuffer: false,
             merge: self.merge,
             shade_tolerance: self.shade_tolerance,
         }
@@ -284,6 +287,12 @@ impl Renderer for Bsp {
             ),
         ));
         rows.extend(cp_rows(c));
+        if self.polys.transparent() {
+            rows.push((
+                "note",
+                "meshes with a transmittance drawn opaque: this renderer keeps the nearest surface (woo-chall and sbuffer --sbuffer transparent composite the layers)".to_string(),
+            ));
+        }
         rows
     }
 

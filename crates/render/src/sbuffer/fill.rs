@@ -16,6 +16,8 @@
 //! the chain's value at `a`: the array, adding the same `dI`, holds exactly the host's
 //! values, whichever run of the span ends up visible.
 
+use super::abuffer::{resolve, Fragment, FragmentLine};
+use super::layers::{composite, LayerLine};
 use super::polys::{Poly, Polys};
 use super::sweep::{edge_value, span_gradient, LineCounts, Sweep};
 use crate::cp::{columns_in, Increment};
@@ -23,7 +25,7 @@ use crate::error::{scene_io, NonFinite};
 use crate::renderer::Counters;
 use crate::span::{fit_span, SpanStats};
 use crate::subsample::{Grid, Sampler};
-use crate::woochall::emit::{emit_row, EmitRule, Subline};
+use crate::woochall::emit::{emit_row, send, Class, EmitCounts, EmitRule, Subline};
 use crate::woochall::lists::NONE;
 use cwisim_isa::{Instruction, Intensity, Opcode, TraceWrite};
 use cwisim_scene::{Shading, Vector};
@@ -110,6 +112,11 @@ pub(crate) struct DepthLine {
     pub(crate) val: Vec<Vector>,
     /// The gradient of the owner's span (Gouraud; 0 for flat).
     pub(crate) grad: Vec<Vector>,
+    /// With transparency (§5.2): each sample's list down to the nearest opaque polygon.
+    pub(crate) layers: LayerLine,
+    /// The A-buffer (§5.2): each pixel's fragments, over the row's sub-scanlines (reset
+    /// per row, not per line).
+    pub(crate) frags: FragmentLine,
 }
 
 impl DepthLine {
@@ -124,6 +131,7 @@ impl DepthLine {
         self.val.resize(columns, Vector::default());
         self.grad.clear();
         self.grad.resize(columns, Vector::default());
+        self.layers.reset(columns);
     }
 }
 
@@ -152,6 +160,8 @@ pub(crate) struct RowCounts {
     pub(crate) shadow_crossings: u64,
     /// The comparisons sorting them took.
     pub(crate) shadow_comparisons: u64,
+    /// The A-buffer's fragments.
+    pub(crate) fragments: u64,
 }
 
 impl RowCounts {
@@ -175,6 +185,7 @@ impl RowCounts {
         self.shadow_spans += o.shadow_spans;
         self.shadow_crossings += o.shadow_crossings;
         self.shadow_comparisons += o.shadow_comparisons;
+        self.fragments += o.fragments;
     }
 
     fn spans_fitted(&mut self, s: &SpanStats) {
@@ -204,6 +215,11 @@ impl RowCounts {
             .with("eval3", self.eval3)
             .with("fit_candidates", self.fit_candidates)
             .with("instructions", self.instructions);
+        let c = if self.fragments > 0 {
+            c.with("fragments", self.fragments)
+        } else {
+            c
+        };
         if self.shadow_spans == 0 {
             return c;
         }
@@ -306,6 +322,12 @@ pub(crate) struct Scan<'a> {
     pub(crate) rule: Rule,
     /// `Rule::Nearer` at one sample: send each run as it is set, undoing overwrites.
     pub(crate) overdraw: bool,
+    /// `Rule::Nearer` with §5.2's lists: each sample's transparent polygons down to the
+    /// nearest opaque one, composited.
+    pub(crate) transparent: bool,
+    /// The scanline A-buffer (§5.2): every sample of a span goes to its pixel's fragment
+    /// of the polygon, resolved per pixel once the row's sub-scanlines are done.
+    pub(crate) abuffer: bool,
     pub(crate) merge: bool,
     pub(crate) shade_tolerance: f64,
 }
@@ -339,11 +361,13 @@ impl Scan<'_> {
         let s = &self.sampler;
         let ch = self.scene.channel_count();
         let columns = s.columns();
-        line.reset(columns);
+        // the A-buffer keeps no depth line: its fragments are the buffer
+        line.reset(if self.abuffer { 0 } else { columns });
         unset.reset(columns);
         let flat = self.shading == Shading::Flat;
         let mut span_id = 0u32;
         let mut set = Vec::new();
+        let mut slots: Vec<usize> = Vec::new();
         let mut taken = Vec::new();
         let rule = self.rule;
         let shadows = self.scene.shadows.is_some();
@@ -446,7 +470,17 @@ impl Scan<'_> {
                 };
                 let (mut v, span_step) = values(p, first);
                 set.clear();
+                slots.clear();
                 match rule {
+                    Rule::Nearer if self.abuffer => set.resize(end - first, true),
+                    Rule::Nearer if self.transparent => {
+                        for c in first..end {
+                            let key = p.key(s.column_x(c), y);
+                            let at = line.layers.insert(c, key, k, p.transmittance);
+                            set.push(at.is_some());
+                            slots.push(at.unwrap_or(0));
+                        }
+                    }
                     Rule::Nearer => {
                         for c in first..end {
                             let key = p.key(s.column_x(c), y);
@@ -520,6 +554,20 @@ impl Scan<'_> {
                     let mut w = v0;
                     for x in start..c {
                         counts.pixels_set += 1;
+                        if self.abuffer {
+                            line.frags.add(x, k, &w, s.column_x(x), y);
+                            for q in w.iter_mut().zip(&d) {
+                                *q.0 += q.1;
+                            }
+                            continue;
+                        }
+                        if self.transparent {
+                            line.layers.set_val(x, slots[x - first], w);
+                            for q in w.iter_mut().zip(&d) {
+                                *q.0 += q.1;
+                            }
+                            continue;
+                        }
                         if line.owner[x] != NONE {
                             counts.pixels_overwritten += 1;
                         }
@@ -617,7 +665,12 @@ impl Scan<'_> {
     }
 
     /// A sub-scanline's samples as `woo-chall`'s emitter takes them: winners and colours.
-    fn subline_of(&self, line: &DepthLine, y: f64, sub: &mut Subline) -> io::Result<()> {
+    /// With transparency each sample's winner is its list's front and its colour the
+    /// list's composite (and the line's owners are set to the fronts, for the counts).
+    fn subline_of(&self, line: &mut DepthLine, y: f64, sub: &mut Subline) -> io::Result<()> {
+        if self.transparent {
+            return self.composite_of(line, y, sub);
+        }
         sub.winners.clone_from(&line.owner);
         sub.rgb.clear();
         for (c, &o) in line.owner.iter().enumerate() {
@@ -632,6 +685,110 @@ impl Scan<'_> {
             });
         }
         Ok(())
+    }
+
+    /// [`Self::subline_of`] with transparency: the lists composited.
+    fn composite_of(&self, line: &mut DepthLine, y: f64, sub: &mut Subline) -> io::Result<()> {
+        sub.winners.clear();
+        sub.rgb.clear();
+        for c in 0..line.owner.len() {
+            let list = line.layers.list(c);
+            let front = list.first().map_or(NONE, |l| l.owner);
+            line.owner[c] = front;
+            line.span[c] = 0;
+            sub.winners.push(front);
+            let x = self.sampler.column_x(c);
+            sub.rgb.push(composite(list, |l| -> io::Result<Vector> {
+                if self.per_pixel() {
+                    Ok(self
+                        .scene
+                        .phong(&self.list[l.owner as usize], x, y)
+                        .map_err(scene_io)?
+                        .unwrap_or_default())
+                } else {
+                    Ok(l.val)
+                }
+            })?);
+        }
+        Ok(())
+    }
+
+    /// The bytes of the one-scanline buffer, from the sizes of what it holds: the
+    /// A-buffer's fragments on the row holding most, with a list per pixel; the S-buffer's
+    /// depth line (depth, owner, span, value and gradient per sample column) and, with
+    /// several samples per pixel or transparency, the row's sub-scanlines kept for the
+    /// emitter (a winner and a colour per sample column); with transparency its lists
+    /// are not counted (their length varies: `max_layers`).
+    fn buffer_bytes(&self, max_fragments: usize) -> u64 {
+        use std::mem::size_of;
+        let width = self.scene.width as usize;
+        let bytes = if self.abuffer {
+            max_fragments * size_of::<Fragment>() + width * size_of::<Vec<Fragment>>()
+        } else {
+            let columns = self.sampler.columns();
+            let depth =
+                columns * (size_of::<f64>() + 2 * size_of::<u32>() + 2 * size_of::<Vector>());
+            let kept = if self.one_sample() && !self.transparent {
+                0
+            } else {
+                self.sampler.l as usize * columns * (size_of::<u32>() + size_of::<Vector>())
+            };
+            depth + kept
+        };
+        bytes as u64
+    }
+
+    /// The A-buffer's row: each pixel's fragments resolved (their depth at the pixel
+    /// centre orders them; a fragment's colour is its samples' mean, or with per-pixel
+    /// lighting the shade at their centroid) and sent as `woo-chall`'s emitter sends a
+    /// merged row: runs of pixels one polygon covers whole and in front through the span
+    /// fitter, the others one `Eval1` each.
+    fn resolve_row(
+        &self,
+        frags: &FragmentLine,
+        row: u32,
+        list: &mut Vec<Instruction>,
+    ) -> io::Result<EmitCounts> {
+        let ch = self.scene.channel_count();
+        let width = self.scene.width as usize;
+        let yc = f64::from(row) + 0.5;
+        let mut targets = vec![0.0; width * ch];
+        let mut class = vec![Class::Empty; width];
+        for x in 0..width {
+            let xc = x as f64 + 0.5;
+            let r = resolve(
+                frags.pixel(x),
+                frags.side,
+                ch,
+                |f| self.list[f.owner as usize].key(xc, yc),
+                |f| -> io::Result<Vector> {
+                    let n = f64::from(f.mask.count_ones());
+                    if self.per_pixel() {
+                        Ok(self
+                            .scene
+                            .phong(&self.list[f.owner as usize], f.at[0] / n, f.at[1] / n)
+                            .map_err(scene_io)?
+                            .unwrap_or_default())
+                    } else {
+                        Ok(cwisim_scene::vector(ch, |c| f.sum[c] / n))
+                    }
+                },
+            )?;
+            targets[x * ch..(x + 1) * ch].copy_from_slice(&r.value[..ch]);
+            class[x] = match r.interior {
+                _ if r.empty => Class::Empty,
+                Some(k) => Class::Interior(k),
+                None => Class::Mixed,
+            };
+        }
+        let rule = EmitRule {
+            merge: true,
+            tolerance: self.per_pixel().then_some(self.shade_tolerance),
+            channels: ch,
+        };
+        let mut counts = EmitCounts::default();
+        send(&targets, &class, &rule, 1, list, &mut counts)?;
+        Ok(counts)
     }
 
     /// Runs the whole frame in scan order.
@@ -663,12 +820,43 @@ impl Scan<'_> {
             Rule::Paint => false,
         };
         let release = self.scene.texture_release();
+        let mut max_fragments = 0usize;
         for row in 0..height {
             let mut list = Vec::new();
             let mut counts = RowCounts::default();
             let cp_before = sweep.stats;
             let (mut active, mut aet) = (0u64, 0u64);
-            if self.one_sample() {
+            if self.abuffer {
+                let (first, _) = s.of_pixel(row);
+                line.frags.reset(self.scene.width as usize, l);
+                for o in 0..l {
+                    line.frags.sub = o;
+                    let j = first + o;
+                    let lc = self.fill_line(
+                        &mut sweep,
+                        j,
+                        s.subline_y(j),
+                        &mut line,
+                        &mut unset,
+                        None,
+                        &mut counts,
+                    );
+                    active = active.max(lc.active);
+                    aet = aet.max(lc.aet);
+                }
+                counts.fragments += line.frags.count as u64;
+                max_fragments = max_fragments.max(line.frags.count);
+                let c = self
+                    .resolve_row(&line.frags, row, &mut list)
+                    .map_err(|e| NonFinite::at_row(e, row))?;
+                counts.eval1 += c.edge_pixels + c.runs.eval1;
+                counts.eval2 += c.runs.eval2;
+                counts.eval3 += c.runs.eval3;
+                counts.fit_candidates += c.runs.candidates;
+                counts.instructions += c.instructions;
+                list.push(Instruction::refresh());
+                counts.instructions += 1;
+            } else if self.one_sample() && !self.transparent {
                 let y = f64::from(row) + 0.5;
                 let mut sent = RowCounts::default();
                 let lc = {
@@ -718,7 +906,7 @@ impl Scan<'_> {
                         self.fill_line(&mut sweep, j, y, &mut line, &mut unset, None, &mut counts);
                     active = active.max(lc.active);
                     aet = aet.max(lc.aet);
-                    self.subline_of(&line, y, sub)?;
+                    self.subline_of(&mut line, y, sub)?;
                     counts.visible_runs += Scan::count_visible(&line);
                 }
                 let refs: Vec<&Subline> = sublines.iter().collect();
@@ -761,25 +949,32 @@ impl Scan<'_> {
             .iter()
             .map(|p| p.cp.critical_points().len() as u64)
             .sum();
+        let frame = Counters::default()
+            .with("polygons", self.list.len() as u64)
+            .with(
+                "vertices",
+                self.list.iter().map(|p| p.cp.len() as u64).sum(),
+            )
+            .with("critical_points", critical)
+            .with("max_active_polygons", sweep.max_active)
+            .with("max_aet", sweep.max_aet)
+            .with("moveup_steps", sweep.stats.moveup_steps)
+            .with("aet_inserts", sweep.stats.inserts)
+            .with("aet_insert_scans", sweep.stats.insert_scans)
+            .with("aet_deletes", sweep.stats.deletes)
+            .with("cp_recomputes", sweep.stats.recomputes)
+            .with("cp_increments", sweep.stats.increments)
+            .with("buffer_bytes", self.buffer_bytes(max_fragments));
+        let frame = if self.transparent {
+            frame.with("max_layers", line.layers.max_len as u64)
+        } else {
+            frame
+        };
         Ok(SFrame {
             rows,
             row_counts,
             figures: serde_json::Value::from(figures),
-            frame: Counters::default()
-                .with("polygons", self.list.len() as u64)
-                .with(
-                    "vertices",
-                    self.list.iter().map(|p| p.cp.len() as u64).sum(),
-                )
-                .with("critical_points", critical)
-                .with("max_active_polygons", sweep.max_active)
-                .with("max_aet", sweep.max_aet)
-                .with("moveup_steps", sweep.stats.moveup_steps)
-                .with("aet_inserts", sweep.stats.inserts)
-                .with("aet_insert_scans", sweep.stats.insert_scans)
-                .with("aet_deletes", sweep.stats.deletes)
-                .with("cp_recomputes", sweep.stats.recomputes)
-                .with("cp_increments", sweep.stats.increments),
+            frame,
         })
     }
 }

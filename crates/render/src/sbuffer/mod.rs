@@ -21,7 +21,9 @@
 //! [`fill`] the scan engine (FILL's rules, a row's emission), both shared with `bsp`.
 //! `docs/RENDERERS.md` says how it reads the paper; `docs/ERRATA.md` what it corrects.
 
+mod abuffer;
 pub mod fill;
+mod layers;
 pub mod polys;
 pub mod sweep;
 
@@ -40,7 +42,10 @@ use polys::Polys;
 use std::time::Duration;
 
 /// The registry's one line about it.
-pub const ABOUT: &str = "Barkan & Gordon's S-buffer: critical-points scan conversion polygon by polygon into a host depth line per scanline (or sub-scanline, --samples), visible runs sent (--sbuffer host|overdraw, --cp-increment)";
+pub const ABOUT: &str = "Barkan & Gordon's S-buffer: critical-points scan conversion polygon by polygon into a host depth line per scanline (or sub-scanline, --samples), visible runs sent (--sbuffer host|overdraw|transparent, --cp-increment)";
+
+/// The widest A-buffer mask: 8 × 8 bits, one `u64`.
+pub const MAX_MASK_SIDE: u32 = 8;
 
 /// The S-buffer renderer of a scene.
 pub struct SBuffer {
@@ -78,6 +83,25 @@ impl SBuffer {
                 ));
             }
         }
+        if settings.sbuffer == SbufferMode::Abuffer {
+            if !(1..=MAX_MASK_SIDE).contains(&sampler.l) {
+                return Err(RenderError::Usage(format!(
+                    "--sbuffer abuffer keeps a --samples × --samples coverage mask in 64 bits: use --samples 1 to {MAX_MASK_SIDE}, found {}",
+                    sampler.l
+                )));
+            }
+            if sampler.grid != Grid::Centre {
+                return Err(RenderError::Usage(
+                    "--sbuffer abuffer's mask bits are the centres of a pixel's l × l cells: use --grid centre".into(),
+                ));
+            }
+        }
+        if settings.sbuffer == SbufferMode::Transparent && !polys.transparent() {
+            return Err(RenderError::Usage(format!(
+                "--sbuffer transparent composites the polygons of transparent meshes, and {} has none (no material with a transmittance above 0): use --sbuffer host",
+                polys.source.name()
+            )));
+        }
         Ok(SBuffer {
             polys,
             sampler,
@@ -112,6 +136,8 @@ impl SBuffer {
             increment: self.increment,
             rule: Rule::Nearer,
             overdraw: self.mode == SbufferMode::Overdraw,
+            transparent: self.mode == SbufferMode::Transparent,
+            abuffer: self.mode == SbufferMode::Abuffer,
             merge: self.merge,
             shade_tolerance: self.shade_tolerance,
         }
@@ -146,7 +172,13 @@ impl Renderer for SBuffer {
         } else {
             String::new()
         };
-        let sampling = if self.scan().one_sample() {
+        let sampling = if self.mode == SbufferMode::Abuffer {
+            format!(
+                "{l}×{l} coverage mask per pixel ({} bits), fragments resolved per pixel by the host",
+                s.l * s.l,
+                l = s.l
+            )
+        } else if self.scan().one_sample() {
             "one sample per pixel (its centre)".to_string()
         } else {
             format!(
@@ -168,6 +200,10 @@ impl Renderer for SBuffer {
                 SbufferMode::Host => "visible runs sent (depth on the host)",
                 SbufferMode::Overdraw =>
                     "every run sent as set, overwrites undone (overdraw study)",
+                SbufferMode::Transparent =>
+                    "per sample a list of the transparent polygons down to the nearest opaque one, composited (§5.2)",
+                SbufferMode::Abuffer =>
+                    "the scanline A-buffer: per pixel a fragment per polygon (coverage mask, colour), resolved nearest first at the pixel centre (§5.2)",
             }
         )
     }
@@ -175,6 +211,12 @@ impl Renderer for SBuffer {
     fn summary_rows(&self, c: &Counters, _stats: &RunStats) -> Vec<(&'static str, String)> {
         let mut rows = self.polys.summary_rows();
         rows.extend(cp_rows(c));
+        if self.mode != SbufferMode::Transparent && self.polys.transparent() {
+            rows.push((
+                "note",
+                "meshes with a transmittance drawn opaque: this mode keeps the nearest surface (--sbuffer transparent composites the layers)".to_string(),
+            ));
+        }
         rows
     }
 

@@ -37,6 +37,8 @@ pub struct Poly {
     pub plane: [f64; 3],
     /// The screen polygon or world triangle it comes from.
     pub source: u32,
+    /// Its material's transmittance (0 opaque; screen polygons are opaque).
+    pub transmittance: f64,
 }
 
 impl Poly {
@@ -155,6 +157,7 @@ impl Polys {
                         intensity,
                         plane,
                         source: k as u32,
+                        transmittance: 0.0,
                     });
                 }
                 (s.width, s.height, s.channels)
@@ -179,6 +182,7 @@ impl Polys {
                         intensity,
                         plane,
                         source: k as u32,
+                        transmittance: w.spec.meshes[t.mesh as usize].material.transmittance,
                     });
                 }
                 project = Some(stats);
@@ -238,6 +242,11 @@ impl Polys {
     /// Whether a mesh is textured.
     pub fn textured(&self) -> bool {
         self.textured
+    }
+
+    /// Whether some polygon lets light through (a material's transmittance above 0).
+    pub fn transparent(&self) -> bool {
+        self.polys.iter().any(|p| p.transmittance > 0.0)
     }
 
     /// With Phong shading (or textures): the lit colour of polygon `p` at `(x, y)` (negative terms

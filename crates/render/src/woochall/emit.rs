@@ -33,7 +33,7 @@ pub struct Subline {
 
 /// What a pixel holds after accumulation.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Class {
+pub(crate) enum Class {
     /// No sample hit geometry.
     Empty,
     /// Every sample is the triangle's.
@@ -150,7 +150,7 @@ fn accumulate(
 }
 
 /// Sends one pass: runs of interior pixels through the fitter, edge pixels as `Eval1`.
-fn send(
+pub(crate) fn send(
     targets: &[f64],
     class: &[Class],
     rule: &EmitRule,

@@ -35,7 +35,8 @@ pub struct ListStats {
 
 /// The layers behind a transparent winner, per sample: for each such sample column, the
 /// triangles behind the front one, nearest first, down to the first opaque one (or all
-/// that cover it, when none is).
+/// that cover it, when none is: the background ends the list). Every sample whose
+/// winner is transparent has an entry, with no layer when nothing lies behind.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Layers {
     /// `(column, start, end)`: the sample's layers are `tris[start..end]`; in column order.
@@ -239,10 +240,10 @@ impl Lists<'_> {
                 break;
             }
         }
+        // an entry even with no layer behind: a transparent front over the background
+        // (opaque at z = ∞, colour 0) lets `1 − t` of its colour through, no more
         let end = layers.tris.len() as u32;
-        if end > start {
-            layers.entries.push((k, start, end));
-        }
+        layers.entries.push((k, start, end));
     }
 }
 
