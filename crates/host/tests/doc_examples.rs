@@ -192,6 +192,8 @@ const LONG: &[&str] = &[
     "docs/REPRODUCTION.md: refine pot --sweep",
     // a session of four refinements of the pot: 0.3 s release
     "docs/REPRODUCTION.md: refine pot --events",
+    // the teapot's vertex phase in ten frames, then flat: 1 s release
+    "docs/REPRODUCTION.md: refine teapot --phases vertices,flat --vertex-fraction 0.1",
     // 50–200 s debug, 9–14 s release
     "docs/STUDYING.md: inspect pot -o pot.html",
     "docs/STUDYING.md: inspect pot --size 1024x1024",

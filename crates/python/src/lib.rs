@@ -926,6 +926,7 @@ fn refine<'py>(
             changes: &[],
             settings,
             phases,
+            vertex_parts: 1,
             machine: array.machine,
             naive: true,
             cost_maps: false,

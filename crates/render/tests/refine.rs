@@ -938,3 +938,56 @@ fn kept_pixels_are_the_previous_frames_in_a_narrow_fixed_format_too() {
         );
     }
 }
+
+/// `--vertex-fraction 1/N`: the vertex phase in N frames, each adding every N-th vertex;
+/// the last is the unsplit phase's frame bit for bit, each frame lights what the one
+/// before lit, and the first draws a tenth of the points, spread over the model.
+#[test]
+fn the_vertex_phase_a_fraction_at_a_time_ends_at_the_whole_one() {
+    let settings = Settings::default();
+    let phases = [Phase::Vertices, Phase::Flat];
+    let whole = Refine::with_phases(scene("teapot", 160), &settings, &phases).unwrap();
+    let split = Refine::with_vertex_parts(scene("teapot", 160), &settings, &phases, 10).unwrap();
+    assert_eq!(whole.frames(), 2);
+    assert_eq!(split.frames(), 11);
+    let (a, b) = (run(&whole, 1), run(&split, 2));
+    // the last vertex frame and the flat frame are the unsplit run's
+    assert_eq!(b.frames[9], a.frames[0]);
+    assert_eq!(b.frames[10], a.frames[1]);
+    assert_eq!(b.streams[9], a.streams[0]);
+    // each frame lights every pixel the one before lit (the nearest point wins a pixel,
+    // so a lit pixel may brighten, never go dark)
+    for k in 1..10 {
+        for (p, q) in b.frames[k - 1].iter().zip(&b.frames[k]) {
+            assert!(*q >= *p, "frame {k}");
+        }
+    }
+    let drawn = |k: usize| b.counters.get(split.frame_counter(k, "drawn")).unwrap();
+    let all = a.counters.get("vertices_drawn").unwrap();
+    assert_eq!(drawn(9), all);
+    assert_eq!(drawn(0), all.div_ceil(10));
+    for k in 1..10 {
+        assert!(drawn(k) > drawn(k - 1));
+    }
+    assert_eq!(split.frame_name(0), "vertices-1");
+    assert_eq!(split.frame_name(9), "vertices");
+    assert_eq!(split.frame_name(10), "flat");
+    // the first tenth is spread: points in every quarter of the model's width
+    let lit: Vec<usize> = (0..160 * 160).filter(|&i| b.frames[0][i] > 0.0).collect();
+    let (x0, x1) = lit.iter().fold((usize::MAX, 0), |(a, c), &i| {
+        (a.min(i % 160), c.max(i % 160))
+    });
+    for q in 0..4 {
+        let (from, to) = (x0 + q * (x1 - x0) / 4, x0 + (q + 1) * (x1 - x0) / 4);
+        assert!(
+            lit.iter().any(|&i| (from..=to).contains(&(i % 160))),
+            "quarter {q}"
+        );
+    }
+    // refusals
+    assert!(cwisim_render::refine::vertex_parts(0.3).is_err());
+    assert!(cwisim_render::refine::vertex_parts(0.01).is_err());
+    assert_eq!(cwisim_render::refine::vertex_parts(0.1), Ok(10));
+    assert_eq!(cwisim_render::refine::vertex_parts(1.0), Ok(1));
+    assert!(Refine::with_vertex_parts(scene("teapot", 64), &settings, &[Phase::Flat], 4).is_err());
+}

@@ -111,6 +111,8 @@ pub struct RefineSetup<'a> {
     pub settings: Settings,
     /// The phases, in order.
     pub phases: Vec<Phase>,
+    /// Frames the vertex phase is split into (`--vertex-fraction`; 1: one frame).
+    pub vertex_parts: u32,
     /// The machine model.
     pub machine: Machine,
     /// Also measure the naive sequence.
@@ -231,7 +233,7 @@ fn pass(
         ..*settings
     };
     let loaded = load(setup.scene, setup.changes, settings)?;
-    let refine = Refine::with_phases(loaded, settings, &setup.phases)?;
+    let refine = Refine::with_vertex_parts(loaded, settings, &setup.phases, setup.vertex_parts)?;
     let h = refine.header();
     let (w, lines, ch) = (h.width as usize, h.lines as usize, h.channel_count());
     // every frame's image is kept (8 bytes a value), with the cost maps' counts (8 bytes
@@ -309,7 +311,7 @@ fn rows(p: &Pass, reference: &[f64]) -> Vec<PhaseRow> {
         .phases()
         .iter()
         .enumerate()
-        .map(|(k, &phase)| {
+        .map(|(k, _)| {
             let lines = p.stats.lines.iter().filter(|l| l.frame == k as u64);
             let (busy, worst, late, shown) = lines.fold((0, 0, 0, 0), |(b, w, n, s), l| {
                 (
@@ -322,10 +324,10 @@ fn rows(p: &Pass, reference: &[f64]) -> Vec<PhaseRow> {
             cumulative += busy;
             let (_, rms, psnr) = errors(&p.frames[k].data, reference);
             PhaseRow {
-                phase: phase.name(),
-                pixels: get(phase.counter("pixels")),
-                instructions: get(phase.counter("instructions")),
-                regenerated: get(phase.counter("regenerated")),
+                phase: p.refine.frame_name(k),
+                pixels: get(p.refine.frame_counter(k, "pixels")),
+                instructions: get(p.refine.frame_counter(k, "instructions")),
+                regenerated: get(p.refine.frame_counter(k, "regenerated")),
                 busy_cycles: busy,
                 cumulative_cycles: cumulative,
                 worst_line_cycles: worst,

@@ -18,6 +18,7 @@ fn setup<'a>(scene: &'a Path, settings: Settings) -> RefineSetup<'a> {
         changes: &[],
         settings,
         phases: WORLD_PHASES.to_vec(),
+        vertex_parts: 1,
         machine: Machine::default(),
         naive: false,
         cost_maps: false,

@@ -11,7 +11,7 @@ use crate::output::{write_png, write_rgb_png};
 use crate::progress::Progress;
 use clap::Args;
 use cwisim_isa::{Instruction, TraceWrite};
-use cwisim_render::refine::{parse_phases, Phase};
+use cwisim_render::refine::{parse_phases, vertex_parts, Phase};
 use cwisim_render::settings::{
     Threshold, DEFAULT_AA_THRESHOLD, DEFAULT_GOURAUD_THRESHOLD, DEFAULT_PHONG_ANGLE,
 };
@@ -38,6 +38,11 @@ pub struct RefineArgs {
     /// refining it. The shadow phase runs after flat whenever a light casts shadows.
     #[arg(long, value_name = "LIST", default_value = "flat,gouraud,phong,aa")]
     pub phases: String,
+    /// The vertex phase a fraction of the vertices at a time: 1/N splits it into N frames,
+    /// each adding every N-th vertex of the model (0.1: ten frames, the paper's "10% of
+    /// vertices" first, all of them last); 1 draws them all in one frame.
+    #[arg(long, value_name = "F", default_value_t = 1.0)]
+    pub vertex_fraction: f64,
     /// The Gouraud phase shades a polygon whose vertex-intensity range exceeds T; `all`
     /// or `none`.
     #[arg(long, value_name = "T", default_value_t = Threshold::Above(DEFAULT_GOURAUD_THRESHOLD))]
@@ -231,10 +236,16 @@ pub fn run(args: &RefineArgs, stdout: &mut dyn Write, progress: bool) -> Result<
     for (_, s) in &runs {
         s.check().map_err(CliError::Usage)?;
     }
+    let vertex_parts = vertex_parts(args.vertex_fraction).map_err(CliError::Usage)?;
+    if vertex_parts > 1 && !phases.contains(&Phase::Vertices) {
+        return Err(CliError::Usage(format!(
+            "--vertex-fraction {} splits the vertex phase: list `vertices` in --phases",
+            args.vertex_fraction
+        )));
+    }
     if let Some(path) = &args.events {
-        return session(
-            args, path, settings, &phases, machine, plot, stdout, progress,
-        );
+        let parts = (phases, vertex_parts);
+        return session(args, path, settings, parts, machine, plot, stdout, progress);
     }
     let setups: Vec<RefineSetup> = runs
         .iter()
@@ -244,6 +255,7 @@ pub fn run(args: &RefineArgs, stdout: &mut dyn Write, progress: bool) -> Result<
             changes: &[],
             settings: *s,
             phases: phases.clone(),
+            vertex_parts,
             machine: machine.clone(),
             naive: k == 0,
             cost_maps: args.cost_image_dir.is_some(),
@@ -369,7 +381,7 @@ fn session(
     args: &RefineArgs,
     path: &Path,
     settings: Settings,
-    phases: &[Phase],
+    (phases, vertex_parts): (Vec<Phase>, u32),
     machine: cwisim_xproc::Machine,
     plot: Option<PathBuf>,
     stdout: &mut dyn Write,
@@ -389,7 +401,8 @@ fn session(
         scene: args.scene.as_deref(),
         changes: &[],
         settings,
-        phases: phases.to_vec(),
+        phases,
+        vertex_parts,
         machine,
         naive: false,
         cost_maps: false,

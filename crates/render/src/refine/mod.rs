@@ -167,6 +167,45 @@ impl Phase {
     }
 }
 
+/// The most frames the vertex phase may be split into (`--vertex-fraction` 1/20).
+pub const MAX_VERTEX_PARTS: u32 = 20;
+
+macro_rules! vertex_part_names {
+    ($($k:literal)*) => {
+        /// The frame names and counter names (instructions, regenerated, pixels, points)
+        /// of the vertex phase's first frames when it is split: `vertices-K`.
+        const VERTEX_PARTS: [(&str, [&str; 4]); MAX_VERTEX_PARTS as usize - 1] = [$(
+            (
+                concat!("vertices-", $k),
+                [
+                    concat!("vertices_", $k, "_instructions"),
+                    concat!("vertices_", $k, "_regenerated"),
+                    concat!("vertices_", $k, "_pixels"),
+                    concat!("vertices_", $k, "_drawn"),
+                ],
+            ),
+        )*];
+    };
+}
+vertex_part_names!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19);
+
+/// `--vertex-fraction F`: how many frames the vertex phase is split into, `1/F`, each
+/// adding a fraction `F` of the vertices (`F` must be `1/N`, `N` from 1 to
+/// [`MAX_VERTEX_PARTS`]).
+pub fn vertex_parts(fraction: f64) -> Result<u32, String> {
+    let n = (1.0 / fraction).round();
+    let admitted = fraction > 0.0
+        && fraction <= 1.0
+        && (1.0..=f64::from(MAX_VERTEX_PARTS)).contains(&n)
+        && (n * fraction - 1.0).abs() <= 1e-9;
+    if !admitted {
+        return Err(format!(
+            "--vertex-fraction {fraction}: expected 1/N for N from 1 to {MAX_VERTEX_PARTS} (0.1: ten frames, each adding a tenth of the vertices; 1: all at once)"
+        ));
+    }
+    Ok(n as u32)
+}
+
 /// The phases of a world scene, in order.
 pub const WORLD_PHASES: [Phase; 4] = [Phase::Flat, Phase::Gouraud, Phase::Phong, Phase::Antialias];
 
@@ -236,6 +275,8 @@ pub struct Refine {
     phong_angle: Threshold,
     aa_threshold: Threshold,
     shade_tolerance: f64,
+    /// Frames the vertex phase is split into (1: all the vertices in one frame).
+    vertex_parts: u32,
 }
 
 impl Refine {
@@ -251,6 +292,30 @@ impl Refine {
         settings: &Settings,
         phases: &[Phase],
     ) -> Result<Refine, RenderError> {
+        Refine::with_vertex_parts(loaded, settings, phases, 1)
+    }
+
+    /// [`Refine::with_phases`], the vertex phase (when `phases` has it) split into
+    /// `parts` frames ([`vertex_parts`]): frame `j` of them draws the vertices whose index
+    /// in the model's order of distinct corners is `j` or less modulo `parts`, so the first
+    /// draws every `parts`-th vertex, spread over the whole model (the paper's Figure 5, a
+    /// sparse sketch of all of it), and the last all of them (Figure 6).
+    pub fn with_vertex_parts(
+        loaded: LoadedScene,
+        settings: &Settings,
+        phases: &[Phase],
+        parts: u32,
+    ) -> Result<Refine, RenderError> {
+        if !(1..=MAX_VERTEX_PARTS).contains(&parts) {
+            return Err(RenderError::Usage(format!(
+                "the vertex phase is split into 1 to {MAX_VERTEX_PARTS} frames, not {parts}"
+            )));
+        }
+        if parts > 1 && !phases.contains(&Phase::Vertices) {
+            return Err(RenderError::Usage(
+                "--vertex-fraction splits the vertex phase: list `vertices` in --phases".into(),
+            ));
+        }
         let loaded = loaded.drawn_as(settings)?;
         if settings.shading != Shading::Gouraud {
             return Err(RenderError::Usage(format!(
@@ -296,7 +361,14 @@ impl Refine {
                 "--phases shadows: no light of the scene casts shadows (give one \"shadows\": true, or render with --shadows on)".into(),
             ));
         }
+        // the vertex phase's frames: `parts` of them
+        if let Some(at) = checked.iter().position(|&p| p == Phase::Vertices) {
+            for _ in 1..parts {
+                checked.insert(at, Phase::Vertices);
+            }
+        }
         let mut refine = Refine {
+            vertex_parts: if world { parts } else { 1 },
             phases: if world { checked } else { vec![Phase::Whole] },
             plans: Vec::new(),
             modes: vec![Mode::Flat; n],
@@ -348,6 +420,7 @@ impl Refine {
         };
         let mut modes = vec![first; n];
         let mut plans = Vec::new();
+        let mut vertex_frame = 0;
         for &phase in &self.phases {
             let next: Vec<Mode> = (0..n)
                 .map(|k| {
@@ -394,7 +467,16 @@ impl Refine {
             let triangles = scene.phong.as_ref().map_or(&[][..], |s| &s.triangles[..]);
             plans.push(match phase {
                 Phase::Whole => Plan::Whole,
-                Phase::Vertices => Plan::Sketch(Box::new(Sketch::points(triangles, w, h))),
+                Phase::Vertices => {
+                    vertex_frame += 1;
+                    Plan::Sketch(Box::new(Sketch::points_part(
+                        triangles,
+                        w,
+                        h,
+                        vertex_frame,
+                        self.vertex_parts,
+                    )))
+                }
                 Phase::Edges => Plan::Sketch(Box::new(Sketch::edges(triangles, w, h))),
                 Phase::Antialias => Plan::Antialias {
                     list: Box::new(Subset::of(scene, &next, |_| true)),
@@ -427,6 +509,42 @@ impl Refine {
     /// Its frames, in order.
     pub fn phases(&self) -> &[Phase] {
         &self.phases
+    }
+
+    /// The vertex phase's frames before its last (0 when it is one frame, or absent).
+    fn vertex_parts_before(&self, k: usize) -> Option<usize> {
+        let first = self.phases.iter().position(|&p| p == Phase::Vertices)?;
+        let j = k.checked_sub(first)?;
+        (j + 1 < self.vertex_parts as usize).then_some(j)
+    }
+
+    /// Frame `k`'s name: its phase's, or `vertices-J` for the `J`-th of a split vertex
+    /// phase's frames but the last (which is `vertices`).
+    pub fn frame_name(&self, k: usize) -> &'static str {
+        match self.vertex_parts_before(k) {
+            Some(j) => VERTEX_PARTS[j].0,
+            None => self.phases.get(k).map_or("frame", |p| p.name()),
+        }
+    }
+
+    /// Frame `k`'s counter `what` (as [`Phase::counter`]; a split vertex phase's frames
+    /// have their own, `vertices_J_instructions`, …).
+    pub fn frame_counter(&self, k: usize, what: &str) -> &'static str {
+        match self.vertex_parts_before(k) {
+            Some(j) => {
+                let col = match what {
+                    "instructions" => 0,
+                    "regenerated" => 1,
+                    "pixels" => 2,
+                    _ => 3,
+                };
+                VERTEX_PARTS[j].1[col]
+            }
+            None => self
+                .phases
+                .get(k)
+                .map_or("instructions", |p| p.counter(what)),
+        }
     }
 
     /// The polygons the Gouraud phase Gouraud-shades.
@@ -510,7 +628,7 @@ impl Renderer for Refine {
                 sketch,
                 channels: self.header().channel_count(),
                 names: ["instructions", "regenerated", "pixels", "polygons"]
-                    .map(|what| phase.counter(what)),
+                    .map(|what| self.frame_counter(k, what)),
             }),
             Plan::Whole => Box::new(Whole {
                 plan: ScanPlan::new(&self.scene.screen, &BOX),
@@ -581,8 +699,12 @@ impl Renderer for Refine {
     }
 
     fn summary_rows(&self, counters: &Counters, stats: &RunStats) -> Vec<(&'static str, String)> {
-        const LABELS: [&str; 7] = [
-            "phase 1", "phase 2", "phase 3", "phase 4", "phase 5", "phase 6", "phase 7",
+        const LABELS: [&str; 30] = [
+            "phase 1", "phase 2", "phase 3", "phase 4", "phase 5", "phase 6", "phase 7", "phase 8",
+            "phase 9", "phase 10", "phase 11", "phase 12", "phase 13", "phase 14", "phase 15",
+            "phase 16", "phase 17", "phase 18", "phase 19", "phase 20", "phase 21", "phase 22",
+            "phase 23", "phase 24", "phase 25", "phase 26", "phase 27", "phase 28", "phase 29",
+            "phase 30",
         ];
         let mut rows = self.scene.summary_rows();
         if self.phases == [Phase::Whole] {
@@ -598,9 +720,10 @@ impl Renderer for Refine {
             });
             let what = match phase {
                 Phase::Vertices => format!(
-                    "vertices: {} depth-cued points, {} pixels",
-                    get("vertices_drawn"),
-                    get("vertices_pixels")
+                    "{}: {} depth-cued points, {} pixels",
+                    self.frame_name(k),
+                    get(self.frame_counter(k, "drawn")),
+                    get(self.frame_counter(k, "pixels"))
                 ),
                 Phase::Edges => format!(
                     "edges: {} depth-cued lines, {} pixels",
@@ -638,8 +761,8 @@ impl Renderer for Refine {
                 LABELS[k.min(LABELS.len() - 1)],
                 format!(
                     "{what}; {} instructions ({} regenerated), {busy} busy cycles (worst scanline {worst} of the line period {})",
-                    get(phase.counter("instructions")),
-                    get(phase.counter("regenerated")),
+                    get(self.frame_counter(k, "instructions")),
+                    get(self.frame_counter(k, "regenerated")),
                     stats.line_period
                 ),
             ));

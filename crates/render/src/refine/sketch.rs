@@ -81,14 +81,32 @@ impl Sketch {
 
     /// The distinct corners of `tris` as depth-cued points in a `width × height` image.
     pub fn points(tris: &[ScreenTriangle], width: u32, height: u32) -> Sketch {
+        Sketch::points_part(tris, width, height, 1, 1)
+    }
+
+    /// Part `part` (from 1) of `parts` of the distinct corners of `tris`, as depth-cued
+    /// points: those whose index among the distinct corners (in the triangles' order) is
+    /// below `part` modulo `parts` — every `parts`-th corner in the first part, spread over
+    /// the whole model, and all of them in the last.
+    pub fn points_part(
+        tris: &[ScreenTriangle],
+        width: u32,
+        height: u32,
+        part: u32,
+        parts: u32,
+    ) -> Sketch {
         let range = depth_range(tris);
         let mut s = Sketch::new(height);
         let mut seen = BTreeSet::new();
+        let mut index = 0u64;
         for t in tris {
             for k in 0..3 {
                 if seen.insert(key(t.points[k])) {
-                    s.elements += 1;
-                    s.plot(t.points[k], width, depth_cue(1.0 / t.inv_depth[k], range));
+                    if index % u64::from(parts.max(1)) < u64::from(part) {
+                        s.elements += 1;
+                        s.plot(t.points[k], width, depth_cue(1.0 / t.inv_depth[k], range));
+                    }
+                    index += 1;
                 }
             }
         }
