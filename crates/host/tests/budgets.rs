@@ -389,3 +389,55 @@ fn the_memory_budget_holds_tradeoff_fit_refine_and_inspect() {
         assert_eq!(out.status.code(), Some(0), "{command}: {:?}", text(&out));
     }
 }
+
+/// A scene (or an event script) read from a FIFO, whose size is not known before it is
+/// read, is read up to the memory budget and refused past it, not held whole.
+#[test]
+fn a_stream_past_the_budget_is_refused_as_it_is_read() {
+    use std::io::Write;
+    let dir = scratch("budget-fifo");
+    let fifo = dir.join("scene.json");
+    let made = Command::new("mkfifo").arg(&fifo).status().expect("mkfifo");
+    assert!(made.success());
+    let writer = {
+        let fifo = fifo.clone();
+        std::thread::spawn(move || {
+            let mut f = std::fs::File::options()
+                .write(true)
+                .open(&fifo)
+                .expect("open the FIFO");
+            // 1 MB of spaces: the reader stops at its 64 KB budget and closes
+            let chunk = [b' '; 4096];
+            for _ in 0..256 {
+                if f.write_all(&chunk).is_err() {
+                    break;
+                }
+            }
+        })
+    };
+    let out = cwisim_env(
+        &dir,
+        &[("CWISIM_MAX_MEMORY", "64K")],
+        &["render", "scene.json", "-o", "x.png"],
+    );
+    writer.join().expect("writer");
+    refused(&out, "reading the scene file");
+    assert!(!dir.join("x.png").exists());
+}
+
+/// `refine --events`: the session's runs keep their frames, checked against the budget
+/// once the first run's size is known, before the others are drawn.
+#[test]
+fn a_session_past_the_budget_is_refused_before_its_later_runs() {
+    let dir = scratch("budget-session");
+    let script = common::repo().join("crates/study/fixtures/pot-session.json");
+    let script = script.to_str().unwrap();
+    let args = [
+        "refine", "pot", "--size", "200x200", "--events", script, "--plot", "s.png",
+    ];
+    let out = cwisim_env(&dir, &[("CWISIM_MAX_MEMORY", "2M")], &args);
+    refused(&out, "a session of 4 refinements, each keeping its frames");
+    assert!(!dir.join("s.png").exists());
+    let out = cwisim_env(&dir, &[("CWISIM_MAX_MEMORY", "64M")], &args);
+    assert!(out.status.success(), "{:?}", text(&out));
+}

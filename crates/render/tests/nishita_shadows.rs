@@ -4,11 +4,13 @@
 //! then by the camera), box-filtered by clipping to each pixel here; and the renderer's
 //! answers around it (threads, a light too wide for one view, `--shadows`).
 
+#[allow(dead_code)] // the world reader and one renderer's image are used here
+mod common;
+
 use cwisim_render::nishita::Nishita;
-use cwisim_render::{registry, render, ArrayConfig, LoadedScene, Settings, Taps};
+use cwisim_render::{LoadedScene, Settings};
 use cwisim_world::camera::Camera;
-use cwisim_world::{parse_any, AnyScene, WorldScene};
-use cwisim_xproc::ImageSink;
+use cwisim_world::{AnyScene, WorldScene};
 use glam::DVec3;
 
 type Pt = [f64; 2];
@@ -57,10 +59,7 @@ fn scene(light: [f64; 3]) -> WorldScene {
 ]}}"#,
         light[0], light[1], light[2]
     );
-    match parse_any(&text, None).unwrap() {
-        AnyScene::World(w) => w,
-        AnyScene::Screen(_) => unreachable!("a world scene"),
-    }
+    common::world(&text, None)
 }
 
 /// The part of polygon `poly` inside the convex polygon `clip` (counter-clockwise or
@@ -223,17 +222,7 @@ fn shadows_on_patches_are_byte_identical_at_any_thread_count() {
             ..Settings::default()
         };
         let loaded = LoadedScene::built("flat", AnyScene::World(w.clone()));
-        let r = (registry::find("nishita").unwrap().build)(loaded, &settings).unwrap();
-        let mut sink = ImageSink::new(64, 1, 1 << 30);
-        render(
-            &*r,
-            &ArrayConfig::default(),
-            threads,
-            &mut sink,
-            Taps::default(),
-        )
-        .unwrap();
-        sink.finish().unwrap().data
+        common::drawn_on("nishita", loaded, &settings, threads).0
     };
     let one = image(1);
     assert_eq!(one, image(2));
@@ -243,11 +232,7 @@ fn shadows_on_patches_are_byte_identical_at_any_thread_count() {
         shadows: Some(false),
         ..Settings::default()
     };
-    let loaded = LoadedScene::built("flat", AnyScene::World(w.clone()));
-    let r = (registry::find("nishita").unwrap().build)(loaded, &settings).unwrap();
-    let mut sink = ImageSink::new(64, 1, 1 << 30);
-    render(&*r, &ArrayConfig::default(), 1, &mut sink, Taps::default()).unwrap();
-    let off = sink.finish().unwrap().data;
+    let off = common::rendered_by("nishita", &w, &settings);
     let darker = one.iter().zip(&off).filter(|(a, b)| *a + 0.1 < **b).count();
     assert!(darker > 30, "{darker} pixels in shadow");
 }

@@ -4,12 +4,14 @@
 //! supersampling where no two polygons share a pixel's samples (the two are then the
 //! same mean of the same samples); and its refusals.
 
+#[allow(dead_code)] // one renderer's image is used here
+mod common;
+
 use cwisim_render::settings::SbufferMode;
 use cwisim_render::subsample::Grid;
-use cwisim_render::{registry, render, ArrayConfig, Counters, LoadedScene, Settings, Size, Source};
+use cwisim_render::{registry, Counters, LoadedScene, Settings, Size, Source};
 use cwisim_scene::Shading;
 use cwisim_world::Visibility;
-use cwisim_xproc::ImageSink;
 
 fn abuffer(samples: u32) -> Settings {
     Settings {
@@ -31,18 +33,7 @@ fn draw(name: &str, scene: &str, s: &Settings) -> (Vec<f64>, Counters) {
 }
 
 fn draw_on(name: &str, scene: &str, s: &Settings, threads: usize) -> (Vec<f64>, Counters) {
-    let r = (registry::find(name).unwrap().build)(loaded(scene, s), s).unwrap();
-    let h = r.header();
-    let mut sink = ImageSink::new(h.width as usize, h.channel_count(), 1 << 30);
-    let done = render(
-        &*r,
-        &ArrayConfig::default(),
-        threads,
-        &mut sink,
-        Default::default(),
-    )
-    .unwrap();
-    (sink.finish().unwrap().data, done.counters)
+    common::drawn_on(name, loaded(scene, s), s, threads)
 }
 
 fn mean_error(a: &[f64], b: &[f64]) -> f64 {

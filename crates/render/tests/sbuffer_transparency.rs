@@ -3,15 +3,14 @@
 //! compositing at the same samples (within 1e-9), and at one sample against a ray cast
 //! written here that composites the layers it hits front to back.
 
-#[allow(dead_code)] // the ray caster alone is used here
+#[allow(dead_code)] // the ray caster and one renderer's image are used here
 mod common;
 
 use common::raycast::{hits, ray};
 use cwisim_render::settings::SbufferMode;
-use cwisim_render::{registry, render, ArrayConfig, LoadedScene, Settings, Size, Source};
+use cwisim_render::{registry, LoadedScene, Settings, Size, Source};
 use cwisim_scene::Shading;
 use cwisim_world::{parse_any, AnyScene, WorldScene};
-use cwisim_xproc::ImageSink;
 use glam::DVec3;
 use rand_core::{Rng, SeedableRng};
 use rand_xorshift::XorShiftRng;
@@ -35,18 +34,7 @@ fn woo(s: &Settings) -> Settings {
 }
 
 fn image(name: &str, loaded: LoadedScene, s: &Settings, threads: usize) -> Vec<f64> {
-    let r = (registry::find(name).unwrap().build)(loaded, s).unwrap();
-    let h = r.header();
-    let mut sink = ImageSink::new(h.width as usize, h.channel_count(), 1 << 30);
-    render(
-        &*r,
-        &ArrayConfig::default(),
-        threads,
-        &mut sink,
-        Default::default(),
-    )
-    .unwrap();
-    sink.finish().unwrap().data
+    common::drawn_on(name, loaded, s, threads).0
 }
 
 fn embedded(name: &str, s: &Settings) -> LoadedScene {

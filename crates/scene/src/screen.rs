@@ -219,18 +219,31 @@ pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
 /// A scene file's text; a file that cannot be read is an [`SceneErrorKind::Io`] error
 /// naming it (what every reader of scene files starts with), invalid UTF-8 is located by
 /// byte, line and column, and a file larger than the memory budget
-/// ([`crate::budget::Budget`]) is refused before it is read.
+/// ([`crate::budget::Budget`]) is refused before it is read. A stream whose size is not
+/// known (a FIFO, a device) is read up to the budget and refused past it.
 pub fn read_scene_text(path: &Path) -> Result<String, SceneError> {
+    use std::io::Read;
     let fail =
         |message: String| SceneError::at_field(SceneErrorKind::Io, "", message).in_file(path);
     // the file's size against the memory budget before it is read whole
     let size = std::fs::metadata(path)
         .map_err(|e| fail(format!("cannot read the scene: {e}")))?
         .len();
-    crate::budget::Budget::current()
-        .check_memory("reading the scene file", size)
+    let budget = crate::budget::Budget::current();
+    let what = "reading the scene file";
+    budget
+        .check_memory(what, size)
         .map_err(|e| fail(e.to_string()))?;
-    let bytes = std::fs::read(path).map_err(|e| fail(format!("cannot read the scene: {e}")))?;
+    let mut bytes = Vec::with_capacity(size as usize);
+    std::fs::File::open(path)
+        .and_then(|f| {
+            f.take(budget.memory_bytes.saturating_add(1))
+                .read_to_end(&mut bytes)
+        })
+        .map_err(|e| fail(format!("cannot read the scene: {e}")))?;
+    budget
+        .check_memory(what, bytes.len() as u64)
+        .map_err(|e| fail(e.to_string()))?;
     String::from_utf8(bytes).map_err(|e| {
         let at = e.utf8_error().valid_up_to();
         let text = &e.as_bytes()[..at];

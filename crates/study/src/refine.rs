@@ -13,7 +13,7 @@ use cwisim_isa::{Instruction, Opcode, TraceWrite};
 use cwisim_render::refine::{Phase, Refine};
 use cwisim_render::settings::Threshold;
 use cwisim_render::vanrij::VanRij;
-use cwisim_render::{render, ArrayConfig, Renderer, Settings, Source, Taps};
+use cwisim_render::{render, ArrayConfig, RenderError, Renderer, Settings, Source, Taps};
 use cwisim_scene::Shading;
 use cwisim_world::events::Change;
 use cwisim_xproc::{Image, ImageSink, Machine, RunStats, Timing};
@@ -205,8 +205,12 @@ fn load(
 ) -> Result<cwisim_render::LoadedScene, StudyError> {
     let mut loaded = Source::resolve(scene)?.load_for(settings)?;
     if let cwisim_world::AnyScene::World(w) = &mut loaded.scene {
-        for c in changes {
-            c.apply(&mut w.spec);
+        if !changes.is_empty() {
+            // changes read against another scene are refused here, not drawn wrong
+            for c in changes {
+                c.apply(&mut w.spec).map_err(RenderError::from)?;
+            }
+            w.spec.validate().map_err(RenderError::from)?;
         }
     }
     Ok(loaded)

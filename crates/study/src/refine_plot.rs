@@ -18,7 +18,8 @@ pub const ERROR_FLOOR: f64 = 1e-6;
 /// Width and height of the chart, pixels.
 pub const REFINE_PLOT_SIZE: (u32, u32) = (1100, 820);
 
-const PALETTE: [[u8; 3]; 7] = [
+/// The series' colours (and `refine --events`'s phases').
+pub(crate) const PALETTE: [[u8; 3]; 7] = [
     [31, 119, 180],
     [44, 160, 44],
     [148, 103, 189],

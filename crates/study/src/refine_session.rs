@@ -12,6 +12,7 @@
 use crate::error::StudyError;
 use crate::plot::{draw_on, err, rgb, Align, Label, Rgb};
 use crate::refine::{run_refines, RefineRun, RefineSetup};
+use crate::refine_plot::PALETTE;
 use cwisim_world::events::{EventScript, Unit};
 use plotters::prelude::*;
 use std::io::{self, Write};
@@ -88,7 +89,22 @@ pub fn run_session(
             ..setup.clone()
         })
         .collect();
-    let done = run_refines(&setups, threads, None, progress, |_, _| {})?;
+    // the first run, then the others' frames (every run keeps its own) against the
+    // memory budget before they are drawn
+    let mut done = run_refines(&setups[..1], threads, None, progress, |_, _| {})?;
+    let held: u64 = done[0].frames.iter().map(|f| f.data.len() as u64 * 8).sum();
+    cwisim_scene::budget::Budget::current()
+        .check_memory(
+            &format!(
+                "a session of {} refinements, each keeping its frames",
+                setups.len()
+            ),
+            held.saturating_mul(setups.len() as u64),
+        )
+        .map_err(|e| StudyError::Usage(e.to_string()))?;
+    let base = (done[0].frames.len() * done[0].lines) as u64;
+    let rest = |lines: u64| progress(base + lines);
+    done.extend(run_refines(&setups[1..], threads, None, &rest, |_, _| {})?);
     let first = &done[0];
     let frame_cycles =
         (first.lines as u64 + u64::from(setup.machine.vblank_lines)) * first.line_period;
@@ -194,15 +210,6 @@ pub fn write_session(out: &mut dyn Write, s: &Session) -> io::Result<()> {
 /// phase's frame a segment ending where the display has shown it (hatched grey: cut short
 /// by the next event), the events as vertical lines.
 pub fn render_session_plot(s: &Session) -> Result<Rgb, String> {
-    const PHASE_COLORS: [[u8; 3]; 7] = [
-        [31, 119, 180],
-        [44, 160, 44],
-        [148, 103, 189],
-        [255, 127, 14],
-        [140, 86, 75],
-        [227, 119, 194],
-        [23, 190, 207],
-    ];
     let rows = s.runs.len().max(1) as i32;
     let (w, h) = (1100u32, (150 + 46 * rows + 90) as u32);
     let (left, right) = (90i32, w as i32 - 40);
@@ -219,7 +226,7 @@ pub fn render_session_plot(s: &Session) -> Result<Rgb, String> {
             }
         }
     }
-    let color = |n: &str| PHASE_COLORS[names.iter().position(|m| *m == n).unwrap_or(0) % 7];
+    let color = |n: &str| PALETTE[names.iter().position(|m| *m == n).unwrap_or(0) % PALETTE.len()];
     draw_on(&mut img, |root, labels| {
         labels.push(Label::new(
             format!(

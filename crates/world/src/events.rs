@@ -103,8 +103,9 @@ impl Change {
         }
     }
 
-    /// `spec` as this change leaves it.
-    pub fn apply(&self, spec: &mut WorldSpec) {
+    /// `spec` as this change leaves it; a light that `spec` does not have is refused,
+    /// at `lights` (a change read against another scene).
+    pub fn apply(&self, spec: &mut WorldSpec) -> Result<(), SceneError> {
         match self {
             Change::Camera(c) => {
                 let cam = &mut spec.camera;
@@ -118,7 +119,14 @@ impl Change {
                 position,
                 intensity,
             } => {
-                let light = &mut spec.lights[*index];
+                let count = spec.lights.len();
+                let Some(light) = spec.lights.get_mut(*index) else {
+                    return Err(SceneError::at_field(
+                        SceneErrorKind::Schema,
+                        "lights",
+                        format!("an event moves light {index}, and the scene has {count} light(s)"),
+                    ));
+                };
                 if let Some(p) = position {
                     light.position = *p;
                 }
@@ -127,6 +135,7 @@ impl Change {
                 }
             }
         }
+        Ok(())
     }
 }
 
@@ -283,14 +292,16 @@ impl EventScript {
                     ))
                 }
             };
-            change.apply(&mut scene);
-            scene.validate().map_err(|inner| {
-                locate(
-                    at(""),
-                    inner.kind,
-                    format!("the scene this event leaves: {}", inner),
-                )
-            })?;
+            change
+                .apply(&mut scene)
+                .and_then(|()| scene.validate())
+                .map_err(|inner| {
+                    locate(
+                        at(""),
+                        inner.kind,
+                        format!("the scene this event leaves: {}", inner),
+                    )
+                })?;
             events.push(Event { at: e.at, change });
         }
         Ok(EventScript {
@@ -301,13 +312,13 @@ impl EventScript {
     }
 
     /// The scene of run `k` of the session (0: as given; `k`: after the first `k`
-    /// events).
-    pub fn scene(&self, spec: &WorldSpec, k: usize) -> WorldSpec {
+    /// events), `spec` the scene the script was read against.
+    pub fn scene(&self, spec: &WorldSpec, k: usize) -> Result<WorldSpec, SceneError> {
         let mut out = spec.clone();
         for e in &self.events[..k] {
-            e.change.apply(&mut out);
+            e.change.apply(&mut out)?;
         }
-        out
+        Ok(out)
     }
 }
 
@@ -341,11 +352,16 @@ mod tests {
         let s = EventScript::parse(text, &spec()).unwrap();
         assert_eq!(s.unit, Unit::Frames);
         assert_eq!(s.events.len(), 2);
-        let two = s.scene(&spec(), 2);
+        let two = s.scene(&spec(), 2).unwrap();
         assert_eq!(two.camera.eye, [0.0, 3.0, 9.0]);
         assert_eq!(two.lights[0].position, [5.0, 5.0, 5.0]);
-        assert_eq!(s.scene(&spec(), 0), spec());
-        assert_eq!(s.scene(&spec(), 1).lights, spec().lights);
+        assert_eq!(s.scene(&spec(), 0).unwrap(), spec());
+        assert_eq!(s.scene(&spec(), 1).unwrap().lights, spec().lights);
+        // read against another scene, a light it lacks is refused, not a panic
+        let mut dark = spec();
+        dark.lights.clear();
+        let e = s.scene(&dark, 2).unwrap_err().to_string();
+        assert!(e.contains("lights: an event moves light 0"), "{e}");
     }
 
     #[test]

@@ -557,29 +557,29 @@ impl Reach {
     }
 }
 
+/// The bounding box `[x0, y0, x1, y1]` of `points` (empty: an inverted, infinite box).
+pub fn bounding_box(points: &[[f64; 2]]) -> [f64; 4] {
+    points.iter().fold(
+        [
+            f64::INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NEG_INFINITY,
+        ],
+        |b, p| {
+            [
+                b[0].min(p[0]),
+                b[1].min(p[1]),
+                b[2].max(p[0]),
+                b[3].max(p[1]),
+            ]
+        },
+    )
+}
+
 /// The bounding box `[x0, y0, x1, y1]` of each contour.
 fn boxes(shape: &Shape) -> Vec<[f64; 4]> {
-    shape
-        .iter()
-        .map(|c| {
-            c.iter().fold(
-                [
-                    f64::INFINITY,
-                    f64::INFINITY,
-                    f64::NEG_INFINITY,
-                    f64::NEG_INFINITY,
-                ],
-                |b, p| {
-                    [
-                        b[0].min(p[0]),
-                        b[1].min(p[1]),
-                        b[2].max(p[0]),
-                        b[3].max(p[1]),
-                    ]
-                },
-            )
-        })
-        .collect()
+    shape.iter().map(|c| bounding_box(c)).collect()
 }
 
 /// What every shadow-casting light reaches of every camera triangle, on the screen: what

@@ -237,15 +237,21 @@ pub fn run(args: &RefineArgs, stdout: &mut dyn Write, progress: bool) -> Result<
         s.check().map_err(CliError::Usage)?;
     }
     let vertex_parts = vertex_parts(args.vertex_fraction).map_err(CliError::Usage)?;
-    if vertex_parts > 1 && !phases.contains(&Phase::Vertices) {
-        return Err(CliError::Usage(format!(
-            "--vertex-fraction {} splits the vertex phase: list `vertices` in --phases",
-            args.vertex_fraction
-        )));
-    }
     if let Some(path) = &args.events {
-        let parts = (phases, vertex_parts);
-        return session(args, path, settings, parts, machine, plot, stdout, progress);
+        let setup = RefineSetup {
+            scene: args.scene.as_deref(),
+            changes: &[],
+            settings,
+            phases,
+            vertex_parts,
+            machine,
+            naive: false,
+            cost_maps: false,
+            ids: false,
+            threads: 1,
+            cancel: None,
+        };
+        return session(args, path, &setup, plot, stdout, progress);
     }
     let setups: Vec<RefineSetup> = runs
         .iter()
@@ -375,19 +381,17 @@ pub fn run(args: &RefineArgs, stdout: &mut dyn Write, progress: bool) -> Result<
     stdout.flush().map_err(CliError::Stdout)
 }
 
-/// `cwisim refine --events SCRIPT`: the session, its table and its timeline.
-#[allow(clippy::too_many_arguments)]
+/// `cwisim refine --events SCRIPT`: the session of `setup`'s refinement, its table and its
+/// timeline.
 fn session(
     args: &RefineArgs,
     path: &Path,
-    settings: Settings,
-    (phases, vertex_parts): (Vec<Phase>, u32),
-    machine: cwisim_xproc::Machine,
+    setup: &RefineSetup,
     plot: Option<PathBuf>,
     stdout: &mut dyn Write,
     progress: bool,
 ) -> Result<(), CliError> {
-    let loaded = Source::resolve(args.scene.as_deref())?.load_for(&settings)?;
+    let loaded = Source::resolve(setup.scene)?.load_for(&setup.settings)?;
     let cwisim_world::AnyScene::World(w) = &loaded.scene else {
         return Err(CliError::Usage(format!(
             "--events moves a world scene's camera and lights; {} is a screen scene",
@@ -397,26 +401,13 @@ fn session(
     let text = cwisim_scene::read_scene_text(path)?;
     let script =
         EventScript::parse(&text, &w.spec).map_err(|e| CliError::Scene(e.in_file(path)))?;
-    let setup = RefineSetup {
-        scene: args.scene.as_deref(),
-        changes: &[],
-        settings,
-        phases,
-        vertex_parts,
-        machine,
-        naive: false,
-        cost_maps: false,
-        ids: false,
-        threads: 1,
-        cancel: None,
-    };
     let bar = std::sync::Mutex::new(Progress::scanlines(0, progress));
     let report = |lines: u64| {
         if let Ok(mut bar) = bar.lock() {
             bar.update(lines);
         }
     };
-    let (s, _) = run_session(&setup, &script, args.threads, &report)?;
+    let (s, _) = run_session(setup, &script, args.threads, &report)?;
     drop(bar);
     write_session(stdout, &s).map_err(CliError::Stdout)?;
     if let Some(p) = &plot {

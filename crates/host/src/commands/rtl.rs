@@ -176,6 +176,30 @@ fn rtl_error(e: RtlError) -> CliError {
     }
 }
 
+/// The array in `format` for the opcodes of the stream `renderer` emits, `processors` wide
+/// (at most the stream's width; `None`: all of it), and the stream's width.
+fn scene_design(
+    renderer: &dyn cwisim_render::Renderer,
+    machine: &cwisim_xproc::Machine,
+    format: cwisim_xproc::FixedFormat,
+    processors: Option<u32>,
+) -> Result<(Design, u32), CliError> {
+    let (mut reader, _) = crate::input::emitted(renderer, false)?;
+    let header = *reader.header();
+    let trace = read_all(&mut *reader)?;
+    let timing = BusTiming::new(machine, &header).map_err(rtl_error)?;
+    let width = processors.map_or(header.width, |p| p.min(header.width));
+    let design = Design::new(
+        format,
+        opcodes_used(&trace),
+        width,
+        header.channel_count(),
+        timing,
+    )
+    .map_err(rtl_error)?;
+    Ok((design, header.width))
+}
+
 /// The area of one processor in `format` for the opcodes of the stream `renderer` emits
 /// (Yosys in a temporary directory): what `fit --area` prints.
 pub(crate) fn scene_area(
@@ -183,18 +207,7 @@ pub(crate) fn scene_area(
     machine: &cwisim_xproc::Machine,
     format: cwisim_xproc::FixedFormat,
 ) -> Result<area::Area, CliError> {
-    let (mut reader, _) = crate::input::emitted(renderer, false)?;
-    let header = *reader.header();
-    let trace = read_all(&mut *reader)?;
-    let timing = BusTiming::new(machine, &header).map_err(rtl_error)?;
-    let design = Design::new(
-        format,
-        opcodes_used(&trace),
-        header.width,
-        header.channel_count(),
-        timing,
-    )
-    .map_err(rtl_error)?;
+    let (design, _) = scene_design(renderer, machine, format, None)?;
     let dir = WorkDir::new(None, "area")?;
     area::synthesize(&design, dir.path()).map_err(rtl_error)
 }
@@ -216,18 +229,7 @@ pub(crate) fn scene_fpga(
     device: &fpga::Device,
     processors: u32,
 ) -> Result<(fpga::FpgaReport, u32), CliError> {
-    let (mut reader, _) = crate::input::emitted(renderer, false)?;
-    let header = *reader.header();
-    let trace = read_all(&mut *reader)?;
-    let timing = BusTiming::new(machine, &header).map_err(rtl_error)?;
-    let design = Design::new(
-        format,
-        opcodes_used(&trace),
-        processors.min(header.width),
-        header.channel_count(),
-        timing,
-    )
-    .map_err(rtl_error)?;
+    let (design, width) = scene_design(renderer, machine, format, Some(processors))?;
     let dir = WorkDir::new(None, "fpga")?;
     let r = fpga::place_and_route(
         &design,
@@ -237,7 +239,7 @@ pub(crate) fn scene_fpga(
         &mut |_| {},
     )
     .map_err(rtl_error)?;
-    Ok((r, header.width))
+    Ok((r, width))
 }
 
 /// Refuses, before any work, a run whose tools are not installed: `programs`, each on the

@@ -15,6 +15,8 @@
 //! * [`resolve`] — the bands made and resolved strip by strip, on `--threads`.
 //! * [`merged`] — a patch's visible fragments on a pixel row box-filtered on the host and
 //!   sent through the span fitter as one span.
+//! * [`shadow`] — the paper's §7: the patches scanned again from each light that casts
+//!   shadows, and the camera's pieces cut where the light does not reach them.
 //!
 //! The pieces of every band — triangles with their surface points and the patch's own
 //! normals at their corners — go through the scan segments of their strip and then

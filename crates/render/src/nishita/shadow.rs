@@ -46,7 +46,9 @@ use crate::settings::Settings;
 use cwisim_scene::{SceneError, SceneErrorKind};
 use cwisim_world::camera::Camera;
 use cwisim_world::face::{ScreenTriangle, Surface};
-use cwisim_world::shadow::{light_triangle, one_view, world_at, Casters, Reach, ShadowTest};
+use cwisim_world::shadow::{
+    bounding_box, light_triangle, one_view, world_at, Casters, Reach, ShadowTest,
+};
 use cwisim_world::visibility::{exact_fragments_on, Fragment};
 use cwisim_world::WorldScene;
 use glam::DVec3;
@@ -132,26 +134,6 @@ fn area2(points: &[Pt]) -> f64 {
         .sum()
 }
 
-/// The bounding box `[x0, y0, x1, y1]` of `points`.
-fn bounds(points: &[Pt]) -> [f64; 4] {
-    points.iter().fold(
-        [
-            f64::INFINITY,
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-            f64::NEG_INFINITY,
-        ],
-        |b, p| {
-            [
-                b[0].min(p[0]),
-                b[1].min(p[1]),
-                b[2].max(p[0]),
-                b[3].max(p[1]),
-            ]
-        },
-    )
-}
-
 /// A fragment the light sees: its polygon on the light's screen, its bounding box, and
 /// its inverse depth from the light (affine there).
 struct Seen {
@@ -233,7 +215,7 @@ fn reach(
     let orientation = area2(&lt.points).signum();
     let whole = area2(&lt.points).abs() / 2.0;
     let triangle = lt.points;
-    grid.near(bounds(&triangle), near);
+    grid.near(bounding_box(&triangle), near);
     let mut shadowed = Vec::new();
     let mut area = 0.0;
     for &i in near.iter() {
@@ -419,7 +401,7 @@ pub fn shadow_test(
                 let t = &ltris[f.source];
                 let inv_depth = Affine::through(&t.points, t.inv_depth)?;
                 Some(Seen {
-                    bounds: bounds(&f.polygon.vertices),
+                    bounds: bounding_box(&f.polygon.vertices),
                     polygon: f.polygon.vertices.clone(),
                     inv_depth,
                 })
@@ -476,7 +458,7 @@ mod tests {
                 let x = f64::from(i) * 3.0;
                 let polygon = vec![[x, 10.0], [x + 20.0, 10.0], [x, 30.0]];
                 Seen {
-                    bounds: bounds(&polygon),
+                    bounds: bounding_box(&polygon),
                     polygon,
                     inv_depth: flat,
                 }

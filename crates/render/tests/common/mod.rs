@@ -5,7 +5,7 @@
 pub mod footprint;
 pub mod raycast;
 
-use cwisim_render::{registry, render, ArrayConfig, LoadedScene, Settings, Taps};
+use cwisim_render::{registry, render, ArrayConfig, Counters, LoadedScene, Settings, Taps};
 use cwisim_world::{parse_any, AnyScene, WorldScene};
 use cwisim_xproc::ImageSink;
 
@@ -30,9 +30,27 @@ pub fn rendered(w: &WorldScene, settings: &Settings) -> Vec<f64> {
 /// The image renderer `name` draws of `w` under `settings` (the array's exact values).
 pub fn rendered_by(name: &str, w: &WorldScene, settings: &Settings) -> Vec<f64> {
     let loaded = LoadedScene::built("test", AnyScene::World(w.clone()));
+    drawn_on(name, loaded, settings, 1).0
+}
+
+/// The image renderer `name` draws of `loaded` under `settings` on `threads` threads
+/// (the array's exact values), and the frame's counters.
+pub fn drawn_on(
+    name: &str,
+    loaded: LoadedScene,
+    settings: &Settings,
+    threads: usize,
+) -> (Vec<f64>, Counters) {
     let r = (registry::find(name).unwrap().build)(loaded, settings).unwrap();
     let h = r.header();
     let mut sink = ImageSink::new(h.width as usize, h.channel_count(), 1 << 30);
-    render(&*r, &ArrayConfig::default(), 1, &mut sink, Taps::default()).unwrap();
-    sink.finish().unwrap().data
+    let done = render(
+        &*r,
+        &ArrayConfig::default(),
+        threads,
+        &mut sink,
+        Taps::default(),
+    )
+    .unwrap();
+    (sink.finish().unwrap().data, done.counters)
 }
