@@ -353,9 +353,9 @@ pub struct DrawArgs {
     )]
     pub flatness: f64,
     /// Nishita's §5: a subpatch whose corner normals differ by more than ANGLE degrees is
-    /// divided again [default: off, the flatness alone decides].
-    #[arg(long, value_name = "ANGLE", help_heading = "Bézier patches (nishita)")]
-    pub normal_angle: Option<f64>,
+    /// divided again; `off`: not [default: off, the flatness alone decides].
+    #[arg(long, value_name = "ANGLE|off", value_parser = angle_or_off, help_heading = "Bézier patches (nishita)")]
+    pub normal_angle: Option<AngleOrOff>,
     /// Pixel rows per band of subpatches (the paper: three or four).
     #[arg(
         long,
@@ -520,7 +520,7 @@ impl DrawArgs {
             unset: self.unset.into(),
             root_tolerance: self.root_tolerance,
             flatness: self.flatness,
-            normal_angle: self.normal_angle,
+            normal_angle: self.normal_angle.and_then(|a| a.0),
             band: self.band,
             subscan: self.subscan,
             gouraud_threshold: self.gouraud_threshold,
@@ -663,5 +663,21 @@ mod tests {
         // a flag given with its default value counts: it was given
         assert_eq!(r.draw.given, ["--renderer", "--samples", "--seed"]);
         assert_eq!(r.draw.given_settings(), [Setting::Samples, Setting::Seed]);
+    }
+}
+
+/// One value of `--normal-angle` (`render`'s, and each of `tradeoff`'s list): degrees, or
+/// `off` (the test not made).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AngleOrOff(pub Option<f64>);
+
+/// Parses `off` or a number of degrees (the range is the library's to check).
+pub fn angle_or_off(text: &str) -> Result<AngleOrOff, String> {
+    match text.trim() {
+        t if t.eq_ignore_ascii_case("off") => Ok(AngleOrOff(None)),
+        t => t
+            .parse::<f64>()
+            .map(|a| AngleOrOff(Some(a)))
+            .map_err(|_| format!("expected a number of degrees or off, found `{text}`")),
     }
 }

@@ -201,6 +201,9 @@ const LONG: &[&str] = &[
     "docs/TRADEOFF.md: tradeoff pot --csv pot.csv",
     // 80 s debug, 3.5 s release
     "docs/TRADEOFF.md: tradeoff teapot --renderers vanrij",
+    // twelve nishita teapots at 160², half with the normal test, and the reference: 16 s
+    // release
+    "docs/TRADEOFF.md: --normal-angle off,30",
     // the help's examples: 90 s release; 100 s debug, 9 s release; the whole 400-processor
     // array, 30 s debug
     "cwisim --help: cwisim tradeoff pot",

@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{cwisim, cwisim_ok, read, repo, scratch, text};
+use common::{cwisim, cwisim_ok, patch_scene, read, repo, scratch, text};
 use cwisim_render::settings::Setting;
 use cwisim_render::REGISTRY;
 use std::path::Path;
@@ -354,34 +354,6 @@ fn example(s: Setting, shading: bool) -> Vec<&'static str> {
         Setting::Shadows => vec!["--shadows", "on"],
         Setting::TextureFilter => vec!["--texture-filter", "point"],
     }
-}
-
-/// A small world scene of two bicubic Bézier patches, 32×32: a flat one, and a dome in
-/// front of it, partly hiding it (drawn after it: overdraw has something to undo).
-fn patch_scene() -> String {
-    let mut vertices = Vec::new();
-    for (x0, z0, bump, size) in [(0.9, -0.8, 0.3, 2.4), (0.0, 0.0, 1.2, 2.0)] {
-        for j in 0..4 {
-            for i in 0..4 {
-                let inner = (1..=2).contains(&i) && (1..=2).contains(&j);
-                let x = x0 + size * (f64::from(i) - 1.5) / 3.0;
-                let y = size * (f64::from(j) - 1.5) / 3.0;
-                let z = z0 + if inner { bump } else { 0.0 };
-                vertices.push(format!("[{x}, {y}, {z}]"));
-            }
-        }
-    }
-    let indices = |r: std::ops::Range<u32>| r.map(|k| k.to_string()).collect::<Vec<_>>().join(", ");
-    format!(
-        r#"{{"kind": "world", "width": 32, "height": 32, "channels": 1,
-"camera": {{"eye": [0.3, 0.4, 5], "target": [0.2, 0, 0], "up": [0, 1, 0], "fov_y": 40}},
-"ambient": 0.2, "lights": [{{"position": [2, 3, 6], "intensity": 0.8}}],
-"meshes": [{{"material": {{"k_a": 0.4, "k_d": 0.7, "k_s": 0.6, "n": 20}}, "two_sided": true,
-  "bezier": {{"tessellate": 3, "vertices": [{}], "patches": [[{}], [{}]]}}}}]}}"#,
-        vertices.join(", "),
-        indices(0..16),
-        indices(16..32)
-    )
 }
 
 /// The flag of `s` and its value in [`example`] (none for a switch).

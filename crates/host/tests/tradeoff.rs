@@ -2,7 +2,7 @@
 
 mod common;
 
-use common::{cwisim, cwisim_ok, scratch, text};
+use common::{cwisim, cwisim_ok, patch_scene, scratch, text};
 use cwisim_scene::{parse_scene, Scene};
 use cwisim_ypipe::exact::scene_box_filtered;
 use std::path::Path;
@@ -569,4 +569,121 @@ fn the_a_buffer_s_mask_is_an_axis_its_rows_parse_back_and_bad_modes_are_refused(
         assert_eq!(out.status.code(), Some(2), "{stderr}");
         assert!(stderr.contains(says), "{stderr}");
     }
+}
+
+#[test]
+fn nishita_s_normal_angle_is_an_axis_its_rows_parse_back_and_bad_angles_are_refused() {
+    let dir = scratch("tradeoff-normal-angle");
+    std::fs::write(dir.join("patches.json"), patch_scene()).unwrap();
+    let out = cwisim_ok(
+        &dir,
+        &[
+            "tradeoff",
+            "patches.json",
+            "--renderers",
+            "nishita",
+            "--normal-angle",
+            "off,10",
+            "--numeric",
+            "f64",
+            "--repeat",
+            "1",
+            "--csv",
+            "na.csv",
+        ],
+    );
+    let (header, rows) = read_csv(&dir.join("na.csv"));
+    // the root tolerances × the angles × Phong and Gouraud
+    assert_eq!(rows.len(), 12, "{out}");
+    let angles: Vec<String> = rows
+        .iter()
+        .map(|r| r.get(&header, "normal_angle"))
+        .collect();
+    assert_eq!(angles.iter().filter(|a| a.is_empty()).count(), 6, "{out}");
+    assert_eq!(angles.iter().filter(|a| *a == "10").count(), 6, "{out}");
+    // the table shows the angle beside the tolerance, the columns after it lined up
+    let lines: Vec<&str> = out.lines().filter(|l| l.starts_with("nishita")).collect();
+    assert!(lines.iter().any(|l| l.contains("1e-5 10°")), "{out}");
+    let shading_at = |l: &str| {
+        ["phong", "gouraud"]
+            .iter()
+            .filter_map(|s| l.find(s).map(|b| l[..b].chars().count()))
+            .min()
+    };
+    assert!(
+        lines.iter().all(|l| shading_at(l) == shading_at(lines[0])),
+        "{out}"
+    );
+    // the test divides further: more pieces where it is on, the same error or less
+    let pieces = |k: usize| -> u64 {
+        rows[k]
+            .get(&header, "counter_piece_triangles")
+            .parse()
+            .unwrap()
+    };
+    let (off, on) = (
+        rows.iter()
+            .position(|r| r.get(&header, "normal_angle").is_empty())
+            .unwrap(),
+        rows.iter()
+            .position(|r| r.get(&header, "normal_angle") == "10")
+            .unwrap(),
+    );
+    assert!(pieces(on) > pieces(off), "{out}");
+    // the CSV is read back (a sweep joined from one part), the angle in the table
+    let merged = cwisim_ok(&dir, &["tradeoff", "--merge", "na.csv"]);
+    assert!(merged.contains("1e-3 10°"), "{merged}");
+    for (args, says) in [
+        (
+            &["--normal-angle", "sharp"][..],
+            "expected a number of degrees or off",
+        ),
+        (
+            &["--normal-angle", "0.1"][..],
+            "--normal-angle must be between",
+        ),
+        (&["--normal-angle", "10,10"][..], "at most once"),
+        (
+            &["--normal-angle", "10", "--renderers", "vanrij"][..],
+            "leaves nishita out",
+        ),
+    ] {
+        let out = cwisim(&dir, &[&["tradeoff", "patches.json"][..], args].concat());
+        let (_, stderr) = text(&out);
+        assert_eq!(out.status.code(), Some(2), "{stderr}");
+        assert!(stderr.contains(says), "{stderr}");
+    }
+    let out = cwisim(
+        &dir,
+        &["tradeoff", "pot", "--size", "16x16", "--normal-angle", "10"],
+    );
+    let (_, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("the scene has none"), "{stderr}");
+    // `render --normal-angle off` is the test left off, as the default
+    for (name, extra) in [
+        ("default.npy", &[][..]),
+        ("off.npy", &["--normal-angle", "off"][..]),
+    ] {
+        cwisim_ok(
+            &dir,
+            &[
+                &[
+                    "render",
+                    "patches.json",
+                    "--renderer",
+                    "nishita",
+                    "-q",
+                    "--npy",
+                    name,
+                ][..],
+                extra,
+            ]
+            .concat(),
+        );
+    }
+    assert_eq!(
+        std::fs::read(dir.join("default.npy")).unwrap(),
+        std::fs::read(dir.join("off.npy")).unwrap()
+    );
 }

@@ -721,7 +721,7 @@ impl TradeoffPlan {
     /// The plan of `scene` (a file or an embedded name; `None`: the default) over the
     /// axes, as `cwisim tradeoff` takes them.
     #[new]
-    #[pyo3(signature = (scene=None, size=None, tessellate=Vec::new(), shadows=Vec::new(), renderers=Vec::new(), numeric=Vec::new(), machine=None))]
+    #[pyo3(signature = (scene=None, size=None, tessellate=Vec::new(), shadows=Vec::new(), renderers=Vec::new(), numeric=Vec::new(), sbuffer=Vec::new(), normal_angle=Vec::new(), machine=None))]
     #[allow(clippy::too_many_arguments)] // Python's keywords: the command line's flags
     fn new(
         py: Python<'_>,
@@ -731,6 +731,8 @@ impl TradeoffPlan {
         shadows: Vec<bool>,
         renderers: Vec<String>,
         numeric: Vec<String>,
+        sbuffer: Vec<String>,
+        normal_angle: Vec<Option<f64>>,
         machine: Option<&str>,
     ) -> PyResult<TradeoffPlan> {
         let size = size
@@ -742,21 +744,26 @@ impl TradeoffPlan {
             .map(|f| f.parse::<Numeric>())
             .collect::<Result<Vec<_>, _>>()
             .map_err(|e| usage_error(format!("numeric: {e}")))?;
+        let sbuffer = sbuffer
+            .iter()
+            .map(|m| m.parse::<cwisim_render::settings::SbufferMode>())
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|e| usage_error(format!("sbuffer: {e}")))?;
         let machine = match machine {
             Some(path) => Machine::from_file(Path::new(path)).map_err(|e| to_py(e.into()))?,
             None => Machine::default(),
         };
+        let request = tradeoff::Request {
+            size,
+            tessellations: tessellate,
+            shadows,
+            renderers,
+            formats,
+            sbuffer,
+            normal_angles: normal_angle,
+        };
         let plan = py
-            .detach(|| {
-                tradeoff::Plan::new(
-                    scene.map(Path::new),
-                    size,
-                    &tessellate,
-                    &shadows,
-                    &renderers,
-                    &formats,
-                )
-            })
+            .detach(|| tradeoff::Plan::new(scene.map(Path::new), &request))
             .map_err(study_to_py)?;
         Ok(TradeoffPlan { plan, machine })
     }

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import csv
 import io
+import json
 import os
 import time
 
@@ -142,3 +143,42 @@ def test_an_error_on_a_dask_worker_comes_home_as_itself():
     ) as cluster, distributed.Client(cluster) as client:
         with pytest.raises(cwisim.UsageError, match=r"^group 99 of a plan of \d+"):
             client.submit(sweep.measure_group, args, 99, 1, pure=False).result()
+
+
+def test_sbuffer_s_a_buffer_and_nishita_s_normal_angle_are_axes_as_on_the_command_line(tmp_path):
+    rows = cwisim.tradeoff(
+        "pot", size=(32, 32), renderers="sbuffer", sbuffer=["host", "abuffer"], numeric="f64", repeat=1
+    )
+    # per shading, the samples axis once for each mode; the A-buffer's shown in `aa`
+    assert len(rows) == 24
+    assert sum(r["aa"] == "abuffer" for r in rows) == 12
+    # one bicubic dome (crates/host/tests/common's patch scene, its front patch)
+    patches = tmp_path / "patches.json"
+    vertices = []
+    for j in range(4):
+        for i in range(4):
+            bump = 1.2 if 1 <= i <= 2 and 1 <= j <= 2 else 0.0
+            vertices.append([2.0 * (i - 1.5) / 3.0, 2.0 * (j - 1.5) / 3.0, bump])
+    patches.write_text(json.dumps({
+        "kind": "world", "width": 32, "height": 32, "channels": 1,
+        "camera": {"eye": [0.3, 0.4, 5], "target": [0.2, 0, 0], "up": [0, 1, 0], "fov_y": 40},
+        "ambient": 0.2, "lights": [{"position": [2, 3, 6], "intensity": 0.8}],
+        "meshes": [{"material": {"k_a": 0.4, "k_d": 0.7, "k_s": 0.6, "n": 20}, "two_sided": True,
+                    "bezier": {"tessellate": 3, "vertices": vertices, "patches": [list(range(16))]}}],
+    }))
+    rows = cwisim.tradeoff(str(patches), renderers="nishita", normal_angle=["off", 10], numeric="f64", repeat=1)
+    assert [r["normal_angle"] for r in rows] == [None, None, 10.0, 10.0] * 3
+    out = cli(
+        "tradeoff", str(patches), "--renderers", "nishita", "--normal-angle", "off,10",
+        "--numeric", "f64", "--repeat", "1", "--csv", "na.csv", cwd=tmp_path,
+    )
+    assert out.returncode == 0, out.stderr
+    theirs = list(csv.DictReader(io.StringIO((tmp_path / "na.csv").read_text())))
+    assert [r["normal_angle"] for r in theirs] == ["" if r["normal_angle"] is None else "10" for r in rows]
+    assert [int(r["instructions"]) for r in theirs] == [r["instructions"] for r in rows]
+    with pytest.raises(cwisim.UsageError, match="normal_angle: expected a number of degrees or off"):
+        cwisim.tradeoff(str(patches), normal_angle="sharp")
+    with pytest.raises(cwisim.UsageError, match="between 0.5 and 180 degrees"):
+        cwisim.tradeoff(str(patches), renderers="nishita", normal_angle=200)
+    with pytest.raises(cwisim.UsageError, match="^sbuffer: "):
+        cwisim.tradeoff("pot", renderers="sbuffer", sbuffer="everything")

@@ -62,6 +62,9 @@ pub struct Row {
     /// The root tolerance of a renderer that draws the patches directly (`nishita`);
     /// its rows are measured against the reference at the finest tessellation.
     pub root_tolerance: Option<f64>,
+    /// `nishita`'s normal-difference angle, degrees (`--normal-angle`); `None` where the
+    /// test is off or the renderer draws no patches.
+    pub normal_angle: Option<f64>,
     /// The array's numeric format.
     pub numeric: String,
     /// Register bits per processor and channel (I, dI, ddI and the accumulator).
@@ -123,6 +126,12 @@ impl Setting {
         if let Some(n) = s.tessellate {
             words.push(format!("tessellate {n}"));
         }
+        if self.renderer.patches {
+            words.push(format!("root tolerance {:.0e}", s.root_tolerance));
+            if let Some(a) = s.normal_angle {
+                words.push(format!("normal angle {a}°"));
+            }
+        }
         if let (Some(on), true) = (s.shadows, reads(self, Flag::Shadows)) {
             words.push(if on { "shadows on" } else { "shadows off" }.into());
         }
@@ -163,6 +172,8 @@ pub struct Axes {
     /// `sbuffer`'s modes to try at every samples value (empty: its default, `host`);
     /// `abuffer` rows show it in the `aa` column.
     pub sbuffer: Vec<SbufferMode>,
+    /// `nishita`'s normal-difference angles to try at every root tolerance (empty: off).
+    pub normal_angles: Vec<Option<f64>>,
 }
 
 /// The root tolerances of a renderer that draws Bézier patches directly (Nishita et
@@ -255,20 +266,27 @@ fn grid_of(
             // patches drawn directly: no tessellation, exact visibility (it reads no
             // other), smooth shading, the box filter (Phong's: `box-centre`); the root
             // tolerance is its axis
+            let angles = match axes.normal_angles.is_empty() {
+                true => vec![None],
+                false => axes.normal_angles.clone(),
+            };
             for tolerance in ROOT_TOLERANCE_AXIS {
-                for shading in [Shading::Phong, Shading::Gouraud] {
-                    for numeric in formats {
-                        out.push(Setting {
-                            renderer,
-                            settings: Settings {
-                                shading,
-                                aa: box_filter(shading),
-                                size: axes.size,
-                                root_tolerance: tolerance,
-                                ..Settings::default()
-                            },
-                            numeric: *numeric,
-                        });
+                for &normal_angle in &angles {
+                    for shading in [Shading::Phong, Shading::Gouraud] {
+                        for numeric in formats {
+                            out.push(Setting {
+                                renderer,
+                                settings: Settings {
+                                    shading,
+                                    aa: box_filter(shading),
+                                    size: axes.size,
+                                    root_tolerance: tolerance,
+                                    normal_angle,
+                                    ..Settings::default()
+                                },
+                                numeric: *numeric,
+                            });
+                        }
                     }
                 }
             }
@@ -634,6 +652,50 @@ pub fn shadows_axis(wanted: &[bool], lights: &[bool]) -> Result<Vec<Option<bool>
         .collect()
 }
 
+/// What a sweep tries, as `cwisim tradeoff` takes it: each axis's values (empty: the
+/// axis's default, as [`Plan::new`] says).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Request {
+    /// The image size (`None`: the scene's).
+    pub size: Option<Size>,
+    /// Tessellations of the scene's Bézier meshes (empty: as the scene says).
+    pub tessellations: Vec<u32>,
+    /// Shadows on (`true`) and off to try (empty: as the scene says).
+    pub shadows: Vec<bool>,
+    /// Renderers by name (empty: every registered one-frame renderer).
+    pub renderers: Vec<String>,
+    /// The array's numeric formats.
+    pub formats: Vec<Numeric>,
+    /// `sbuffer`'s modes, `host` and `abuffer` (empty: `host`).
+    pub sbuffer: Vec<SbufferMode>,
+    /// `nishita`'s normal-difference angles, degrees (`None`: the test off; empty: off).
+    pub normal_angles: Vec<Option<f64>>,
+}
+
+/// Refuses a normal-angle axis that nothing would read (`--renderers` without `nishita`),
+/// an angle `cwisim render --normal-angle` would refuse, or a value given twice.
+fn check_normal_angles(angles: &[Option<f64>], renderers: &[String]) -> Result<(), StudyError> {
+    if !angles.is_empty() && !renderers.is_empty() && !renderers.iter().any(|r| r == "nishita") {
+        return Err(StudyError::Usage(
+            "--normal-angle sets nishita's subdivision, and --renderers leaves nishita out".into(),
+        ));
+    }
+    for a in angles {
+        Settings {
+            normal_angle: *a,
+            ..Settings::default()
+        }
+        .check()
+        .map_err(StudyError::Usage)?;
+    }
+    if (1..angles.len()).any(|k| angles[..k].contains(&angles[k])) {
+        return Err(StudyError::Usage(
+            "--normal-angle: each angle (and off) at most once".into(),
+        ));
+    }
+    Ok(())
+}
+
 /// A sweep planned: the grid of settings of one scene, cut into the groups that share a
 /// stream ([`streams`]). Each group is measured alone ([`Plan::measure_group`]), so a
 /// group is a task: a thread's here ([`tradeoff_rows`]), a Dask task's in Python. The
@@ -654,33 +716,22 @@ pub struct Plan {
 }
 
 impl Plan {
-    /// The grid of `scene` (a file or an embedded name; `None`: the default): `renderers`
-    /// by name (empty: every registered one-frame renderer) over the axes — `size`, the
-    /// `tessellations` of a scene with patches, the `shadows` values, the numeric
-    /// `formats`.
-    pub fn new(
-        scene: Option<&Path>,
-        size: Option<Size>,
-        tessellations: &[u32],
-        shadows: &[bool],
-        renderers: &[String],
-        formats: &[Numeric],
-    ) -> Result<Plan, StudyError> {
-        Plan::with_sbuffer(scene, size, tessellations, shadows, renderers, formats, &[])
-    }
-
-    /// [`Plan::new`] with `sbuffer`'s modes to try (empty: `host` alone): `host` and
-    /// `abuffer` (the scanline A-buffer, its mask the samples axis) are measured against
-    /// the exact image; the others are refused.
-    pub fn with_sbuffer(
-        scene: Option<&Path>,
-        size: Option<Size>,
-        tessellations: &[u32],
-        shadows: &[bool],
-        renderers: &[String],
-        formats: &[Numeric],
-        sbuffer: &[SbufferMode],
-    ) -> Result<Plan, StudyError> {
+    /// The grid of `scene` (a file or an embedded name; `None`: the default) over the
+    /// axes `request` asks for: `renderers` by name (empty: every registered one-frame
+    /// renderer), `size`, the `tessellations` of a scene with patches, the `shadows`
+    /// values, `sbuffer`'s modes, `nishita`'s normal angles and the numeric `formats`.
+    /// Refused: a value of an axis no renderer of the grid would read, a value given twice.
+    pub fn new(scene: Option<&Path>, request: &Request) -> Result<Plan, StudyError> {
+        let Request {
+            size,
+            tessellations,
+            shadows,
+            renderers,
+            formats,
+            sbuffer,
+            normal_angles,
+        } = request;
+        let size = *size;
         if let Some(m) = sbuffer
             .iter()
             .find(|m| !matches!(m, SbufferMode::Host | SbufferMode::Abuffer))
@@ -700,6 +751,7 @@ impl Plan {
                 "--sbuffer sets sbuffer's modes, and --renderers leaves sbuffer out".into(),
             ));
         }
+        check_normal_angles(normal_angles, renderers)?;
         // a progressive renderer's frames refine one another: one frame against the exact
         // image says nothing of it (its phases are measured by its own summary)
         let entries: Vec<&'static registry::Entry> = if renderers.is_empty() {
@@ -738,7 +790,14 @@ impl Plan {
             patches: probe.has_patches(),
             textured: probe.is_textured(),
             sbuffer: sbuffer.to_vec(),
+            normal_angles: normal_angles.clone(),
         };
+        if !normal_angles.is_empty() && !axes.patches {
+            return Err(StudyError::Usage(
+                "--normal-angle is nishita's subdivision of Bézier patches, and the scene has none"
+                    .into(),
+            ));
+        }
         let settings = grid(&entries, &axes, formats);
         let skipped = skipped_renderers(&entries, &axes);
         if settings.is_empty() {
@@ -886,28 +945,23 @@ fn check_repeat(repeat: u32) -> Result<(), StudyError> {
     }
 }
 
-/// Measures every setting of the grid ([`Plan`]): `renderers` by name (empty: every
-/// registered one-frame renderer), on `threads` threads (0: one per core). The settings
+/// Measures every setting of the grid ([`Plan`]) of `scene` over the axes `request`
+/// asks for, on `threads` threads (0: one per core). The settings
 /// that share a stream (the same drawing in several numeric formats, [`streams`]) are
 /// measured together: the stream is drawn once and executed in each format
 /// ([`measure_stream`]); each reference image is made once. Streams are measured in
 /// parallel, their rows reported to `progress` in the grid's order as soon as they and
 /// every row before them are measured: the rows (but their host times) are the same at any
 /// thread count.
-#[allow(clippy::too_many_arguments)]
 pub fn tradeoff_rows(
     scene: Option<&Path>,
-    size: Option<Size>,
-    tessellations: &[u32],
-    shadows: &[bool],
-    renderers: &[String],
-    formats: &[Numeric],
+    request: &Request,
     machine: &Machine,
     repeat: u32,
     threads: usize,
     progress: &mut dyn FnMut(Step<'_>),
 ) -> Result<Vec<Row>, StudyError> {
-    let plan = Plan::new(scene, size, tessellations, shadows, renderers, formats)?;
+    let plan = Plan::new(scene, request)?;
     let mut rows = measure_groups(
         &plan,
         0..plan.groups.len(),
@@ -1248,6 +1302,7 @@ fn row_of(
         },
         tessellate: s.tessellate,
         root_tolerance: patches.then_some(s.root_tolerance),
+        normal_angle: s.normal_angle.filter(|_| patches),
         numeric: short_numeric(&setting.numeric),
         register_bits: register_bits(&setting.numeric),
         instructions: stats.totals.instructions,
@@ -1272,10 +1327,10 @@ fn row_of(
 
 /// The table, as `tradeoff` prints it.
 pub fn write_table(out: &mut dyn Write, rows: &[Row]) -> std::io::Result<()> {
-    let rw = name_width(rows.iter().map(|r| r.renderer));
-    write_table_header(out, rw)?;
+    let layout = TableLayout::of_rows(rows);
+    write_table_header(out, layout)?;
     for r in rows {
-        write_table_row(out, r, rw)?;
+        write_table_row(out, r, layout)?;
     }
     Ok(())
 }
@@ -1285,27 +1340,94 @@ pub fn name_width<'a>(names: impl Iterator<Item = &'a str>) -> usize {
     names.map(str::len).chain([8]).max().unwrap_or(8)
 }
 
-/// The table's header line, the renderer column `rw` wide.
-pub fn write_table_header(out: &mut dyn Write, rw: usize) -> std::io::Result<()> {
+/// The `tess` column's cell: the tessellation, or the root tolerance of a renderer that
+/// draws patches directly, with its normal angle when the test is on (`1e-5 20°`).
+fn tess_cell(
+    tessellate: Option<u32>,
+    root_tolerance: Option<f64>,
+    normal_angle: Option<f64>,
+) -> String {
+    match (tessellate, root_tolerance, normal_angle) {
+        (_, Some(t), Some(a)) => format!("{t:.0e} {a}°"),
+        (_, Some(t), None) => format!("{t:.0e}"),
+        (Some(n), None, _) => n.to_string(),
+        (None, None, _) => "-".to_string(),
+    }
+}
+
+/// The widths of the table's columns that vary: the renderer's (its names) and `tess`'s
+/// (wider when a row shows `nishita`'s normal angle beside its root tolerance).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TableLayout {
+    /// The renderer column's width ([`name_width`]).
+    pub renderer: usize,
+    /// The `tess` column's width (at least the header's 4).
+    pub tess: usize,
+}
+
+impl TableLayout {
+    /// The layout of these rows, the renderer column as wide as every registered
+    /// renderer's name (so that sweeps' tables line up).
+    pub fn of_rows(rows: &[Row]) -> TableLayout {
+        TableLayout {
+            renderer: name_width(registry::REGISTRY.iter().map(|e| e.name)),
+            tess: rows
+                .iter()
+                .map(|r| {
+                    tess_cell(r.tessellate, r.root_tolerance, r.normal_angle)
+                        .chars()
+                        .count()
+                })
+                .chain([4])
+                .max()
+                .unwrap_or(4),
+        }
+    }
+
+    /// The layout of a plan's rows before they are measured, the renderer column as wide
+    /// as every registered renderer's name (so that sweeps' tables line up).
+    pub fn of_plan(plan: &Plan) -> TableLayout {
+        TableLayout {
+            renderer: name_width(registry::REGISTRY.iter().map(|e| e.name)),
+            tess: plan
+                .settings
+                .iter()
+                .map(|s| {
+                    let patches = s.renderer.patches && plan.axes.world;
+                    tess_cell(
+                        s.settings.tessellate,
+                        patches.then_some(s.settings.root_tolerance),
+                        s.settings.normal_angle.filter(|_| patches),
+                    )
+                    .chars()
+                    .count()
+                })
+                .chain([4])
+                .max()
+                .unwrap_or(4),
+        }
+    }
+}
+
+/// The table's header line, laid out as `layout` says.
+pub fn write_table_header(out: &mut dyn Write, layout: TableLayout) -> std::io::Result<()> {
+    let (rw, tw) = (layout.renderer, layout.tess);
     writeln!(
         out,
-        "{:<rw$} {:>4} {:<8} {:<10} {:>2} {:<5} {:<4} {:<34} {:>4} {:>8} {:>9} {:>6} {:>4} {:>8} {:>9} {:>9} {:>6} {:>5}  pareto",
+        "{:<rw$} {:>tw$} {:<8} {:<10} {:>2} {:<5} {:<4} {:<34} {:>4} {:>8} {:>9} {:>6} {:>4} {:>8} {:>9} {:>9} {:>6} {:>5}  pareto",
         "renderer", "tess", "shading", "aa", "l", "vis", "shad", "numeric", "bits", "instr", "busy cyc", "worst", "late", "host ms", "max err", "RMS err", "PSNR", "ovfl"
     )
 }
 
-/// One row of the table, the renderer column `rw` wide; `*` in the last column when the
-/// row is on the Pareto front ([`mark_pareto`]: known only once every row is measured).
-pub fn write_table_row(out: &mut dyn Write, r: &Row, rw: usize) -> std::io::Result<()> {
+/// One row of the table, laid out as `layout` says; `*` in the last column when the row
+/// is on the Pareto front ([`mark_pareto`]: known only once every row is measured).
+pub fn write_table_row(out: &mut dyn Write, r: &Row, layout: TableLayout) -> std::io::Result<()> {
+    let (rw, tw) = (layout.renderer, layout.tess);
     writeln!(
             out,
-            "{:<rw$} {:>4} {:<8} {:<10} {:>2} {:<5} {:<4} {:<34} {:>4} {:>8} {:>9} {:>5.1}% {:>4} {:>8.2} {:>9.2e} {:>9.2e} {:>6} {:>5}  {}",
+            "{:<rw$} {:>tw$} {:<8} {:<10} {:>2} {:<5} {:<4} {:<34} {:>4} {:>8} {:>9} {:>5.1}% {:>4} {:>8.2} {:>9.2e} {:>9.2e} {:>6} {:>5}  {}",
             r.renderer,
-            match (r.tessellate, r.root_tolerance) {
-                (_, Some(t)) => format!("{t:.0e}"),
-                (Some(n), None) => n.to_string(),
-                (None, None) => "-".to_string(),
-            },
+            tess_cell(r.tessellate, r.root_tolerance, r.normal_angle),
             r.shading,
             r.aa,
             r.samples.map_or_else(|| "-".to_string(), |n| n.to_string()),
@@ -1332,10 +1454,11 @@ pub fn write_table_row(out: &mut dyn Write, r: &Row, rw: usize) -> std::io::Resu
 
 /// The fixed columns of [`csv`], in order; the renderers' counters follow, one column
 /// `counter_NAME` each.
-pub const CSV_COLUMNS: [&str; 20] = [
+pub const CSV_COLUMNS: [&str; 21] = [
     "renderer",
     "tessellate",
     "root_tolerance",
+    "normal_angle",
     "shading",
     "aa",
     "samples",
@@ -1397,11 +1520,12 @@ pub fn csv(rows: &[Row], prov: &Provenance) -> String {
     s.push('\n');
     for (k, r) in rows.iter().enumerate() {
         s.push_str(&format!(
-            "{},{},{},{},{},{},{},{},\"{}\",{},{},{},{},{},{},{:e},{:e},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},\"{}\",{},{},{},{},{},{},{:e},{:e},{},{},{}",
             r.renderer,
             r.tessellate.map_or_else(String::new, |n| n.to_string()),
             r.root_tolerance
                 .map_or_else(String::new, |t| format!("{t:e}")),
+            r.normal_angle.map_or_else(String::new, |a| a.to_string()),
             r.shading,
             r.aa,
             r.samples.map_or_else(String::new, |n| n.to_string()),
@@ -1502,27 +1626,32 @@ fn row_of_fields(f: &[String]) -> Result<Row, String> {
         } else {
             Some(real(2)?)
         },
-        shading: dash_or(3, &shadings)?,
-        aa: dash_or(4, &[filters.as_slice(), &[ABUFFER_AA]].concat())?,
-        samples: optional(5)?.map(|v| small(v, 5)).transpose()?,
-        visibility: dash_or(6, &visibilities)?,
-        shadows: dash_or(7, &["on", "off"])?,
-        numeric: col(8).to_string(),
-        register_bits: small(int(9)?, 9)?,
-        instructions: int(10)?,
-        busy_cycles: int(11)?,
-        worst_line_share: real(12)?,
-        late_lines: int(13)?,
-        host_ms: real(14)?,
-        max_error: real(15)?,
-        rms_error: real(16)?,
-        psnr_db: real(17)?,
-        overflows: int(18)?,
+        normal_angle: if col(3).is_empty() {
+            None
+        } else {
+            Some(real(3)?)
+        },
+        shading: dash_or(4, &shadings)?,
+        aa: dash_or(5, &[filters.as_slice(), &[ABUFFER_AA]].concat())?,
+        samples: optional(6)?.map(|v| small(v, 6)).transpose()?,
+        visibility: dash_or(7, &visibilities)?,
+        shadows: dash_or(8, &["on", "off"])?,
+        numeric: col(9).to_string(),
+        register_bits: small(int(10)?, 10)?,
+        instructions: int(11)?,
+        busy_cycles: int(12)?,
+        worst_line_share: real(13)?,
+        late_lines: int(14)?,
+        host_ms: real(15)?,
+        max_error: real(16)?,
+        rms_error: real(17)?,
+        psnr_db: real(18)?,
+        overflows: int(19)?,
         counters: cwisim_render::Counters::default(),
-        pareto: match col(19) {
+        pareto: match col(20) {
             "true" => true,
             "false" => false,
-            _ => return Err(what(19, "true or false")),
+            _ => return Err(what(20, "true or false")),
         },
     })
 }
@@ -1816,23 +1945,17 @@ mod tests {
             width: 40,
             height: 30,
         });
-        let plan = Plan::new(
-            Some(Path::new("still-life")),
+        let request = Request {
             size,
-            &[],
-            &[],
-            &renderers,
-            &formats,
-        )
-        .unwrap();
+            renderers: renderers.to_vec(),
+            formats: formats.clone(),
+            ..Request::default()
+        };
+        let plan = Plan::new(Some(Path::new("still-life")), &request).unwrap();
         let machine = Machine::default();
         let whole = tradeoff_rows(
             Some(Path::new("still-life")),
-            size,
-            &[],
-            &[],
-            &renderers,
-            &formats,
+            &request,
             &machine,
             1,
             1,
@@ -1904,15 +2027,7 @@ mod tests {
             e.contains("are in no part") && e.contains("missing): a part left out?"),
             "{e}"
         );
-        let other = Plan::new(
-            Some(Path::new("fig25")),
-            size,
-            &[],
-            &[],
-            &renderers,
-            &formats,
-        )
-        .unwrap();
+        let other = Plan::new(Some(Path::new("fig25")), &request).unwrap();
         let fig = measure_groups(&other, 0..1, &machine, 1, 1, &mut |_| {}).unwrap();
         let foreign = (
             "fig.csv".to_string(),
@@ -1965,7 +2080,7 @@ mod tests {
             .join(",");
         let e = err(&[("old.csv".into(), old)]);
         assert!(
-            e.starts_with("old.csv:1: not a tradeoff CSV of this cwisim: it has 20 column(s), and `sweep` (column 21) is missing"),
+            e.starts_with("old.csv:1: not a tradeoff CSV of this cwisim: it has 21 column(s), and `sweep` (column 22) is missing"),
             "{e}"
         );
         let mut broken = csv(&whole, &plan.provenance(&machine, 0..plan.groups.len()));
@@ -1975,6 +2090,44 @@ mod tests {
             e.to_string()
                 .starts_with("y.csv:2: column `renderer`: unknown renderer"),
             "{e}"
+        );
+    }
+
+    #[test]
+    fn a_csv_row_reads_back_as_written_and_the_table_makes_room_for_the_normal_angle() {
+        let mut rows = vec![row(10, 1e-3), row(20, 2e-3)];
+        rows[0].renderer = "nishita";
+        rows[0].root_tolerance = Some(1e-5);
+        rows[0].normal_angle = Some(22.5);
+        rows[1].renderer = "vanrij";
+        rows[1].tessellate = Some(8);
+        let prov = Provenance {
+            sweep: "x:0".into(),
+            first: 0,
+            settings: 2,
+        };
+        let text = csv(&rows, &prov);
+        let header: Vec<String> = csv_fields(text.lines().next().unwrap()).unwrap();
+        assert_eq!(header[3], "normal_angle");
+        for (line, want) in text.lines().skip(1).zip(&rows) {
+            let back = row_of_fields(&csv_fields(line).unwrap()).unwrap();
+            assert_eq!(&back, want, "{line}");
+        }
+        let mut table = Vec::new();
+        write_table(&mut table, &rows).unwrap();
+        let table = String::from_utf8(table).unwrap();
+        let lines: Vec<&str> = table.lines().collect();
+        let words = |l: &str| l.split_whitespace().take(3).collect::<Vec<_>>().join(" ");
+        assert_eq!(words(lines[1]), "nishita 1e-5 22.5°", "{table}");
+        assert_eq!(words(lines[2]), "vanrij 8 gouraud", "{table}");
+        // the columns after `tess` line up
+        let at = |l: &str| l.find("gouraud").map(|b| l[..b].chars().count());
+        assert_eq!(at(lines[1]), at(lines[2]));
+        assert_eq!(
+            lines[0]
+                .find("shading")
+                .map(|b| lines[0][..b].chars().count()),
+            at(lines[1])
         );
     }
 
@@ -1988,6 +2141,7 @@ mod tests {
             shadows: "off",
             tessellate: None,
             root_tolerance: None,
+            normal_angle: None,
             numeric: "f64".into(),
             register_bits: 256,
             instructions: 0,
@@ -2128,8 +2282,20 @@ mod tests {
                     ..Axes::default()
                 },
             ),
+            (
+                "teapot",
+                &teapot,
+                Axes {
+                    world: true,
+                    size,
+                    patches: true,
+                    normal_angles: vec![None, Some(20.0)],
+                    ..Axes::default()
+                },
+            ),
         ];
         let mut abuffer = 0;
+        let mut angled = 0;
         let measured = Measured {
             image: Vec::new(),
             counters: Default::default(),
@@ -2176,6 +2342,11 @@ mod tests {
                     given.push(Flag::RootTolerance);
                     parsed.root_tolerance = t;
                 }
+                if let Some(a) = row.normal_angle {
+                    angled += 1;
+                    given.push(Flag::NormalAngle);
+                    parsed.normal_angle = Some(a);
+                }
                 // shadows printed otherwise than the scene draws them: the flag
                 if row.shadows != "-" && (row.shadows == "on") != axes.casting {
                     given.push(Flag::Shadows);
@@ -2197,6 +2368,8 @@ mod tests {
         assert!(phong > 0);
         // sbuffer's A-buffer: three shadings × the samples axis
         assert_eq!(abuffer, 3 * SAMPLES_AXIS.len());
+        // nishita's normal angle: two shadings × the root tolerances
+        assert_eq!(angled, 2 * ROOT_TOLERANCE_AXIS.len());
     }
 
     /// Phong's box filter is coverage × the centre's shade whether asked as `box` or
@@ -2443,14 +2616,15 @@ mod tests {
     fn a_textured_scene_is_measured_per_pixel_against_each_shading_s_own_best_image() {
         let rows = tradeoff_rows(
             Some(Path::new("textures4")),
-            Some(Size {
-                width: 40,
-                height: 30,
-            }),
-            &[],
-            &[],
-            &["vanrij".to_string(), "woo-chall".to_string()],
-            &[Numeric::F64],
+            &Request {
+                size: Some(Size {
+                    width: 40,
+                    height: 30,
+                }),
+                renderers: vec!["vanrij".to_string(), "woo-chall".to_string()],
+                formats: vec![Numeric::F64],
+                ..Request::default()
+            },
             &Machine::default(),
             1,
             1,

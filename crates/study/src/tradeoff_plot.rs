@@ -279,6 +279,7 @@ mod tests {
             shadows: "-",
             tessellate: Some(16),
             root_tolerance: None,
+            normal_angle: None,
             numeric: numeric.to_string(),
             register_bits: 40 + k as u32,
             instructions: 1000 + k as u64,

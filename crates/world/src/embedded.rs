@@ -51,7 +51,7 @@ pub const EMBEDDED: &[Embedded] = &[
     },
     Embedded {
         name: "teapot-floor",
-        about: "world, grey, 500×500: the teapot standing on a floor, its light casting the teapot's shadow (Nishita et al.'s §7 scene; vanrij draws the shadows, nishita refuses them on patches)",
+        about: "world, grey, 500×500: the teapot standing on a floor, its light casting the teapot's shadow (Nishita et al.'s §7 scene: nishita draws the shadows on its patches, the other renderers on the tessellation)",
         text: include_str!("../scenes/teapot-floor.json"),
     },
     Embedded {

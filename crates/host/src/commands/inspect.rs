@@ -196,7 +196,9 @@ fn draw_value(d: &DrawArgs, flag: &str) -> Result<Option<String>, ()> {
         "--unset" => name(&d.unset),
         "--root-tolerance" => num(d.root_tolerance),
         "--flatness" => num(d.flatness),
-        "--normal-angle" => d.normal_angle.and_then(num),
+        "--normal-angle" => d
+            .normal_angle
+            .map(|a| a.0.and_then(num).unwrap_or_else(|| "off".into())),
         "--band" => Some(d.band.to_string()),
         "--subscan" => Some(d.subscan.to_string()),
         "--gouraud-threshold" => Some(d.gouraud_threshold.to_string()),

@@ -5,7 +5,7 @@
 //!
 
 use super::MachineArgs;
-use crate::draw::{SbufferArg, ShadowsArg};
+use crate::draw::{angle_or_off, AngleOrOff, SbufferArg, ShadowsArg};
 use crate::error::CliError;
 use crate::files::{write_atomic, Io};
 use crate::output::write_rgb_png;
@@ -13,8 +13,8 @@ use crate::progress::Progress;
 use clap::Args;
 use cwisim_render::{Size, Source};
 use cwisim_study::tradeoff::{
-    csv, mark_pareto, measure_groups, merge_csv, name_width, write_table_header, write_table_row,
-    Plan, Shard, Step, DEFAULT_FORMATS, DEFAULT_TESSELLATIONS,
+    csv, mark_pareto, measure_groups, merge_csv, write_table_header, write_table_row, Plan,
+    Request, Shard, Step, TableLayout, DEFAULT_FORMATS, DEFAULT_TESSELLATIONS,
 };
 use cwisim_study::tradeoff_plot::render_tradeoff_plot;
 use cwisim_xproc::Numeric;
@@ -48,6 +48,11 @@ pub struct TradeoffArgs {
     /// mask per pixel, shown as `abuffer` in the aa column) [default: host].
     #[arg(long, value_enum, value_name = "SBUFFER,…", value_delimiter = ',')]
     pub sbuffer: Vec<SbufferArg>,
+    /// nishita's normal-difference subdivision (its §5) to try at every root tolerance,
+    /// comma-separated: angles in degrees and `off` (e.g. `off,20,10`; the tess column
+    /// shows the angle beside the tolerance, the CSV's `normal_angle`) [default: off].
+    #[arg(long = "normal-angle", value_name = "ANGLE|off,…", value_delimiter = ',', value_parser = angle_or_off)]
+    pub normal_angle: Vec<AngleOrOff>,
     /// The numeric formats of the array to try: repeat the flag, or separate them with
     /// `;` (a fixed format has commas of its own): f64, f32,
     /// fixed:I=M.N,dI=M.N,ddI=M.N[,acc=M.N][,overflow=wrap|saturate].
@@ -79,7 +84,7 @@ pub struct TradeoffArgs {
         long,
         value_name = "PART.csv",
         num_args = 1..,
-        conflicts_with_all = ["scene", "size", "tessellate", "shadows", "renderers", "sbuffer", "numeric", "repeat", "threads", "shard"]
+        conflicts_with_all = ["scene", "size", "tessellate", "shadows", "renderers", "sbuffer", "normal_angle", "numeric", "repeat", "threads", "shard"]
     )]
     pub merge: Vec<PathBuf>,
     /// The machine model.
@@ -125,20 +130,19 @@ pub fn run(args: &TradeoffArgs, stdout: &mut dyn Write, progress: bool) -> Resul
     };
     // rows are printed as they are measured, a progress bar on a terminal says where the
     // sweep is; the Pareto front needs every row, so it comes last
-    let width = name_width(cwisim_render::registry::REGISTRY.iter().map(|e| e.name));
     let mut bar: Option<Progress> = None;
     let mut failed: Option<std::io::Error> = None;
-    let modes: Vec<cwisim_render::settings::SbufferMode> =
-        args.sbuffer.iter().map(|&m| m.into()).collect();
-    let plan = Plan::with_sbuffer(
-        args.scene.as_deref(),
-        args.size,
-        &args.tessellate,
-        &shadows,
-        &args.renderers,
-        &formats,
-        &modes,
-    )?;
+    let request = Request {
+        size: args.size,
+        tessellations: args.tessellate.clone(),
+        shadows,
+        renderers: args.renderers.clone(),
+        formats,
+        sbuffer: args.sbuffer.iter().map(|&m| m.into()).collect(),
+        normal_angles: args.normal_angle.iter().map(|a| a.0).collect(),
+    };
+    let plan = Plan::new(args.scene.as_deref(), &request)?;
+    let layout = TableLayout::of_plan(&plan);
     let groups = match args.shard {
         Some(shard) => shard.groups(plan.groups.len()),
         None => 0..plan.groups.len(),
@@ -160,7 +164,7 @@ pub fn run(args: &TradeoffArgs, stdout: &mut dyn Write, progress: bool) -> Resul
                     skipped
                         .iter()
                         .try_for_each(|(name, why)| writeln!(stdout, "skipped {name}: {why}"))
-                        .and_then(|()| write_table_header(stdout, width))
+                        .and_then(|()| write_table_header(stdout, layout))
                 }
                 Step::Measuring { setting, .. } => {
                     // several settings may be under way: the bar counts rows printed
@@ -171,7 +175,7 @@ pub fn run(args: &TradeoffArgs, stdout: &mut dyn Write, progress: bool) -> Resul
                 }
                 Step::Measured { index, row, .. } => {
                     let mut write =
-                        || write_table_row(stdout, row, width).and_then(|()| stdout.flush());
+                        || write_table_row(stdout, row, layout).and_then(|()| stdout.flush());
                     match &mut bar {
                         Some(bar) => {
                             bar.update(index as u64 + 1);
@@ -244,10 +248,10 @@ fn merge(args: &TradeoffArgs, stdout: &mut dyn Write) -> Result<(), CliError> {
         parts.push((path.display().to_string(), text));
     }
     let (text, rows) = merge_csv(&parts)?;
-    let width = name_width(cwisim_render::registry::REGISTRY.iter().map(|e| e.name));
-    write_table_header(stdout, width).map_err(CliError::Stdout)?;
+    let layout = TableLayout::of_rows(&rows);
+    write_table_header(stdout, layout).map_err(CliError::Stdout)?;
     for row in &rows {
-        write_table_row(stdout, row, width).map_err(CliError::Stdout)?;
+        write_table_row(stdout, row, layout).map_err(CliError::Stdout)?;
     }
     writeln!(
         stdout,
@@ -271,9 +275,8 @@ fn finish(
     name: &str,
     front: bool,
 ) -> Result<(), CliError> {
-    let width = name_width(cwisim_render::registry::REGISTRY.iter().map(|e| e.name));
     if front {
-        print_front(stdout, rows, width)?;
+        print_front(stdout, rows, TableLayout::of_rows(rows))?;
     }
     let mut written = Vec::new();
     if let Some(path) = &args.csv {
@@ -298,7 +301,7 @@ fn finish(
 fn print_front(
     stdout: &mut dyn Write,
     rows: &[cwisim_study::tradeoff::Row],
-    width: usize,
+    layout: TableLayout,
 ) -> Result<(), CliError> {
     let front: Vec<_> = rows.iter().filter(|r| r.pareto).collect();
     writeln!(
@@ -309,9 +312,9 @@ all at once): {} of {} settings",
         rows.len()
     )
     .map_err(CliError::Stdout)?;
-    write_table_header(stdout, width).map_err(CliError::Stdout)?;
+    write_table_header(stdout, layout).map_err(CliError::Stdout)?;
     for row in front {
-        write_table_row(stdout, row, width).map_err(CliError::Stdout)?;
+        write_table_row(stdout, row, layout).map_err(CliError::Stdout)?;
     }
     Ok(())
 }

@@ -302,7 +302,9 @@ def _records(columns: Mapping[str, np.ndarray]) -> np.ndarray:
     return out
 
 
-def _plan_args(scene, size, tessellate, shadows, renderers, numeric, machine) -> Dict[str, Any]:
+def _plan_args(
+    scene, size, tessellate, shadows, renderers, numeric, machine, sbuffer=None, normal_angle=None
+) -> Dict[str, Any]:
     """The arguments of a tradeoff plan, as plain (picklable) Python values."""
     scene = _named(scene, "tradeoff")
     if size is not None and not isinstance(size, str):
@@ -313,6 +315,10 @@ def _plan_args(scene, size, tessellate, shadows, renderers, numeric, machine) ->
         numeric = [numeric]
     if isinstance(renderers, str):
         renderers = [renderers]
+    if isinstance(sbuffer, str):
+        sbuffer = [sbuffer]
+    if normal_angle is not None and not isinstance(normal_angle, (list, tuple)):
+        normal_angle = [normal_angle]
     return {
         "scene": scene,
         "size": size,
@@ -320,8 +326,20 @@ def _plan_args(scene, size, tessellate, shadows, renderers, numeric, machine) ->
         "shadows": [bool(v) for v in (shadows or [])],
         "renderers": list(renderers or []),
         "numeric": list(_native.default_formats() if numeric is None else numeric),
+        "sbuffer": list(sbuffer or []),
+        "normal_angle": [_angle_or_off(a) for a in (normal_angle or [])],
         "machine": _path(machine),
     }
+
+
+def _angle_or_off(value: Any) -> Optional[float]:
+    """A ``normal_angle`` value: degrees, or ``None``/``"off"`` (the test not made)."""
+    if value is None or (isinstance(value, str) and value.strip().lower() == "off"):
+        return None
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        raise UsageError(f"normal_angle: expected a number of degrees or off, found {value!r}") from None
 
 
 def tradeoff(
@@ -332,6 +350,8 @@ def tradeoff(
     shadows: Optional[Union[bool, List[bool]]] = None,
     renderers: Optional[List[str]] = None,
     numeric: Optional[Union[str, List[str]]] = None,
+    sbuffer: Optional[Union[str, List[str]]] = None,
+    normal_angle: Optional[Union[float, str, List[Optional[Union[float, str]]]]] = None,
     machine: Optional[Union[str, "os.PathLike[str]"]] = None,
     repeat: int = 3,
     threads: int = 1,
@@ -347,7 +367,11 @@ def tradeoff(
     scene's grid in turn, each row with its ``scene``, each scene's front marked among
     its own rows. The axes default to the command line's: every one-frame renderer,
     ``tessellate`` (4, 8, 16) on a scene with patches, the scene's own shadows, the five
-    default ``numeric`` formats. ``threads``: measured on that many threads in this
+    default ``numeric`` formats, ``sbuffer``'s ``host`` mode, ``nishita`` without the
+    normal-angle test. ``sbuffer``: the command line's ``--sbuffer`` (``["host",
+    "abuffer"]``: the scanline A-buffer's rows too, their ``aa`` ``"abuffer"``);
+    ``normal_angle``: its ``--normal-angle``, degrees and ``None`` (or ``"off"``) for the
+    test off (``[None, 20]``). ``threads``: measured on that many threads in this
     process. ``client``: a ``dask.distributed.Client``: each group of settings that
     shares a stream (of every scene) becomes a Dask task, run on the cluster's workers,
     and the rows gathered in the same order — equal to the local sweep's, row for row,
@@ -355,13 +379,14 @@ def tradeoff(
 
     A field that does not apply to a row is ``None``: ``aa`` (a renderer that does not
     read it), ``samples`` (one that does not supersample), ``visibility``, ``shadows``
-    (a screen scene), ``tessellate`` and ``root_tolerance``. A renderer left out of the
+    (a screen scene), ``tessellate``, ``root_tolerance`` and ``normal_angle`` (also
+    ``None`` on a ``nishita`` row without the test). A renderer left out of the
     grid (``nishita`` on a scene without Bézier patches) is a :class:`TradeoffWarning`
     saying why, as the command line's ``skipped nishita: …``.
     """
     many = isinstance(scene, (list, tuple))
     plans = [
-        _plan_args(one, size, tessellate, shadows, renderers, numeric, machine)
+        _plan_args(one, size, tessellate, shadows, renderers, numeric, machine, sbuffer, normal_angle)
         for one in (scene if many else [scene])
     ]
     native = [_native.TradeoffPlan(**args) for args in plans]
@@ -403,7 +428,8 @@ def _measured_here(plan: Any, repeat: int, threads: int) -> List[Dict[str, Any]]
 
 
 #: The fields of a tradeoff row that may not apply to its renderer or scene (the CSV's
-#: ``-``); ``None`` in Python, as ``samples``, ``tessellate`` and ``root_tolerance`` are.
+#: ``-``); ``None`` in Python, as ``samples``, ``tessellate``, ``root_tolerance`` and
+#: ``normal_angle`` are.
 NOT_APPLICABLE = ("aa", "visibility", "shadows")
 
 
