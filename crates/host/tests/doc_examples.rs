@@ -218,6 +218,8 @@ const LONG: &[&str] = &[
     "docs/HARDWARE.md: --cosim icarus --work-dir run1",
     "docs/HARDWARE.md: cwisim rtl --for pot --max-error 1/512 -o pot_xproc.v --area",
     "docs/HARDWARE.md: cwisim fit pot --max-error 1/512 --area",
+    // gouraud through the FPGA shell in Icarus: 4 s debug or release
+    "docs/HARDWARE.md: --cosim icarus --fpga-shell",
     // place and route (nextpnr-ice40): 16 processors, 20 s debug; the pot's fit and 8
     // processors, a minute
     "cwisim --help: --fpga ice40-up5k",

@@ -76,6 +76,14 @@ pub struct RtlArgs {
     /// and print the first difference or what agreed.
     #[arg(long, value_enum, value_name = "SIM", requires = "for_input")]
     pub cosim: Option<SimArg>,
+    /// With --cosim icarus: co-simulate through the FPGA's I/O shell (docs/HARDWARE.md, "The
+    /// I/O shell"): the instruction words in beats of 8 bits, each scanline out one value a
+    /// cycle, every value held to the stepped engine bit for bit and at the engine's cycle
+    /// plus the shell's fixed latency. The machine is paced for the shell's port (each
+    /// opcode's issue at least a word's beats and one cycles), and the design written is
+    /// the paced one. The overflow counts do not come out through the shell's ports.
+    #[arg(long)]
+    pub fpga_shell: bool,
     /// Keep the co-simulation's files (design, testbench, stimulus, dump) in this new
     /// directory; otherwise they go in a temporary one, kept only on a mismatch.
     #[arg(long, value_name = "DIR", requires = "cosim")]
@@ -139,6 +147,20 @@ fn fpga_stage_message(device: &fpga::Device, stage: fpga::FpgaStage) -> String {
             device.name
         ),
     }
+}
+
+/// What the `shell` line says: the shell's port, the pace it sets and its fixed latency.
+fn shell_summary(shell: &fpga::Shell, d: &Design) -> String {
+    let beats = shell.beats(d);
+    format!(
+        "instruction words of {} bits in {beats} beats of {}, every opcode's issue paced to at least {} cycles; the array's cycle 0 is the shell's {} ({} after the first word's last beat); a scanline comes out {} cycles after its Refresh reaches the last processor, one value a cycle",
+        fpga::Shell::word_bits(d),
+        shell.beat_bits,
+        beats + 1,
+        shell.start_cycle(d),
+        fpga::INPUT_LATENCY,
+        fpga::OUTPUT_LATENCY
+    )
 }
 
 /// `--cosim`.
@@ -254,6 +276,26 @@ pub(crate) fn require_tools(programs: &[&str]) -> Result<(), CliError> {
 /// Runs `cwisim rtl`.
 pub fn run(args: &RtlArgs, stdout: &mut dyn Write, progress: bool) -> Result<(), CliError> {
     crate::input::drawing_applies(&args.draw, &[args.for_input.as_deref()])?;
+    if args.fpga_shell {
+        match args.cosim {
+            Some(SimArg::Icarus) => {}
+            Some(SimArg::Verilator) => {
+                return Err(CliError::Usage(
+                    "--fpga-shell co-simulates through the shell in Icarus Verilog: give --cosim icarus (--cosim verilator co-simulates the bare array)".into(),
+                ))
+            }
+            None => {
+                return Err(CliError::Usage(
+                    "--fpga-shell says how --cosim co-simulates (through the FPGA's I/O shell): give --cosim icarus".into(),
+                ))
+            }
+        }
+        if args.watch.is_some() && args.testbench.is_none() {
+            return Err(CliError::Usage(
+                "--watch chooses the processors whose token arrivals --cosim compares; through the shell (--fpga-shell) only the scanlines come out".into(),
+            ));
+        }
+    }
     // the tools, before anything is written or drawn
     if let Some(sim) = args.cosim {
         require_tools(sim_of(sim).programs())?;
@@ -347,6 +389,13 @@ pub fn run(args: &RtlArgs, stdout: &mut dyn Write, progress: bool) -> Result<(),
         timing,
     )
     .map_err(rtl_error)?;
+    let shell = fpga::Shell::default();
+    // through the shell: the machine paced for its port, and the design with it
+    let (design, machine) = if args.fpga_shell {
+        shell.pace(&design, &machine, &header).map_err(rtl_error)?
+    } else {
+        (design, machine)
+    };
     let text = verilog::design(&design);
     write_atomic(&args.output, |w| {
         w.write_all(text.as_bytes())
@@ -399,7 +448,6 @@ pub fn run(args: &RtlArgs, stdout: &mut dyn Write, progress: bool) -> Result<(),
         };
         let dir = WorkDir::new(args.fpga_dir.as_deref(), "fpga")?;
         let stage = crate::progress::Stage::new(progress, "rtl: fpga");
-        let shell = fpga::Shell::default();
         let r = fpga::place_and_route(&placed, &shell, device, dir.path(), &mut |now| {
             stage.message(&fpga_stage_message(device, now))
         })
@@ -486,7 +534,57 @@ pub fn run(args: &RtlArgs, stdout: &mut dyn Write, progress: bool) -> Result<(),
             )?,
         }
     }
-    if let (Some(sim), Some(trace)) = (args.cosim, &trace) {
+    if let (true, Some(trace)) = (args.fpga_shell, &trace) {
+        say(out, "shell", shell_summary(&shell, &design))?;
+        let dir = WorkDir::new(args.work_dir.as_deref(), "cosim")?;
+        let stage = crate::progress::Stage::new(progress, "rtl: co-simulating");
+        let outcome = fpga::cosimulate_shell_with(
+            &design,
+            &shell,
+            &header,
+            trace,
+            &machine,
+            &fpga::Netlist::Rtl,
+            dir.path(),
+            &mut |now| stage.message(&cosim_stage_message(Simulator::Icarus, now)),
+        )
+        .map_err(rtl_error)?;
+        drop(stage);
+        match outcome.result {
+            Ok(a) => {
+                drop(dir);
+                say(
+                    out,
+                    "co-sim",
+                    format!(
+                        "icarus through the FPGA shell: identical to the stepped engine: {} scanline(s), {} value(s) bit for bit, each out at the shell's cycle {} + a + {} + k (a: the engine's cycle its Refresh reaches the last processor, k: its place in the scanline), {} cycles of the array; overflow events do not come out through the shell's ports",
+                        a.scanlines,
+                        a.values,
+                        a.start,
+                        fpga::OUTPUT_LATENCY,
+                        a.cycles
+                    ),
+                )?;
+                say(
+                    out,
+                    "times",
+                    format!(
+                        "build {:.1} s, simulation {:.1} s, stepped engine {:.1} s",
+                        outcome.build.as_secs_f64(),
+                        outcome.simulate.as_secs_f64(),
+                        outcome.reference.as_secs_f64()
+                    ),
+                )?;
+            }
+            Err(m) => {
+                let dir = dir.keep();
+                return Err(CliError::Internal(format!(
+                    "the icarus co-simulation through the FPGA shell differs from the stepped engine: {m} (files in {})",
+                    dir.display()
+                )));
+            }
+        }
+    } else if let (Some(sim), Some(trace)) = (args.cosim, &trace) {
         let sim = sim_of(sim);
         let dir = WorkDir::new(args.work_dir.as_deref(), "cosim")?;
         let stage = crate::progress::Stage::new(progress, "rtl: co-simulating");

@@ -6,6 +6,7 @@
 //! fixed latencies ([`Shell::start_cycle`], [`OUTPUT_LATENCY`]).
 
 use super::shell::{Shell, OUTPUT_LATENCY, SHELL_MODULE};
+use crate::cosim::CosimStage;
 use crate::design::Design;
 use crate::error::RtlError;
 use crate::reference::expected;
@@ -15,6 +16,7 @@ use crate::verilog::{self, Text, Watch, STIMULUS_FILE};
 use cwisim_isa::{Instruction, Opcode, TraceHeader};
 use cwisim_xproc::{Arith, FixedArith, Machine};
 use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
 
 /// The shell testbench's module.
 pub const SHELL_TESTBENCH_MODULE: &str = "cwisim_fpga_tb";
@@ -45,6 +47,21 @@ pub struct ShellAgreement {
     pub values: u64,
     /// The shell's cycle of the array's cycle 0.
     pub start: u64,
+    /// The cycles the stepped engine took (the array's).
+    pub cycles: u64,
+}
+
+/// What a co-simulation through the shell found, with its times.
+#[derive(Clone, Debug)]
+pub struct ShellOutcome {
+    /// Everything agreed, or the first difference.
+    pub result: Result<ShellAgreement, ShellMismatch>,
+    /// Time to compile the shell, the array and the testbench.
+    pub build: Duration,
+    /// Time the simulation ran.
+    pub simulate: Duration,
+    /// Time the stepped engine took.
+    pub reference: Duration,
 }
 
 /// The first difference.
@@ -193,6 +210,22 @@ pub fn cosimulate_shell(
     netlist: &Netlist,
     dir: &Path,
 ) -> Result<Result<ShellAgreement, ShellMismatch>, RtlError> {
+    cosimulate_shell_with(d, shell, header, trace, machine, netlist, dir, &mut |_| {})
+        .map(|o| o.result)
+}
+
+/// [`cosimulate_shell`] with its times, telling `stage` as each [`CosimStage`] begins.
+#[allow(clippy::too_many_arguments)]
+pub fn cosimulate_shell_with(
+    d: &Design,
+    shell: &Shell,
+    header: &TraceHeader,
+    trace: &[Instruction],
+    machine: &Machine,
+    netlist: &Netlist,
+    dir: &Path,
+    stage: &mut dyn FnMut(CosimStage),
+) -> Result<ShellOutcome, RtlError> {
     if trace.is_empty() {
         return Err(RtlError::Settings(
             "the trace is empty: nothing to co-simulate".into(),
@@ -200,21 +233,18 @@ pub fn cosimulate_shell(
     }
     let dir = &dir.canonicalize().map_err(|e| RtlError::io(dir, e))?;
     let last = d.width - 1;
+    let started = Instant::now();
+    stage(CosimStage::Reference);
     let want = expected(d, header, trace, machine, &Watch::new([last], d.width))?;
+    let reference = started.elapsed();
     if want.cycles > crate::cosim::MAX_COSIM_CYCLES {
         return Err(RtlError::Settings(format!(
-            "the co-simulation would run {} cycles, over the limit of {}",
+            "the co-simulation would run {} cycles ({} scanline(s) of the machine's line period), over the limit of {}: a lower clock_hz (--set clock_hz=…) or a shorter trace",
             want.cycles,
+            want.lines.len(),
             crate::cosim::MAX_COSIM_CYCLES
         )));
     }
-    let refreshes: Vec<usize> = trace
-        .iter()
-        .enumerate()
-        .filter(|(_, i)| i.op == Opcode::Refresh)
-        .map(|(k, _)| k)
-        .collect();
-    let arrivals = want.arrivals.get(&last).cloned().unwrap_or_default();
     let lines = want.lines.len() as u64;
     let mut stim = Vec::new();
     stimulus::write(d, header, trace, &mut stim)?;
@@ -225,6 +255,8 @@ pub fn cosimulate_shell(
         .cycles
         .saturating_mul(2)
         .saturating_add(1000 + 4 * u64::from(shell.beats(d)) * trace.len() as u64);
+    let started = Instant::now();
+    stage(CosimStage::Build);
     let mut sources: Vec<String> = vec!["tb.v".into()];
     match netlist {
         Netlist::Rtl => {
@@ -267,11 +299,44 @@ pub fn cosimulate_shell(
     args.extend(sources);
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
     run("iverilog", &args, dir)?;
+    let build = started.elapsed();
+    let started = Instant::now();
+    stage(CosimStage::Simulate {
+        cycles: want.cycles,
+    });
     run("vvp", &["-n", "shell.vvp"], dir)?;
-    let path = dir.join(SHELL_DUMP_FILE);
-    let text = std::fs::read_to_string(&path).map_err(|source| RtlError::NoOutput {
+    let simulate = started.elapsed();
+    stage(CosimStage::Compare);
+    let result = compare_dump(d, shell, trace, &want, &dir.join(SHELL_DUMP_FILE))?;
+    Ok(ShellOutcome {
+        result,
+        build,
+        simulate,
+        reference,
+    })
+}
+
+/// The shell testbench's dump at `path` held to the stepped engine's `want`: every value
+/// bit for bit, each at its cycle.
+fn compare_dump(
+    d: &Design,
+    shell: &Shell,
+    trace: &[Instruction],
+    want: &crate::reference::Expected,
+    path: &Path,
+) -> Result<Result<ShellAgreement, ShellMismatch>, RtlError> {
+    let last = d.width - 1;
+    let refreshes: Vec<usize> = trace
+        .iter()
+        .enumerate()
+        .filter(|(_, i)| i.op == Opcode::Refresh)
+        .map(|(k, _)| k)
+        .collect();
+    let arrivals = want.arrivals.get(&last).cloned().unwrap_or_default();
+    let lines = want.lines.len() as u64;
+    let text = std::fs::read_to_string(path).map_err(|source| RtlError::NoOutput {
         tool: "vvp".into(),
-        path: path.clone(),
+        path: path.to_path_buf(),
         source,
     })?;
     let arith = FixedArith::new(&d.format)?;
@@ -354,5 +419,6 @@ pub fn cosimulate_shell(
         scanlines: lines,
         values: got.len() as u64,
         start,
+        cycles: want.cycles,
     }))
 }

@@ -10,7 +10,9 @@ pub mod device;
 pub mod report;
 pub mod shell;
 
-pub use cosim::{cosimulate_shell, Netlist, ShellAgreement, ShellMismatch};
+pub use cosim::{
+    cosimulate_shell, cosimulate_shell_with, Netlist, ShellAgreement, ShellMismatch, ShellOutcome,
+};
 pub use device::{device, devices, Device};
 pub use report::{Cells, Hierarchy, Pnr};
 pub use shell::{Shell, INPUT_LATENCY, OUTPUT_LATENCY, SHELL_MODULE};

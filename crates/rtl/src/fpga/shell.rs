@@ -23,7 +23,8 @@
 //! operands the design carries, in the array's own formats (what [`crate::stimulus`]
 //! writes).
 
-use crate::design::{bits_for, Design};
+use crate::design::{bits_for, BusTiming, Design};
+use crate::error::RtlError;
 use crate::verilog::{Text, ARRAY_MODULE};
 use cwisim_xproc::Register;
 
@@ -104,6 +105,20 @@ impl Shell {
             m.opcode_cycles.set(*op, c.max(cycles));
         }
         m
+    }
+
+    /// Design `d` (of a stream with `header`) and `machine` paced for the shell's port
+    /// ([`Shell::paced`]): the machine, and the design with the bus timing it gives.
+    pub fn pace(
+        &self,
+        d: &Design,
+        machine: &cwisim_xproc::Machine,
+        header: &cwisim_isa::TraceHeader,
+    ) -> Result<(Design, cwisim_xproc::Machine), RtlError> {
+        let machine = self.paced(d, machine);
+        let timing = BusTiming::new(&machine, header)?;
+        let paced = Design::new(d.format, d.opcodes.clone(), d.width, d.channels, timing)?;
+        Ok((paced, machine))
     }
 
     /// Bits of one output value (the accumulator's format).
