@@ -59,6 +59,8 @@ fn the_verilog_is_deterministic_and_follows_the_settings() {
 #[test]
 fn bad_settings_are_one_line_errors_and_write_nothing() {
     let dir = scratch("rtl-errors");
+    let g = trace("gouraud.cwt");
+    let gouraud = ["rtl", "--for", &g, "--numeric", FORMAT, "-o", "x.v"];
     for (args, wants) in [
         (
             vec!["rtl", "--numeric", "f32", "-o", "x.v"],
@@ -94,48 +96,19 @@ fn bad_settings_are_one_line_errors_and_write_nothing() {
             "unknown FPGA `ice40-hx9k`: the known ones are ice40-hx1k, ice40-hx8k, ice40-up5k",
         ),
         (
-            vec![
-                "rtl",
-                "--for",
-                &trace("gouraud.cwt"),
-                "--numeric",
-                FORMAT,
-                "-o",
-                "x.v",
-                "--fpga-shell",
-            ],
+            [&gouraud[..], &["--fpga-shell"]].concat(),
             "--fpga-shell says how --cosim co-simulates",
         ),
         (
-            vec![
-                "rtl",
-                "--for",
-                &trace("gouraud.cwt"),
-                "--numeric",
-                FORMAT,
-                "-o",
-                "x.v",
-                "--cosim",
-                "verilator",
-                "--fpga-shell",
-            ],
+            [&gouraud[..], &["--cosim", "verilator", "--fpga-shell"]].concat(),
             "give --cosim icarus",
         ),
         (
-            vec![
-                "rtl",
-                "--for",
-                &trace("gouraud.cwt"),
-                "--numeric",
-                FORMAT,
-                "-o",
-                "x.v",
-                "--cosim",
-                "icarus",
-                "--fpga-shell",
-                "--watch",
-                "0",
-            ],
+            [
+                &gouraud[..],
+                &["--cosim", "icarus", "--fpga-shell", "--watch", "0"],
+            ]
+            .concat(),
             "only the scanlines come out",
         ),
     ] {

@@ -534,106 +534,89 @@ pub fn run(args: &RtlArgs, stdout: &mut dyn Write, progress: bool) -> Result<(),
             )?,
         }
     }
-    if let (true, Some(trace)) = (args.fpga_shell, &trace) {
-        say(out, "shell", shell_summary(&shell, &design))?;
-        let dir = WorkDir::new(args.work_dir.as_deref(), "cosim")?;
-        let stage = crate::progress::Stage::new(progress, "rtl: co-simulating");
-        let outcome = fpga::cosimulate_shell_with(
-            &design,
-            &shell,
-            &header,
-            trace,
-            &machine,
-            &fpga::Netlist::Rtl,
-            dir.path(),
-            &mut |now| stage.message(&cosim_stage_message(Simulator::Icarus, now)),
-        )
-        .map_err(rtl_error)?;
-        drop(stage);
-        match outcome.result {
-            Ok(a) => {
-                drop(dir);
-                say(
-                    out,
-                    "co-sim",
-                    format!(
-                        "icarus through the FPGA shell: identical to the stepped engine: {} scanline(s), {} value(s) bit for bit, each out at the shell's cycle {} + a + {} + k (a: the engine's cycle its Refresh reaches the last processor, k: its place in the scanline), {} cycles of the array; overflow events do not come out through the shell's ports",
-                        a.scanlines,
-                        a.values,
-                        a.start,
-                        fpga::OUTPUT_LATENCY,
-                        a.cycles
-                    ),
-                )?;
-                say(
-                    out,
-                    "times",
-                    format!(
-                        "build {:.1} s, simulation {:.1} s, stepped engine {:.1} s",
-                        outcome.build.as_secs_f64(),
-                        outcome.simulate.as_secs_f64(),
-                        outcome.reference.as_secs_f64()
-                    ),
-                )?;
-            }
-            Err(m) => {
-                let dir = dir.keep();
-                return Err(CliError::Internal(format!(
-                    "the icarus co-simulation through the FPGA shell differs from the stepped engine: {m} (files in {})",
-                    dir.display()
-                )));
-            }
-        }
-    } else if let (Some(sim), Some(trace)) = (args.cosim, &trace) {
+    if let (Some(sim), Some(trace)) = (args.cosim, &trace) {
         let sim = sim_of(sim);
+        if args.fpga_shell {
+            say(out, "shell", shell_summary(&shell, &design))?;
+        }
         let dir = WorkDir::new(args.work_dir.as_deref(), "cosim")?;
         let stage = crate::progress::Stage::new(progress, "rtl: co-simulating");
-        let outcome = cosimulate_with(
-            &design,
-            &header,
-            trace,
-            &machine,
-            &watch,
-            sim,
-            dir.path(),
-            &mut |now| stage.message(&cosim_stage_message(sim, now)),
-        )
-        .map_err(rtl_error)?;
+        let tell = &mut |now| stage.message(&cosim_stage_message(sim, now));
+        // what agreed or the first difference, and the times: build, simulation, engine
+        let (result, times) = if args.fpga_shell {
+            let o = fpga::cosimulate_shell_with(
+                &design,
+                &shell,
+                &header,
+                trace,
+                &machine,
+                &fpga::Netlist::Rtl,
+                dir.path(),
+                tell,
+            )
+            .map_err(rtl_error)?;
+            let result = o.result.map(|a| format!(
+                "icarus through the FPGA shell: identical to the stepped engine: {} scanline(s), {} value(s) bit for bit, each out at the shell's cycle {} + a + {} + k (a: the engine's cycle its Refresh reaches the last processor, k: its place in the scanline), {} cycles of the array; overflow events do not come out through the shell's ports",
+                a.scanlines,
+                a.values,
+                a.start,
+                fpga::OUTPUT_LATENCY,
+                a.cycles
+            ));
+            (
+                result.map_err(|m| m.to_string()),
+                [o.build, o.simulate, o.reference],
+            )
+        } else {
+            let o = cosimulate_with(
+                &design,
+                &header,
+                trace,
+                &machine,
+                &watch,
+                sim,
+                dir.path(),
+                tell,
+            )
+            .map_err(rtl_error)?;
+            let result = o.result.map(|a| format!(
+                "{}: identical to the stepped engine: {} scanline(s), {} value(s) bit for bit, {} token arrival(s) at {} watched processor(s), {} overflow event(s) ({} in the adders), {} cycles",
+                sim.name(),
+                a.scanlines,
+                a.values,
+                a.arrivals,
+                watch.processors().len(),
+                a.overflows,
+                a.adder_overflows,
+                a.cycles
+            ));
+            (
+                result.map_err(|m| m.to_string()),
+                [o.build, o.simulate, o.reference],
+            )
+        };
         drop(stage);
-        match outcome.result {
-            Ok(a) => {
+        match result {
+            Ok(agreed) => {
                 drop(dir);
-                say(
-                    out,
-                    "co-sim",
-                    format!(
-                        "{}: identical to the stepped engine: {} scanline(s), {} value(s) bit for bit, {} token arrival(s) at {} watched processor(s), {} overflow event(s) ({} in the adders), {} cycles",
-                        sim.name(),
-                        a.scanlines,
-                        a.values,
-                        a.arrivals,
-                        watch.processors().len(),
-                        a.overflows,
-                        a.adder_overflows,
-                        a.cycles
-                    ),
-                )?;
+                say(out, "co-sim", agreed)?;
+                let [build, simulate, reference] = times.map(|t| t.as_secs_f64());
                 say(
                     out,
                     "times",
-                    format!(
-                        "build {:.1} s, simulation {:.1} s, stepped engine {:.1} s",
-                        outcome.build.as_secs_f64(),
-                        outcome.simulate.as_secs_f64(),
-                        outcome.reference.as_secs_f64()
-                    ),
+                    format!("build {build:.1} s, simulation {simulate:.1} s, stepped engine {reference:.1} s"),
                 )?;
             }
             Err(m) => {
                 // kept, for a look
                 let dir = dir.keep();
+                let through = if args.fpga_shell {
+                    " through the FPGA shell"
+                } else {
+                    ""
+                };
                 return Err(CliError::Internal(format!(
-                    "the {} co-simulation differs from the stepped engine: {m} (files in {})",
+                    "the {} co-simulation{through} differs from the stepped engine: {m} (files in {})",
                     sim.name(),
                     dir.display()
                 )));

@@ -6,14 +6,15 @@
 //! fixed latencies ([`Shell::start_cycle`], [`OUTPUT_LATENCY`]).
 
 use super::shell::{Shell, OUTPUT_LATENCY, SHELL_MODULE};
+use crate::compare::{refresh_indices, sign_extend};
 use crate::cosim::CosimStage;
 use crate::design::Design;
 use crate::error::RtlError;
 use crate::reference::expected;
 use crate::stimulus;
-use crate::tools::run;
-use crate::verilog::{self, Text, Watch, STIMULUS_FILE};
-use cwisim_isa::{Instruction, Opcode, TraceHeader};
+use crate::tools::{run, write_file};
+use crate::verilog::{self, bench, Text, Watch, STIMULUS_FILE};
+use cwisim_isa::{Instruction, TraceHeader};
 use cwisim_xproc::{Arith, FixedArith, Machine};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -85,28 +86,14 @@ pub fn testbench(d: &Design, shell: &Shell, lines: u64) -> String {
         "Testbench of the CWI X-processor array through its FPGA shell",
     );
     v.line("`timescale 1ns / 1ns");
-    let fields = Shell::word_fields(d);
-    let mut reads: Vec<u32> = Vec::new();
-    for (name, bits) in &fields {
-        let per = match name.as_str() {
-            "op" | "x" | "dx" => 1,
-            _ => d.channels as u32,
-        };
-        for _ in 0..per {
-            reads.push(bits / per);
-        }
-    }
+    let reads: Vec<u32> = bench::stimulus_words(d).iter().map(|w| w.1).collect();
     let b = shell.beat_bits;
     let k = shell.beats(d);
     let wa = Shell::value_bits(d);
     v.line(&format!("module {SHELL_TESTBENCH_MODULE};"));
-    v.line("    parameter INSTRUCTIONS = 1;");
-    v.line("    parameter CYCLE_LIMIT = 1000;");
-    v.line(&format!("    localparam integer FIELDS = {};", reads.len()));
+    bench::stimulus_parameters(&mut v, reads.len());
     v.line(&format!("    localparam integer LINES = {lines};"));
-    v.line("    reg clk = 1'b0;");
-    v.line("    reg rst = 1'b1;");
-    v.line("    always #5 clk = ~clk;");
+    bench::clock_and_reset(&mut v);
     v.line(&format!("    reg [{}:0] s_data = {b}'d0;", b - 1));
     v.line("    reg s_valid = 1'b0;");
     v.line("    wire s_ready;");
@@ -170,31 +157,11 @@ pub fn testbench(d: &Design, shell: &Shell, lines: u64) -> String {
     v.line("            $fwrite(dump, \"R %0d\\n\", cycle);");
     v.line("            overrun_seen = 1'b1;");
     v.line("        end");
-    v.line("        if (done == LINES) begin");
-    v.line("            $fwrite(dump, \"E %0d\\n\", cycle);");
-    v.line("            $fclose(dump);");
-    v.line("            $finish;");
-    v.line("        end");
-    v.line("        if (cycle >= CYCLE_LIMIT) begin");
-    v.line("            $fwrite(dump, \"T %0d\\n\", cycle);");
-    v.line("            $fclose(dump);");
-    v.line("            $finish;");
-    v.line("        end");
+    bench::finish_when(&mut v, "done == LINES", 'E');
+    bench::finish_when(&mut v, "cycle >= CYCLE_LIMIT", 'T');
     v.line("    end");
     v.line("endmodule");
     v.into_string()
-}
-
-fn write_file(path: &Path, text: &str) -> Result<(), RtlError> {
-    std::fs::write(path, text).map_err(|e| RtlError::io(path, e))
-}
-
-fn sign_extend(x: u64, bits: u32) -> i64 {
-    if bits >= 64 {
-        return x as i64;
-    }
-    let shift = 64 - bits;
-    ((x << shift) as i64) >> shift
 }
 
 /// Streams `trace` through the shell of design `d` in Icarus Verilog (the RTL, or the
@@ -326,12 +293,7 @@ fn compare_dump(
     path: &Path,
 ) -> Result<Result<ShellAgreement, ShellMismatch>, RtlError> {
     let last = d.width - 1;
-    let refreshes: Vec<usize> = trace
-        .iter()
-        .enumerate()
-        .filter(|(_, i)| i.op == Opcode::Refresh)
-        .map(|(k, _)| k)
-        .collect();
+    let refreshes = refresh_indices(trace);
     let arrivals = want.arrivals.get(&last).cloned().unwrap_or_default();
     let lines = want.lines.len() as u64;
     let text = std::fs::read_to_string(path).map_err(|source| RtlError::NoOutput {
