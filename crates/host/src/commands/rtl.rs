@@ -73,7 +73,8 @@ pub struct RtlArgs {
     #[arg(long, value_name = "TB.v")]
     pub testbench: Option<PathBuf>,
     /// Co-simulate the --for trace or scene in this simulator against the stepped engine,
-    /// and print the first difference or what agreed.
+    /// and print the first difference or what agreed (with --fpga-shell: through the
+    /// FPGA's I/O shell).
     #[arg(long, value_enum, value_name = "SIM", requires = "for_input")]
     pub cosim: Option<SimArg>,
     /// With --cosim icarus: co-simulate through the FPGA's I/O shell (docs/HARDWARE.md, "The
