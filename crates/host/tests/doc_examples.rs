@@ -218,11 +218,16 @@ const LONG: &[&str] = &[
     "docs/HARDWARE.md: --cosim icarus --work-dir run1",
     "docs/HARDWARE.md: cwisim rtl --for pot --max-error 1/512 -o pot_xproc.v --area",
     "docs/HARDWARE.md: cwisim fit pot --max-error 1/512 --area",
+    // gouraud through the FPGA shell in Icarus: 4 s debug, 2 s release
+    "docs/HARDWARE.md: --cosim icarus --fpga-shell",
     // place and route (nextpnr-ice40): 16 processors, 20 s debug; the pot's fit and 8
     // processors, a minute
     "cwisim --help: --fpga ice40-up5k",
     "docs/HARDWARE.md: --fpga ice40-up5k",
     "docs/HARDWARE.md: --fpga ice40-hx8k",
+    // the FPGA table: four scenes on two devices, eight place-and-routes, 3 min 23 s
+    // release (needs CWISIM_EXAMPLES_DIR too)
+    "docs/HARDWARE.md: --example fpga_table",
 ];
 
 /// Whether a command of a document is [`LONG`].
@@ -1101,6 +1106,9 @@ impl Runner {
                     "an example whose output the document shows: CWISIM_EXAMPLES_DIR (the built release examples, as .ci/run sets it) runs it",
                 );
             };
+            if long_entry(&self.name, &code).is_some() && !long_examples() {
+                return self.skip(u, "long: CWISIM_LONG_EXAMPLES=1 runs it");
+            }
             let Some(code) = example_command(&code, Path::new(&dir)) else {
                 self.failures.push(format!(
                     "{}: not `cargo run --release -p PACKAGE --example NAME [-- ARGS]`: {}",

@@ -59,6 +59,8 @@ fn the_verilog_is_deterministic_and_follows_the_settings() {
 #[test]
 fn bad_settings_are_one_line_errors_and_write_nothing() {
     let dir = scratch("rtl-errors");
+    let g = trace("gouraud.cwt");
+    let gouraud = ["rtl", "--for", &g, "--numeric", FORMAT, "-o", "x.v"];
     for (args, wants) in [
         (
             vec!["rtl", "--numeric", "f32", "-o", "x.v"],
@@ -92,6 +94,22 @@ fn bad_settings_are_one_line_errors_and_write_nothing() {
                 "ice40-hx9k",
             ],
             "unknown FPGA `ice40-hx9k`: the known ones are ice40-hx1k, ice40-hx8k, ice40-up5k",
+        ),
+        (
+            [&gouraud[..], &["--fpga-shell"]].concat(),
+            "--fpga-shell says how --cosim co-simulates",
+        ),
+        (
+            [&gouraud[..], &["--cosim", "verilator", "--fpga-shell"]].concat(),
+            "give --cosim icarus",
+        ),
+        (
+            [
+                &gouraud[..],
+                &["--cosim", "icarus", "--fpga-shell", "--watch", "0"],
+            ]
+            .concat(),
+            "only the scanlines come out",
         ),
     ] {
         let out = cwisim(&dir, &args);
@@ -143,6 +161,71 @@ fn a_trace_co_simulates_identically_in_icarus() {
     for f in ["design.v", "testbench.v", "stimulus.hex", "dump.txt"] {
         assert!(dir.join("run").join(f).is_file(), "{f}");
     }
+}
+
+#[test]
+fn a_trace_co_simulates_through_the_fpga_shell_at_its_latency() {
+    if std::env::var("CWISIM_SKIP_HDL_TESTS").is_ok_and(|v| v == "1") {
+        eprintln!("SKIPPED: cwisim rtl --cosim icarus --fpga-shell (CWISIM_SKIP_HDL_TESTS=1)");
+        return;
+    }
+    let dir = scratch("rtl-cosim-shell");
+    let args = |out: &'static str| {
+        vec![
+            "rtl".to_string(),
+            "--for".into(),
+            trace("gouraud.cwt"),
+            "--numeric".into(),
+            FORMAT.into(),
+            "-o".into(),
+            out.into(),
+            "--cosim".into(),
+            "icarus".into(),
+        ]
+    };
+    let mut shell = args("s.v");
+    shell.extend(["--fpga-shell".into(), "--work-dir".into(), "run".into()]);
+    let shell: Vec<&str> = shell.iter().map(String::as_str).collect();
+    let out = cwisim(&dir, &shell);
+    let (stdout, stderr) = text(&out);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{stderr} (the HDL tools: crates/rtl/tools/install-hdl.sh, or CWISIM_SKIP_HDL_TESTS=1)"
+    );
+    let line = |label: &str| {
+        stdout
+            .lines()
+            .find(|l| l.starts_with(label))
+            .unwrap_or_else(|| panic!("no {label} line: {stdout}"))
+            .to_string()
+    };
+    let words = line("shell");
+    assert!(words.contains("beats of 8"), "{words}");
+    let cosim = line("co-sim");
+    assert!(
+        cosim.contains("icarus through the FPGA shell: identical to the stepped engine: 6 scanline(s), 96 value(s) bit for bit"),
+        "{cosim}"
+    );
+    assert!(
+        cosim.contains("overflow events do not come out through the shell's ports"),
+        "{cosim}"
+    );
+    for f in [
+        "design.v",
+        "shell.v",
+        "tb.v",
+        "stimulus.hex",
+        "shell_dump.txt",
+    ] {
+        assert!(dir.join("run").join(f).is_file(), "{f}");
+    }
+    // the machine is paced for the port: the design written differs from the bare one's
+    let plain = args("p.v");
+    let plain: Vec<&str> = plain.iter().map(String::as_str).collect();
+    let bare = cwisim_ok(&dir, &plain);
+    assert!(!bare.contains("through the FPGA shell"), "{bare}");
+    assert_ne!(read(dir.join("s.v")), read(dir.join("p.v")));
 }
 
 #[test]

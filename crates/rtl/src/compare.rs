@@ -82,8 +82,18 @@ fn line_of(trace: &[Instruction]) -> Vec<u64> {
         .collect()
 }
 
+/// The indices of `trace`'s Refresh instructions: scanline `n`'s is the `n`-th.
+pub(crate) fn refresh_indices(trace: &[Instruction]) -> Vec<usize> {
+    trace
+        .iter()
+        .enumerate()
+        .filter(|(_, i)| i.op == Opcode::Refresh)
+        .map(|(k, _)| k)
+        .collect()
+}
+
 /// `x`'s low `bits` bits as a two's-complement number.
-fn sign_extend(x: u64, bits: u32) -> i64 {
+pub(crate) fn sign_extend(x: u64, bits: u32) -> i64 {
     if bits >= 64 {
         x as i64
     } else {
@@ -141,12 +151,7 @@ pub fn compare(
     // the scanlines, processor by processor
     let c_n = d.channels;
     let wa = d.bits(Register::Acc);
-    let refreshes: Vec<usize> = trace
-        .iter()
-        .enumerate()
-        .filter(|(_, i)| i.op == Opcode::Refresh)
-        .map(|(k, _)| k)
-        .collect();
+    let refreshes = refresh_indices(trace);
     let mut values = 0u64;
     for p in 0..d.width {
         let got = observed.outputs.get(&p).map(Vec::as_slice).unwrap_or(&[]);

@@ -8,7 +8,7 @@ use crate::dump;
 use crate::error::RtlError;
 use crate::reference::expected;
 use crate::stimulus;
-use crate::tools::run;
+use crate::tools::{run, write_file};
 use crate::verilog::{self, Watch, DUMP_FILE, STIMULUS_FILE, TESTBENCH_MODULE};
 use cwisim_isa::{Instruction, TraceHeader};
 use cwisim_xproc::Machine;
@@ -54,10 +54,6 @@ pub struct Outcome {
     pub simulate: Duration,
     /// Time the stepped engine took.
     pub reference: Duration,
-}
-
-fn write_file(path: &Path, text: &str) -> Result<(), RtlError> {
-    std::fs::write(path, text).map_err(|e| RtlError::io(path, e))
 }
 
 /// The most cycles a co-simulation may run: the simulators step every cycle, idle ones

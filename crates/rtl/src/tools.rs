@@ -153,3 +153,8 @@ pub fn lint(design: &Path, top: &str) -> Result<Vec<String>, RtlError> {
     }
     Ok(warnings)
 }
+
+/// Writes `text` to `path`, an error naming the file.
+pub(crate) fn write_file(path: &Path, text: &str) -> Result<(), RtlError> {
+    std::fs::write(path, text).map_err(|e| RtlError::io(path, e))
+}

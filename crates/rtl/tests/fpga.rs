@@ -20,10 +20,8 @@ fn paced(
     instrs: &[cwisim_isa::Instruction],
     shell: &Shell,
 ) -> (cwisim_rtl::Design, Machine) {
-    let machine = base;
-    let d = design_for(format(fmt), header, instrs, &machine);
-    let machine = shell.paced(&d, &machine);
-    (design_for(format(fmt), header, instrs, &machine), machine)
+    let d = design_for(format(fmt), header, instrs, &base);
+    shell.pace(&d, &base, header).unwrap()
 }
 
 fn shell_cosim(name: &str, fmt: &str, shell: &Shell) -> fpga::ShellAgreement {

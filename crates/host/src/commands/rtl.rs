@@ -73,9 +73,18 @@ pub struct RtlArgs {
     #[arg(long, value_name = "TB.v")]
     pub testbench: Option<PathBuf>,
     /// Co-simulate the --for trace or scene in this simulator against the stepped engine,
-    /// and print the first difference or what agreed.
+    /// and print the first difference or what agreed (with --fpga-shell: through the
+    /// FPGA's I/O shell).
     #[arg(long, value_enum, value_name = "SIM", requires = "for_input")]
     pub cosim: Option<SimArg>,
+    /// With --cosim icarus: co-simulate through the FPGA's I/O shell (docs/HARDWARE.md, "The
+    /// I/O shell"): the instruction words in beats of 8 bits, each scanline out one value a
+    /// cycle, every value held to the stepped engine bit for bit and at the engine's cycle
+    /// plus the shell's fixed latency. The machine is paced for the shell's port (each
+    /// opcode's issue at least a word's beats and one cycles), and the design written is
+    /// the paced one. The overflow counts do not come out through the shell's ports.
+    #[arg(long)]
+    pub fpga_shell: bool,
     /// Keep the co-simulation's files (design, testbench, stimulus, dump) in this new
     /// directory; otherwise they go in a temporary one, kept only on a mismatch.
     #[arg(long, value_name = "DIR", requires = "cosim")]
@@ -139,6 +148,20 @@ fn fpga_stage_message(device: &fpga::Device, stage: fpga::FpgaStage) -> String {
             device.name
         ),
     }
+}
+
+/// What the `shell` line says: the shell's port, the pace it sets and its fixed latency.
+fn shell_summary(shell: &fpga::Shell, d: &Design) -> String {
+    let beats = shell.beats(d);
+    format!(
+        "instruction words of {} bits in {beats} beats of {}, every opcode's issue paced to at least {} cycles; the array's cycle 0 is the shell's {} ({} after the first word's last beat); a scanline comes out {} cycles after its Refresh reaches the last processor, one value a cycle",
+        fpga::Shell::word_bits(d),
+        shell.beat_bits,
+        beats + 1,
+        shell.start_cycle(d),
+        fpga::INPUT_LATENCY,
+        fpga::OUTPUT_LATENCY
+    )
 }
 
 /// `--cosim`.
@@ -254,6 +277,26 @@ pub(crate) fn require_tools(programs: &[&str]) -> Result<(), CliError> {
 /// Runs `cwisim rtl`.
 pub fn run(args: &RtlArgs, stdout: &mut dyn Write, progress: bool) -> Result<(), CliError> {
     crate::input::drawing_applies(&args.draw, &[args.for_input.as_deref()])?;
+    if args.fpga_shell {
+        match args.cosim {
+            Some(SimArg::Icarus) => {}
+            Some(SimArg::Verilator) => {
+                return Err(CliError::Usage(
+                    "--fpga-shell co-simulates through the shell in Icarus Verilog: give --cosim icarus (--cosim verilator co-simulates the bare array)".into(),
+                ))
+            }
+            None => {
+                return Err(CliError::Usage(
+                    "--fpga-shell says how --cosim co-simulates (through the FPGA's I/O shell): give --cosim icarus".into(),
+                ))
+            }
+        }
+        if args.watch.is_some() && args.testbench.is_none() {
+            return Err(CliError::Usage(
+                "--watch chooses the processors whose token arrivals --cosim compares; through the shell (--fpga-shell) only the scanlines come out".into(),
+            ));
+        }
+    }
     // the tools, before anything is written or drawn
     if let Some(sim) = args.cosim {
         require_tools(sim_of(sim).programs())?;
@@ -347,6 +390,13 @@ pub fn run(args: &RtlArgs, stdout: &mut dyn Write, progress: bool) -> Result<(),
         timing,
     )
     .map_err(rtl_error)?;
+    let shell = fpga::Shell::default();
+    // through the shell: the machine paced for its port, and the design with it
+    let (design, machine) = if args.fpga_shell {
+        shell.pace(&design, &machine, &header).map_err(rtl_error)?
+    } else {
+        (design, machine)
+    };
     let text = verilog::design(&design);
     write_atomic(&args.output, |w| {
         w.write_all(text.as_bytes())
@@ -399,7 +449,6 @@ pub fn run(args: &RtlArgs, stdout: &mut dyn Write, progress: bool) -> Result<(),
         };
         let dir = WorkDir::new(args.fpga_dir.as_deref(), "fpga")?;
         let stage = crate::progress::Stage::new(progress, "rtl: fpga");
-        let shell = fpga::Shell::default();
         let r = fpga::place_and_route(&placed, &shell, device, dir.path(), &mut |now| {
             stage.message(&fpga_stage_message(device, now))
         })
@@ -488,54 +537,87 @@ pub fn run(args: &RtlArgs, stdout: &mut dyn Write, progress: bool) -> Result<(),
     }
     if let (Some(sim), Some(trace)) = (args.cosim, &trace) {
         let sim = sim_of(sim);
+        if args.fpga_shell {
+            say(out, "shell", shell_summary(&shell, &design))?;
+        }
         let dir = WorkDir::new(args.work_dir.as_deref(), "cosim")?;
         let stage = crate::progress::Stage::new(progress, "rtl: co-simulating");
-        let outcome = cosimulate_with(
-            &design,
-            &header,
-            trace,
-            &machine,
-            &watch,
-            sim,
-            dir.path(),
-            &mut |now| stage.message(&cosim_stage_message(sim, now)),
-        )
-        .map_err(rtl_error)?;
+        let tell = &mut |now| stage.message(&cosim_stage_message(sim, now));
+        // what agreed or the first difference, and the times: build, simulation, engine
+        let (result, times) = if args.fpga_shell {
+            let o = fpga::cosimulate_shell_with(
+                &design,
+                &shell,
+                &header,
+                trace,
+                &machine,
+                &fpga::Netlist::Rtl,
+                dir.path(),
+                tell,
+            )
+            .map_err(rtl_error)?;
+            let result = o.result.map(|a| format!(
+                "icarus through the FPGA shell: identical to the stepped engine: {} scanline(s), {} value(s) bit for bit, each out at the shell's cycle {} + a + {} + k (a: the engine's cycle its Refresh reaches the last processor, k: its place in the scanline), {} cycles of the array; overflow events do not come out through the shell's ports",
+                a.scanlines,
+                a.values,
+                a.start,
+                fpga::OUTPUT_LATENCY,
+                a.cycles
+            ));
+            (
+                result.map_err(|m| m.to_string()),
+                [o.build, o.simulate, o.reference],
+            )
+        } else {
+            let o = cosimulate_with(
+                &design,
+                &header,
+                trace,
+                &machine,
+                &watch,
+                sim,
+                dir.path(),
+                tell,
+            )
+            .map_err(rtl_error)?;
+            let result = o.result.map(|a| format!(
+                "{}: identical to the stepped engine: {} scanline(s), {} value(s) bit for bit, {} token arrival(s) at {} watched processor(s), {} overflow event(s) ({} in the adders), {} cycles",
+                sim.name(),
+                a.scanlines,
+                a.values,
+                a.arrivals,
+                watch.processors().len(),
+                a.overflows,
+                a.adder_overflows,
+                a.cycles
+            ));
+            (
+                result.map_err(|m| m.to_string()),
+                [o.build, o.simulate, o.reference],
+            )
+        };
         drop(stage);
-        match outcome.result {
-            Ok(a) => {
+        match result {
+            Ok(agreed) => {
                 drop(dir);
-                say(
-                    out,
-                    "co-sim",
-                    format!(
-                        "{}: identical to the stepped engine: {} scanline(s), {} value(s) bit for bit, {} token arrival(s) at {} watched processor(s), {} overflow event(s) ({} in the adders), {} cycles",
-                        sim.name(),
-                        a.scanlines,
-                        a.values,
-                        a.arrivals,
-                        watch.processors().len(),
-                        a.overflows,
-                        a.adder_overflows,
-                        a.cycles
-                    ),
-                )?;
+                say(out, "co-sim", agreed)?;
+                let [build, simulate, reference] = times.map(|t| t.as_secs_f64());
                 say(
                     out,
                     "times",
-                    format!(
-                        "build {:.1} s, simulation {:.1} s, stepped engine {:.1} s",
-                        outcome.build.as_secs_f64(),
-                        outcome.simulate.as_secs_f64(),
-                        outcome.reference.as_secs_f64()
-                    ),
+                    format!("build {build:.1} s, simulation {simulate:.1} s, stepped engine {reference:.1} s"),
                 )?;
             }
             Err(m) => {
                 // kept, for a look
                 let dir = dir.keep();
+                let through = if args.fpga_shell {
+                    " through the FPGA shell"
+                } else {
+                    ""
+                };
                 return Err(CliError::Internal(format!(
-                    "the {} co-simulation differs from the stepped engine: {m} (files in {})",
+                    "the {} co-simulation{through} differs from the stepped engine: {m} (files in {})",
                     sim.name(),
                     dir.display()
                 )));

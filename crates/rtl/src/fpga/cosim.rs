@@ -6,15 +6,18 @@
 //! fixed latencies ([`Shell::start_cycle`], [`OUTPUT_LATENCY`]).
 
 use super::shell::{Shell, OUTPUT_LATENCY, SHELL_MODULE};
+use crate::compare::{refresh_indices, sign_extend};
+use crate::cosim::CosimStage;
 use crate::design::Design;
 use crate::error::RtlError;
 use crate::reference::expected;
 use crate::stimulus;
-use crate::tools::run;
-use crate::verilog::{self, Text, Watch, STIMULUS_FILE};
-use cwisim_isa::{Instruction, Opcode, TraceHeader};
+use crate::tools::{run, write_file};
+use crate::verilog::{self, bench, Text, Watch, STIMULUS_FILE};
+use cwisim_isa::{Instruction, TraceHeader};
 use cwisim_xproc::{Arith, FixedArith, Machine};
 use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
 
 /// The shell testbench's module.
 pub const SHELL_TESTBENCH_MODULE: &str = "cwisim_fpga_tb";
@@ -45,6 +48,21 @@ pub struct ShellAgreement {
     pub values: u64,
     /// The shell's cycle of the array's cycle 0.
     pub start: u64,
+    /// The cycles the stepped engine took (the array's).
+    pub cycles: u64,
+}
+
+/// What a co-simulation through the shell found, with its times.
+#[derive(Clone, Debug)]
+pub struct ShellOutcome {
+    /// Everything agreed, or the first difference.
+    pub result: Result<ShellAgreement, ShellMismatch>,
+    /// Time to compile the shell, the array and the testbench.
+    pub build: Duration,
+    /// Time the simulation ran.
+    pub simulate: Duration,
+    /// Time the stepped engine took.
+    pub reference: Duration,
 }
 
 /// The first difference.
@@ -68,28 +86,14 @@ pub fn testbench(d: &Design, shell: &Shell, lines: u64) -> String {
         "Testbench of the CWI X-processor array through its FPGA shell",
     );
     v.line("`timescale 1ns / 1ns");
-    let fields = Shell::word_fields(d);
-    let mut reads: Vec<u32> = Vec::new();
-    for (name, bits) in &fields {
-        let per = match name.as_str() {
-            "op" | "x" | "dx" => 1,
-            _ => d.channels as u32,
-        };
-        for _ in 0..per {
-            reads.push(bits / per);
-        }
-    }
+    let reads: Vec<u32> = bench::stimulus_words(d).iter().map(|w| w.1).collect();
     let b = shell.beat_bits;
     let k = shell.beats(d);
     let wa = Shell::value_bits(d);
     v.line(&format!("module {SHELL_TESTBENCH_MODULE};"));
-    v.line("    parameter INSTRUCTIONS = 1;");
-    v.line("    parameter CYCLE_LIMIT = 1000;");
-    v.line(&format!("    localparam integer FIELDS = {};", reads.len()));
+    bench::stimulus_parameters(&mut v, reads.len());
     v.line(&format!("    localparam integer LINES = {lines};"));
-    v.line("    reg clk = 1'b0;");
-    v.line("    reg rst = 1'b1;");
-    v.line("    always #5 clk = ~clk;");
+    bench::clock_and_reset(&mut v);
     v.line(&format!("    reg [{}:0] s_data = {b}'d0;", b - 1));
     v.line("    reg s_valid = 1'b0;");
     v.line("    wire s_ready;");
@@ -153,31 +157,11 @@ pub fn testbench(d: &Design, shell: &Shell, lines: u64) -> String {
     v.line("            $fwrite(dump, \"R %0d\\n\", cycle);");
     v.line("            overrun_seen = 1'b1;");
     v.line("        end");
-    v.line("        if (done == LINES) begin");
-    v.line("            $fwrite(dump, \"E %0d\\n\", cycle);");
-    v.line("            $fclose(dump);");
-    v.line("            $finish;");
-    v.line("        end");
-    v.line("        if (cycle >= CYCLE_LIMIT) begin");
-    v.line("            $fwrite(dump, \"T %0d\\n\", cycle);");
-    v.line("            $fclose(dump);");
-    v.line("            $finish;");
-    v.line("        end");
+    bench::finish_when(&mut v, "done == LINES", 'E');
+    bench::finish_when(&mut v, "cycle >= CYCLE_LIMIT", 'T');
     v.line("    end");
     v.line("endmodule");
     v.into_string()
-}
-
-fn write_file(path: &Path, text: &str) -> Result<(), RtlError> {
-    std::fs::write(path, text).map_err(|e| RtlError::io(path, e))
-}
-
-fn sign_extend(x: u64, bits: u32) -> i64 {
-    if bits >= 64 {
-        return x as i64;
-    }
-    let shift = 64 - bits;
-    ((x << shift) as i64) >> shift
 }
 
 /// Streams `trace` through the shell of design `d` in Icarus Verilog (the RTL, or the
@@ -193,6 +177,22 @@ pub fn cosimulate_shell(
     netlist: &Netlist,
     dir: &Path,
 ) -> Result<Result<ShellAgreement, ShellMismatch>, RtlError> {
+    cosimulate_shell_with(d, shell, header, trace, machine, netlist, dir, &mut |_| {})
+        .map(|o| o.result)
+}
+
+/// [`cosimulate_shell`] with its times, telling `stage` as each [`CosimStage`] begins.
+#[allow(clippy::too_many_arguments)]
+pub fn cosimulate_shell_with(
+    d: &Design,
+    shell: &Shell,
+    header: &TraceHeader,
+    trace: &[Instruction],
+    machine: &Machine,
+    netlist: &Netlist,
+    dir: &Path,
+    stage: &mut dyn FnMut(CosimStage),
+) -> Result<ShellOutcome, RtlError> {
     if trace.is_empty() {
         return Err(RtlError::Settings(
             "the trace is empty: nothing to co-simulate".into(),
@@ -200,21 +200,18 @@ pub fn cosimulate_shell(
     }
     let dir = &dir.canonicalize().map_err(|e| RtlError::io(dir, e))?;
     let last = d.width - 1;
+    let started = Instant::now();
+    stage(CosimStage::Reference);
     let want = expected(d, header, trace, machine, &Watch::new([last], d.width))?;
+    let reference = started.elapsed();
     if want.cycles > crate::cosim::MAX_COSIM_CYCLES {
         return Err(RtlError::Settings(format!(
-            "the co-simulation would run {} cycles, over the limit of {}",
+            "the co-simulation would run {} cycles ({} scanline(s) of the machine's line period), over the limit of {}: a lower clock_hz (--set clock_hz=…) or a shorter trace",
             want.cycles,
+            want.lines.len(),
             crate::cosim::MAX_COSIM_CYCLES
         )));
     }
-    let refreshes: Vec<usize> = trace
-        .iter()
-        .enumerate()
-        .filter(|(_, i)| i.op == Opcode::Refresh)
-        .map(|(k, _)| k)
-        .collect();
-    let arrivals = want.arrivals.get(&last).cloned().unwrap_or_default();
     let lines = want.lines.len() as u64;
     let mut stim = Vec::new();
     stimulus::write(d, header, trace, &mut stim)?;
@@ -225,6 +222,8 @@ pub fn cosimulate_shell(
         .cycles
         .saturating_mul(2)
         .saturating_add(1000 + 4 * u64::from(shell.beats(d)) * trace.len() as u64);
+    let started = Instant::now();
+    stage(CosimStage::Build);
     let mut sources: Vec<String> = vec!["tb.v".into()];
     match netlist {
         Netlist::Rtl => {
@@ -267,11 +266,39 @@ pub fn cosimulate_shell(
     args.extend(sources);
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
     run("iverilog", &args, dir)?;
+    let build = started.elapsed();
+    let started = Instant::now();
+    stage(CosimStage::Simulate {
+        cycles: want.cycles,
+    });
     run("vvp", &["-n", "shell.vvp"], dir)?;
-    let path = dir.join(SHELL_DUMP_FILE);
-    let text = std::fs::read_to_string(&path).map_err(|source| RtlError::NoOutput {
+    let simulate = started.elapsed();
+    stage(CosimStage::Compare);
+    let result = compare_dump(d, shell, trace, &want, &dir.join(SHELL_DUMP_FILE))?;
+    Ok(ShellOutcome {
+        result,
+        build,
+        simulate,
+        reference,
+    })
+}
+
+/// The shell testbench's dump at `path` held to the stepped engine's `want`: every value
+/// bit for bit, each at its cycle.
+fn compare_dump(
+    d: &Design,
+    shell: &Shell,
+    trace: &[Instruction],
+    want: &crate::reference::Expected,
+    path: &Path,
+) -> Result<Result<ShellAgreement, ShellMismatch>, RtlError> {
+    let last = d.width - 1;
+    let refreshes = refresh_indices(trace);
+    let arrivals = want.arrivals.get(&last).cloned().unwrap_or_default();
+    let lines = want.lines.len() as u64;
+    let text = std::fs::read_to_string(path).map_err(|source| RtlError::NoOutput {
         tool: "vvp".into(),
-        path: path.clone(),
+        path: path.to_path_buf(),
         source,
     })?;
     let arith = FixedArith::new(&d.format)?;
@@ -354,5 +381,6 @@ pub fn cosimulate_shell(
         scanlines: lines,
         values: got.len() as u64,
         start,
+        cycles: want.cycles,
     }))
 }

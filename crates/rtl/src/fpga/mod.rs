@@ -10,14 +10,16 @@ pub mod device;
 pub mod report;
 pub mod shell;
 
-pub use cosim::{cosimulate_shell, Netlist, ShellAgreement, ShellMismatch};
+pub use cosim::{
+    cosimulate_shell, cosimulate_shell_with, Netlist, ShellAgreement, ShellMismatch, ShellOutcome,
+};
 pub use device::{device, devices, Device};
 pub use report::{Cells, Hierarchy, Pnr};
 pub use shell::{Shell, INPUT_LATENCY, OUTPUT_LATENCY, SHELL_MODULE};
 
 use crate::design::Design;
 use crate::error::RtlError;
-use crate::tools::run;
+use crate::tools::{run, write_file};
 use crate::verilog::{self, PROCESSOR_MODULE};
 use std::path::Path;
 
@@ -103,10 +105,6 @@ fn synthesize_and_pack(
     let log = run("nextpnr-ice40", &args, dir)?;
     write_file(&dir.join("pack.log"), &log)?;
     Ok((h, report::parse_nextpnr(&log)?))
-}
-
-fn write_file(path: &Path, text: &str) -> Result<(), RtlError> {
-    std::fs::write(path, text).map_err(|e| RtlError::io(path, e))
 }
 
 fn read_output(tool: &str, path: &Path) -> Result<String, RtlError> {

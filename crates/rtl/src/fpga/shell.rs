@@ -23,8 +23,9 @@
 //! operands the design carries, in the array's own formats (what [`crate::stimulus`]
 //! writes).
 
-use crate::design::{bits_for, Design};
-use crate::verilog::{Text, ARRAY_MODULE};
+use crate::design::{bits_for, BusTiming, Design};
+use crate::error::RtlError;
+use crate::verilog::Text;
 use cwisim_xproc::Register;
 
 /// The shell's module (the chip's top level).
@@ -104,6 +105,20 @@ impl Shell {
             m.opcode_cycles.set(*op, c.max(cycles));
         }
         m
+    }
+
+    /// Design `d` (of a stream with `header`) and `machine` paced for the shell's port
+    /// ([`Shell::paced`]): the machine, and the design with the bus timing it gives.
+    pub fn pace(
+        &self,
+        d: &Design,
+        machine: &cwisim_xproc::Machine,
+        header: &cwisim_isa::TraceHeader,
+    ) -> Result<(Design, cwisim_xproc::Machine), RtlError> {
+        let machine = self.paced(d, machine);
+        let timing = BusTiming::new(&machine, header)?;
+        let paced = Design::new(d.format, d.opcodes.clone(), d.width, d.channels, timing)?;
+        Ok((paced, machine))
     }
 
     /// Bits of one output value (the accumulator's format).
@@ -223,29 +238,23 @@ impl Shell {
         v.line(&format!("    wire [{}:0] refresh_at;", w - 1));
         v.line(&format!("    wire [{}:0] out_flat;", wa * n * w - 1));
         v.line("    wire unused_refresh_at = ^refresh_at;");
-        let mut conns = vec![
-            ".clk(clk)".to_string(),
-            ".rst(rst || !started)".into(),
-            ".in_valid(held)".into(),
-        ];
+        let mut hold_bits = std::collections::BTreeMap::new();
         let mut at = 0;
         for (name, bits) in Shell::word_fields(d) {
-            conns.push(format!(".in_{name}(hold[{}:{at}])", at + bits - 1));
+            hold_bits.insert(
+                format!("in_{name}"),
+                format!("hold[{}:{at}]", at + bits - 1),
+            );
             at += bits;
         }
-        conns.push(".in_take(take)".into());
-        conns.push(".cycle()".into());
-        conns.push(".arrive()".into());
-        conns.push(".refresh_at(refresh_at)".into());
-        conns.push(".out_flat(out_flat)".into());
-        conns.push(".exit_valid()".into());
-        if d.order() >= 1 {
-            conns.push(".exit_overflows()".into());
-        }
-        conns.push(".idle()".into());
-        v.line(&format!("    {ARRAY_MODULE} array ("));
-        v.line(&format!("        {}", conns.join(",\n        ")));
-        v.line("    );");
+        let connect = |port: &str| match port {
+            "clk" | "refresh_at" | "out_flat" => port.to_string(),
+            "rst" => "rst || !started".into(),
+            "in_valid" => "held".into(),
+            "in_take" => "take".into(),
+            _ => hold_bits.get(port).cloned().unwrap_or_default(),
+        };
+        crate::verilog::instance(d, "array", &connect, &mut v);
         v.blank();
         v.line("    // the scanline out: started the cycle after the last processor's output is written");
         v.line(

@@ -12,6 +12,47 @@ pub(crate) fn overflow_count_bits(d: &Design) -> u32 {
     bits_for(d.events_per_visit().saturating_mul(u64::from(d.width)))
 }
 
+/// The array's ports, in the order the module declares them.
+pub(crate) fn port_names(d: &Design) -> Vec<String> {
+    let mut ports: Vec<String> = ["clk", "rst", "in_valid", "in_op"].map(String::from).into();
+    if d.addressed() {
+        ports.extend(["in_x".into(), "in_dx".into()]);
+    }
+    ports.extend(
+        d.value_fields()
+            .iter()
+            .map(|(name, _)| format!("in_{name}")),
+    );
+    ports.extend(
+        [
+            "in_take",
+            "cycle",
+            "arrive",
+            "refresh_at",
+            "out_flat",
+            "exit_valid",
+        ]
+        .map(String::from),
+    );
+    if d.order() >= 1 {
+        ports.push("exit_overflows".into());
+    }
+    ports.push("idle".into());
+    ports
+}
+
+/// An instance of the array named `name`, each port connected to what `connect` gives it
+/// (an empty string leaves it open).
+pub(crate) fn instance(d: &Design, name: &str, connect: &dyn Fn(&str) -> String, out: &mut Text) {
+    let conns: Vec<String> = port_names(d)
+        .iter()
+        .map(|p| format!(".{p}({})", connect(p)))
+        .collect();
+    out.line(&format!("    {ARRAY_MODULE} {name} ("));
+    out.line(&format!("        {}", conns.join(",\n        ")));
+    out.line("    );");
+}
+
 /// Writes the array module.
 pub(crate) fn write(d: &Design, out: &mut Text) {
     let n = d.channels as u32;

@@ -7,9 +7,11 @@
 
 mod adder;
 mod array;
+pub(crate) mod bench;
 mod processor;
 mod testbench;
 
+pub(crate) use array::instance;
 pub use testbench::{testbench, Watch, DUMP_FILE, STIMULUS_FILE};
 
 use crate::design::Design;

@@ -4,8 +4,8 @@
 //! watched processor, each processor's output as a `Refresh` passes it, each token's
 //! overflow events as it leaves the chain, and the cycle the array fell idle.
 
-use super::array::overflow_count_bits;
-use super::{header, Text, ARRAY_MODULE, TESTBENCH_MODULE};
+use super::array::{instance, overflow_count_bits};
+use super::{bench, header, Text, TESTBENCH_MODULE};
 use crate::design::Design;
 use cwisim_xproc::Register;
 
@@ -91,17 +91,12 @@ pub fn testbench(d: &Design, watch: &Watch) -> String {
     v.line("// cycle limit was reached).");
     v.line("`timescale 1ns / 1ns");
     v.line(&format!("module {TESTBENCH_MODULE};"));
-    v.line("    reg clk = 1'b0;");
-    v.line("    reg rst = 1'b1;");
-    v.line("    always #5 clk = ~clk;");
+    bench::clock_and_reset(&mut v);
     v.line("    reg in_valid = 1'b0;");
     v.line(&format!("    reg [{}:0] in_op = {ow}'d0;", ow - 1));
-    let mut fields: Vec<(String, u32)> = vec![("in_op".into(), ow)];
     if addressed {
         v.line(&format!("    reg [{}:0] in_x = {aw}'d0;", aw - 1));
         v.line(&format!("    reg [{}:0] in_dx = {cw}'d0;", cw - 1));
-        fields.push(("in_x".into(), aw));
-        fields.push(("in_dx".into(), cw));
     }
     let values = d.value_fields();
     for &(field, bits) in &values {
@@ -122,60 +117,13 @@ pub fn testbench(d: &Design, watch: &Watch) -> String {
         v.line(&format!("    wire [{}:0] exit_overflows;", ovw - 1));
     }
     v.line("    wire idle;");
-    v.line(&format!("    {ARRAY_MODULE} dut ("));
-    let mut conns = vec![
-        ".clk(clk)".to_string(),
-        ".rst(rst)".into(),
-        ".in_valid(in_valid)".into(),
-        ".in_op(in_op)".into(),
-    ];
-    if addressed {
-        conns.push(".in_x(in_x)".into());
-        conns.push(".in_dx(in_dx)".into());
-    }
-    for &(field, _) in &values {
-        conns.push(format!(".in_{field}(in_{field})"));
-    }
-    for s in [
-        "in_take",
-        "cycle",
-        "arrive",
-        "refresh_at",
-        "out_flat",
-        "exit_valid",
-    ] {
-        conns.push(format!(".{s}({s})"));
-    }
-    if counting {
-        conns.push(".exit_overflows(exit_overflows)".into());
-    }
-    conns.push(".idle(idle)".into());
-    for (k, c) in conns.iter().enumerate() {
-        let sep = if k + 1 == conns.len() { "" } else { "," };
-        v.line(&format!("        {c}{sep}"));
-    }
-    v.line("    );");
+    instance(d, "dut", &|port| port.to_string(), &mut v);
     v.blank();
     // the reader
-    let mut reads: Vec<(String, String, u32)> = fields
-        .iter()
-        .map(|(name, bits)| (format!("f_{}", &name[3..]), name.to_string(), *bits))
-        .collect();
-    for &(field, bits) in &values {
-        for c in 0..n {
-            reads.push((
-                format!("f_{field}_c{c}"),
-                format!("in_{field}[{}:{}]", (c + 1) * bits - 1, c * bits),
-                bits,
-            ));
-        }
-    }
-    let k_n = reads.len();
+    let reads = bench::stimulus_words(d);
     v.line("    // the stimulus: INSTRUCTIONS instructions of FIELDS hex words each (set at compile time:");
     v.line("    // iverilog -P cwisim_tb.INSTRUCTIONS=…, verilator -GINSTRUCTIONS=…)");
-    v.line("    parameter INSTRUCTIONS = 1;");
-    v.line("    parameter CYCLE_LIMIT = 1000;");
-    v.line(&format!("    localparam integer FIELDS = {k_n};"));
+    bench::stimulus_parameters(&mut v, reads.len());
     v.line("    reg [63:0] words [0:INSTRUCTIONS*FIELDS-1];");
     v.line("    integer dump, next_index;");
     v.line("    // the next instruction onto the bus's inputs (or none left)");
@@ -184,7 +132,7 @@ pub fn testbench(d: &Design, watch: &Watch) -> String {
     v.line("            if (next_index == INSTRUCTIONS) in_valid <= 1'b0;");
     v.line("            else begin");
     v.line("                in_valid <= 1'b1;");
-    for (k, (_, target, bits)) in reads.iter().enumerate() {
+    for (k, (target, bits)) in reads.iter().enumerate() {
         v.line(&format!(
             "                {target} <= words[next_index*FIELDS+{k}][{}:0];",
             bits - 1
@@ -217,16 +165,8 @@ pub fn testbench(d: &Design, watch: &Watch) -> String {
     } else {
         v.line("        if (exit_valid) $fwrite(dump, \"X %0d 0\\n\", cycle);");
     }
-    v.line("        if (!in_valid && idle) begin");
-    v.line("            $fwrite(dump, \"E %0d\\n\", cycle);");
-    v.line("            $fclose(dump);");
-    v.line("            $finish;");
-    v.line("        end");
-    v.line("        if (cycle >= CYCLE_LIMIT) begin");
-    v.line("            $fwrite(dump, \"T %0d\\n\", cycle);");
-    v.line("            $fclose(dump);");
-    v.line("            $finish;");
-    v.line("        end");
+    bench::finish_when(&mut v, "!in_valid && idle", 'E');
+    bench::finish_when(&mut v, "cycle >= CYCLE_LIMIT", 'T');
     v.line("    end");
     v.line("    // each processor's output registers, the cycle after a Refresh moved them out");
     v.line("    genvar gp;");
