@@ -123,7 +123,10 @@ fn the_named_cases_are_the_one_by_one_run() {
     ] {
         let numeric: Numeric = numeric.parse().unwrap();
         for (k, trace) in cases.iter().enumerate() {
-            let (all, one) = (run(&numeric, 1, trace, true), run(&numeric, 1, trace, false));
+            let (all, one) = (
+                run(&numeric, 1, trace, true),
+                run(&numeric, 1, trace, false),
+            );
             assert_eq!(all, one, "case {k}, {numeric:?}");
         }
     }
