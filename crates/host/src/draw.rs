@@ -671,13 +671,10 @@ mod tests {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AngleOrOff(pub Option<f64>);
 
-/// Parses `off` or a number of degrees (the range is the library's to check).
+/// Parses `off` or a number of degrees as the library spells them (`Setting::set`; the
+/// range is checked with the rest of the settings).
 pub fn angle_or_off(text: &str) -> Result<AngleOrOff, String> {
-    match text.trim() {
-        t if t.eq_ignore_ascii_case("off") => Ok(AngleOrOff(None)),
-        t => t
-            .parse::<f64>()
-            .map(|a| AngleOrOff(Some(a)))
-            .map_err(|_| format!("expected a number of degrees or off, found `{text}`")),
-    }
+    let mut s = Settings::default();
+    cwisim_render::settings::Setting::NormalAngle.set(&mut s, text)?;
+    Ok(AngleOrOff(s.normal_angle))
 }

@@ -3,6 +3,8 @@
 //! 1e-9, from the pieces themselves), the silhouette against a fine tessellation drawn by
 //! `vanrij`, and `--threads N` byte-identical.
 
+mod common;
+
 use cwisim_render::nishita::band::{subpatches, BandStats, Facings, Params, View};
 use cwisim_render::nishita::classify::Facing;
 use cwisim_render::nishita::{pieces, Pieces};
@@ -292,18 +294,7 @@ fn white_teapot(size: u32) -> LoadedScene {
 }
 
 fn image_of(name: &str, loaded: LoadedScene, settings: &Settings, threads: usize) -> Vec<f64> {
-    let r = (registry::find(name).unwrap().build)(loaded, settings).unwrap();
-    let h = r.header();
-    let mut sink = ImageSink::new(h.width as usize, h.channel_count(), 1 << 30);
-    render(
-        &*r,
-        &ArrayConfig::default(),
-        threads,
-        &mut sink,
-        Taps::default(),
-    )
-    .unwrap();
-    sink.finish().unwrap().data
+    common::drawn_on(name, loaded, settings, threads).0
 }
 
 #[test]

@@ -4,7 +4,6 @@
 //! then by the camera), box-filtered by clipping to each pixel here; and the renderer's
 //! answers around it (threads, a light too wide for one view, `--shadows`).
 
-#[allow(dead_code)] // the world reader and one renderer's image are used here
 mod common;
 
 use cwisim_render::nishita::Nishita;

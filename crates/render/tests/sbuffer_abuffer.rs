@@ -4,7 +4,6 @@
 //! supersampling where no two polygons share a pixel's samples (the two are then the
 //! same mean of the same samples); and its refusals.
 
-#[allow(dead_code)] // one renderer's image is used here
 mod common;
 
 use cwisim_render::settings::SbufferMode;

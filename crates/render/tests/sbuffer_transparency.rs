@@ -3,7 +3,6 @@
 //! compositing at the same samples (within 1e-9), and at one sample against a ray cast
 //! written here that composites the layers it hits front to back.
 
-#[allow(dead_code)] // the ray caster and one renderer's image are used here
 mod common;
 
 use common::raycast::{hits, ray};

@@ -4,6 +4,8 @@
 //! own invariants (shading-call counts, determinism, passes against merged rows, no
 //! sample dropped on a shared edge).
 
+mod common;
+
 use cwisim_isa::Instruction;
 use cwisim_render::subsample::{Grid, Sampler};
 use cwisim_render::woochall::lists::span;
@@ -16,18 +18,7 @@ use cwisim_xproc::ImageSink;
 use proptest::prelude::*;
 
 fn image_of(name: &str, loaded: LoadedScene, settings: &Settings, threads: usize) -> Vec<f64> {
-    let r = (registry::find(name).unwrap().build)(loaded, settings).unwrap();
-    let h = r.header();
-    let mut sink = ImageSink::new(h.width as usize, h.channel_count(), 1 << 30);
-    render(
-        &*r,
-        &ArrayConfig::default(),
-        threads,
-        &mut sink,
-        Taps::default(),
-    )
-    .unwrap();
-    sink.finish().unwrap().data
+    common::drawn_on(name, loaded, settings, threads).0
 }
 
 fn embedded_scene(name: &str, size: u32) -> LoadedScene {

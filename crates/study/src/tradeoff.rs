@@ -1269,7 +1269,7 @@ fn row_of(
     let mut times = times.to_vec();
     times.sort();
     let stats = &measured.stats;
-    let patches = setting.renderer.patches && world;
+    let (root_tolerance, normal_angle) = patch_columns(setting, world);
     let (max_error, rms_error, psnr_db) = errors(&measured.image, reference);
     let worst = stats.lines.iter().map(|l| l.busy_cycles).max().unwrap_or(0);
     let s = &setting.settings;
@@ -1301,8 +1301,8 @@ fn row_of(
             "-"
         },
         tessellate: s.tessellate,
-        root_tolerance: patches.then_some(s.root_tolerance),
-        normal_angle: s.normal_angle.filter(|_| patches),
+        root_tolerance,
+        normal_angle,
         numeric: short_numeric(&setting.numeric),
         register_bits: register_bits(&setting.numeric),
         instructions: stats.totals.instructions,
@@ -1322,6 +1322,18 @@ fn row_of(
         overflows: stats.totals.overflows,
         counters: measured.counters.clone(),
         pareto: false,
+    }
+}
+
+/// A row's `root_tolerance` and `normal_angle`: a renderer's that draws the patches of a
+/// world scene directly, `None` for any other.
+fn patch_columns(setting: &Setting, world: bool) -> (Option<f64>, Option<f64>) {
+    match setting.renderer.patches && world {
+        true => (
+            Some(setting.settings.root_tolerance),
+            setting.settings.normal_angle,
+        ),
+        false => (None, None),
     }
 }
 
@@ -1393,14 +1405,10 @@ impl TableLayout {
                 .settings
                 .iter()
                 .map(|s| {
-                    let patches = s.renderer.patches && plan.axes.world;
-                    tess_cell(
-                        s.settings.tessellate,
-                        patches.then_some(s.settings.root_tolerance),
-                        s.settings.normal_angle.filter(|_| patches),
-                    )
-                    .chars()
-                    .count()
+                    let (root_tolerance, normal_angle) = patch_columns(s, plan.axes.world);
+                    tess_cell(s.settings.tessellate, root_tolerance, normal_angle)
+                        .chars()
+                        .count()
                 })
                 .chain([4])
                 .max()

@@ -511,7 +511,8 @@ impl Refine {
         &self.phases
     }
 
-    /// The vertex phase's frames before its last (0 when it is one frame, or absent).
+    /// Which of a split vertex phase's frames before its last frame `k` is, from 0 (`None`:
+    /// frame `k` is another phase's, or the vertex phase's last or only frame).
     fn vertex_parts_before(&self, k: usize) -> Option<usize> {
         let first = self.phases.iter().position(|&p| p == Phase::Vertices)?;
         let j = k.checked_sub(first)?;

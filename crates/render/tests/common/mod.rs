@@ -1,7 +1,8 @@
 //! Helpers shared by the integration tests of `cwisim-render`.
 
-// (only tests/textures.rs reads it)
-#[allow(dead_code)]
+// each test binary uses a part
+#![allow(dead_code)]
+
 pub mod footprint;
 pub mod raycast;
 
