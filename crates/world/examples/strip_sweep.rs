@@ -8,14 +8,18 @@
 //!
 //! N defaults to 32 (65,280 triangles), ROWS (pixel rows a strip) to 4, RUNS to 5; with
 //! `STACKED=L` the scene is the pot as `L` stacked shells instead (`depth_complexity`'s
-//! `stacked` family). Prints each engine's median wall time on one thread, the ratio, strip by strip's on two
-//! threads (and its speed-up; the fragments must be the same), the peak heap each
-//! allocated (a counting allocator, the fragments included), their fragments, and the
-//! largest difference between the visible areas they give a triangle (they must agree:
-//! the run stops if not). The figures are in `docs/VISIBILITY.md`.
+//! `stacked` family), with `QUADS=L` `L` squares stacked over one footprint (each shifted
+//! by up to 5 px, so that none hides another whole). Prints each engine's median wall
+//! time on one thread, the ratio, strip by strip's on two threads (and its speed-up; the
+//! fragments must be the same), the peak heap each allocated (a counting allocator, the
+//! fragments included) and the sweep's own when its bands are handed on and dropped
+//! (`strip_by_strip_into`), their fragments, and the largest difference between the
+//! visible areas they give a triangle (they must agree: the run stops if not). The
+//! figures are in `docs/VISIBILITY.md`.
 
 use cwisim_scene::Shading;
 use cwisim_world::embedded::embedded;
+use cwisim_world::face::ScreenTriangle;
 use cwisim_world::visibility::{exact_fragments_on, Fragment};
 use cwisim_world::{parse_any, AnyScene};
 use std::time::{Duration, Instant};
@@ -37,6 +41,32 @@ fn areas(fragments: &[Fragment], n: usize) -> Vec<f64> {
                 })
                 .sum::<f64>()
                 .abs();
+    }
+    out
+}
+
+/// `layers` squares of 400 px over one footprint, each shifted by up to 5 px along the
+/// diagonal (so that no one hides another whole), on parallel planes at `layers` depths
+/// in a scrambled order; each square two triangles (`like`'s, moved).
+fn stacked_quads(layers: usize, like: ScreenTriangle) -> Vec<ScreenTriangle> {
+    let mut out = Vec::with_capacity(2 * layers);
+    for k in 0..layers {
+        let shift = ((k * 37) % 101) as f64 * 0.05;
+        let inv_depth = 1.0 / (10.0 + ((k * 7919) % layers) as f64 * 0.01);
+        let corner = |x: f64, y: f64| [x + shift, y + shift];
+        let (a, b, c, d) = (
+            corner(50.0, 50.0),
+            corner(450.0, 50.0),
+            corner(450.0, 450.0),
+            corner(50.0, 450.0),
+        );
+        for points in [[a, b, c], [a, c, d]] {
+            out.push(ScreenTriangle {
+                points,
+                inv_depth: [inv_depth; 3],
+                ..like
+            });
+        }
     }
     out
 }
@@ -70,7 +100,10 @@ fn main() {
             w
         }
     };
-    let (tris, _) = cwisim_world::project::project(&w, Shading::Gouraud).expect("projected");
+    let (mut tris, _) = cwisim_world::project::project(&w, Shading::Gouraud).expect("projected");
+    if let Ok(l) = std::env::var("QUADS") {
+        tris = stacked_quads(l.parse().expect("QUADS=LAYERS"), tris[0]);
+    }
     let channels = w.channels();
     let (mut pairs, mut strips, mut strips2) = (Vec::new(), Vec::new(), Vec::new());
     let (mut by_pairs, mut by_strips) = (Vec::new(), Vec::new());
@@ -88,6 +121,10 @@ fn main() {
         strips2.push(t.elapsed());
         assert!(two == by_strips, "two threads gave other fragments");
     }
+    // handed on band by band and dropped: what the sweep itself holds
+    let ((), heap_streamed) = layers::peak_heap(|| {
+        cwisim_world::sweep::strip_by_strip_into(&tris, channels, rows, 1, drop)
+    });
     let (a, b) = (areas(&by_pairs, tris.len()), areas(&by_strips, tris.len()));
     let worst = a
         .iter()
@@ -95,10 +132,10 @@ fn main() {
         .map(|(x, y)| (x - y).abs())
         .fold(0.0, f64::max);
     let (p, s, s2) = (median(pairs), median(strips), median(strips2));
-    println!("| triangles | strip rows | pair by pair | strip by strip | ratio | strips, 2 threads | peak heap (pairs / strips) | fragments (pairs / strips) | largest area difference |");
+    println!("| triangles | strip rows | pair by pair | strip by strip | ratio | strips, 2 threads | peak heap (pairs / strips / streamed) | fragments (pairs / strips) | largest area difference |");
     println!("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
     println!(
-        "| {} | {rows} | {:.1} ms | {:.1} ms | {:.2}× | {:.1} ms ({:.2}×) | {:.1} / {:.1} MB | {} / {} | {worst:.1e} px² |",
+        "| {} | {rows} | {:.1} ms | {:.1} ms | {:.2}× | {:.1} ms ({:.2}×) | {:.1} / {:.1} / {:.1} MB | {} / {} | {worst:.1e} px² |",
         tris.len(),
         p.as_secs_f64() * 1e3,
         s.as_secs_f64() * 1e3,
@@ -107,6 +144,7 @@ fn main() {
         s.as_secs_f64() / s2.as_secs_f64(),
         heap_pairs as f64 / 1e6,
         heap_strips as f64 / 1e6,
+        heap_streamed as f64 / 1e6,
         by_pairs.len(),
         by_strips.len()
     );

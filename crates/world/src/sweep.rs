@@ -253,9 +253,29 @@ struct Prepared {
     x0: f64,
     x1: f64,
     scale: f64,
+    /// Its corners' `x` (every edge's two ends, each once).
+    corner_xs: ArrayVec<f64, 5>,
+    /// Its lower and upper edges (indices in `edges`, left to right; upright ones in
+    /// neither): where two of them cross a slab, the lower is below.
+    chains: [ArrayVec<u8, 5>; 2],
     /// Its edges: a triangle's three, or a convex polygon's (a triangle's part in a
     /// strip: at most five).
     edges: ArrayVec<Line, 5>,
+}
+
+/// A piece's `1/depth` as `gx·x + gy·y + c`, and its size (for the coplanar test).
+#[derive(Clone, Copy, Debug, Default)]
+struct Plane {
+    gx: f64,
+    gy: f64,
+    c: f64,
+    scale: f64,
+}
+
+impl Plane {
+    fn at(&self, x: f64, y: f64) -> f64 {
+        self.gx * x + self.gy * y + self.c
+    }
 }
 
 /// A triangle's `1/depth` as `(gx, gy, c)` (`gx·x + gy·y + c`) and the largest of its
@@ -285,21 +305,35 @@ impl Prepared {
     /// `plane` (`1/depth` as `gx·x + gy·y + c`; `scale`: its size, for the coplanar test).
     fn polygon(corners: &[[f64; 2]], plane: [f64; 3], scale: f64) -> Prepared {
         let xs = corners.iter().map(|p| p[0]);
+        let edges: ArrayVec<Line, 5> = (0..corners.len())
+            .map(|e| Line::edge(corners[e], corners[(e + 1) % corners.len()]))
+            .collect();
+        // going the polygon's way round, an edge that goes the way of its orientation
+        // (left to right when it is anticlockwise with y up) is a lower one
+        let turn = doubled_area(corners).signum();
+        let mut chains = [ArrayVec::new(), ArrayVec::new()];
+        for e in 0..corners.len() {
+            let dx = corners[(e + 1) % corners.len()][0] - corners[e][0];
+            if dx != 0.0 {
+                chains[usize::from(dx.signum() != turn)].push(e as u8);
+            }
+        }
+        for chain in &mut chains {
+            chain.sort_unstable_by(|&a, &b| {
+                edges[a as usize].p[0].total_cmp(&edges[b as usize].p[0])
+            });
+        }
         Prepared {
+            chains,
             gx: plane[0],
             gy: plane[1],
             c: plane[2],
             x0: xs.clone().fold(f64::INFINITY, f64::min),
             x1: xs.fold(f64::NEG_INFINITY, f64::max),
             scale,
-            edges: (0..corners.len())
-                .map(|e| Line::edge(corners[e], corners[(e + 1) % corners.len()]))
-                .collect(),
+            corner_xs: corners.iter().map(|p| p[0]).collect(),
+            edges,
         }
-    }
-
-    fn inv_depth(&self, x: f64, y: f64) -> f64 {
-        self.gx * x + self.gy * y + self.c
     }
 }
 
@@ -345,13 +379,17 @@ struct Scratch {
     bounds: Vec<(usize, Line, Line)>,
     lines: Vec<Line>,
     ends: Vec<Ends>,
-    sorted: Vec<(i64, usize)>,
+    sorted: Vec<(i64, u32)>,
+    /// Spare room for `sorted`.
+    ordered: Vec<(i64, u32)>,
     order: Vec<Ends>,
-    by_rank: Vec<Line>,
+    /// The index in `lines` of the line of each rank.
+    by_rank: Vec<u32>,
     rank_of: Vec<usize>,
     winner: Vec<Option<usize>>,
     runs: Vec<(Option<usize>, usize, usize)>,
     bounding: Vec<Ends>,
+    marked: Vec<bool>,
 }
 
 /// The visible parts of a strip's pieces `tris` (see the [module docs](self)), in
@@ -379,17 +417,29 @@ fn visible_parts(
     let mut xs: Vec<f64> = prepared
         .iter()
         .flatten()
-        .flat_map(|p| p.edges.iter().flat_map(|l| [l.p[0], l.q[0]]))
+        .flat_map(|p| p.corner_xs.iter().copied())
         .collect();
-    xs.sort_by(f64::total_cmp);
+    xs.sort_unstable_by(f64::total_cmp);
     xs.dedup();
     let start = |k: usize| prepared[k].as_ref().map_or(0.0, |p| p.x0);
     let mut by_start: Vec<usize> = (0..prepared.len())
         .filter(|&k| prepared[k].is_some())
         .collect();
-    by_start.sort_by(|&a, &b| start(a).total_cmp(&start(b)).then(a.cmp(&b)));
+    by_start.sort_unstable_by(|&a, &b| start(a).total_cmp(&start(b)).then(a.cmp(&b)));
+    let planes: Vec<Plane> = prepared
+        .iter()
+        .map(|p| {
+            p.as_ref().map_or(Plane::default(), |p| Plane {
+                gx: p.gx,
+                gy: p.gy,
+                c: p.c,
+                scale: p.scale,
+            })
+        })
+        .collect();
     let mut sweep = Sweep {
         prepared,
+        planes: &planes,
         stats,
         chains: Vec::new(),
         open: Vec::new(),
@@ -397,6 +447,10 @@ fn visible_parts(
         closed: Vec::new(),
         pool: Vec::new(),
         nesting: 0,
+        by_y: Vec::new(),
+        listed: vec![false; prepared.len()],
+        bound_of: vec![u32::MAX; prepared.len()],
+        follow: vec![[(0, u8::MAX, f64::NAN, 0.0); 2]; prepared.len()],
     };
     let mut active: Vec<usize> = Vec::new();
     let mut entering = 0;
@@ -456,15 +510,30 @@ fn visible_parts(
 /// continues or starts, and those closed; scratch space for the slabs.
 struct Sweep<'a> {
     prepared: &'a [Option<Prepared>],
+    /// Each piece's `1/depth` plane and size, side by side (what the slabs compare).
+    planes: &'a [Plane],
     stats: &'a mut SegmentStats,
     /// Every chain, open or closed; the sweep's lists hold their indices.
     chains: Vec<Chain>,
     open: Vec<usize>,
     next: Vec<usize>,
     closed: Vec<usize>,
-    pool: Vec<Scratch>,
+    /// Boxed: a slab takes one and gives it back, and moving a pointer is cheaper than
+    /// moving a dozen vectors' headers.
+    #[allow(clippy::vec_box)]
+    pool: Vec<Box<Scratch>>,
     /// Slabs within slabs now.
     nesting: u32,
+    /// The active pieces' lower (0) and upper (1) lines in the order of the last slab
+    /// of the sweep (not a nested one), kept from slab to slab.
+    by_y: Vec<(u32, u8)>,
+    /// Whether a piece is in `by_y`.
+    listed: Vec<bool>,
+    /// Each piece's place in the slab's bounds (`u32::MAX`: none), while ordering.
+    bound_of: Vec<u32>,
+    /// Each piece's lower and upper edge followed from slab to slab: the place in its
+    /// chain, the edge, and its `y` at the `x` last asked.
+    follow: Vec<[(u8, u8, f64, f64); 2]>,
 }
 
 impl Sweep<'_> {
@@ -506,34 +575,28 @@ impl Sweep<'_> {
         let xm = 0.5 * (xa + xb);
         // wide enough to cut, and not nested too deep to do it again
         let wide = xb - xa > 2.0 * MIN_WIDTH && self.nesting < MAX_NESTING;
-        let prepared = self.prepared;
-        let piece = |k: usize| prepared[k].as_ref().expect("an active piece is prepared");
+        let planes = self.planes;
+        let piece = |k: usize| &planes[k];
         // each piece's two edges across the slab, lower first
         sc.bounds.clear();
-        for &k in active {
-            let mut across = [None; 2];
-            let mut n = 0;
-            for l in &piece(k).edges {
-                // p is left of (or level with) q
-                if l.p[0] < xm && xm < l.q[0] && n < 2 {
-                    across[n] = Some(*l);
-                    n += 1;
-                }
-            }
-            if let [Some(l0), Some(l1)] = across {
-                if l0.at(xm) <= l1.at(xm) {
-                    sc.bounds.push((k, l0, l1));
-                } else {
-                    sc.bounds.push((k, l1, l0));
-                }
-            }
+        if self.nesting == 1 && extra.is_empty() {
+            // a slab of the sweep itself: the edges and their ends followed from the
+            // slab before
+            self.bounds_followed(sc, active, xa, xb);
+        } else {
+            self.bounds_found(sc, active, xa, xb);
+            sc.ends.clear();
+            sc.ends.extend(
+                sc.bounds
+                    .iter()
+                    .flat_map(|b| [b.1, b.2])
+                    .map(|l| (l.at(xa), l.at(xb))),
+            );
         }
         sc.lines.clear();
         sc.lines.extend(sc.bounds.iter().flat_map(|b| [b.1, b.2]));
         sc.lines.extend_from_slice(extra);
-        sc.ends.clear();
-        sc.ends
-            .extend(sc.lines.iter().map(|l| (l.at(xa), l.at(xb))));
+        sc.ends.extend(extra.iter().map(|l| (l.at(xa), l.at(xb))));
         if all_cuts && wide {
             let cuts = crossings(&sc.ends, xa, xb);
             if !cuts.is_empty() {
@@ -542,26 +605,46 @@ impl Sweep<'_> {
         }
         // the lines ordered at the middle (equal ends: one line, one rank); the first
         // key of `ends_cmp` as an integer, the rest looked up only on a tie
-        let ends = &sc.ends;
         sc.sorted.clear();
         sc.sorted.extend(
-            ends.iter()
+            sc.ends
+                .iter()
                 .enumerate()
-                .map(|(i, e)| (ordered(e.0 + e.1), i)),
+                .map(|(i, e)| (ordered(e.0 + e.1), i as u32)),
         );
-        sc.sorted.sort_unstable_by(|&(ka, a), &(kb, b)| {
-            ka.cmp(&kb)
-                .then_with(|| ends_cmp(&ends[a], &ends[b]))
-                .then(a.cmp(&b))
-        });
+        if self.nesting == 1 && extra.is_empty() {
+            // a slab of the sweep itself: its lines in the order of the slab before
+            // (each piece's lower and upper line run on from slab to slab), with the new
+            // pieces' after them, then put in order by insertion — a few steps, where a
+            // sort of lines in no order mispredicts at every other comparison
+            self.in_order(sc);
+        } else {
+            sc.sorted.sort_unstable();
+        }
+        let ends = &sc.ends;
+        // equal first keys (rare): ordered by the rest of `ends_cmp`, then the index
+        let mut i = 0;
+        while i < sc.sorted.len() {
+            let mut j = i + 1;
+            while j < sc.sorted.len() && sc.sorted[j].0 == sc.sorted[i].0 {
+                j += 1;
+            }
+            if j - i > 1 {
+                sc.sorted[i..j].sort_unstable_by(|&(_, a), &(_, b)| {
+                    ends_cmp(&ends[a as usize], &ends[b as usize]).then(a.cmp(&b))
+                });
+            }
+            i = j;
+        }
         sc.order.clear();
         sc.by_rank.clear();
         sc.rank_of.clear();
         sc.rank_of.resize(ends.len(), 0);
         for &(_, i) in &sc.sorted {
+            let i = i as usize;
             if sc.order.last() != Some(&ends[i]) {
                 sc.order.push(ends[i]);
-                sc.by_rank.push(sc.lines[i]);
+                sc.by_rank.push(i as u32);
             }
             sc.rank_of[i] = sc.order.len() - 1;
         }
@@ -586,7 +669,7 @@ impl Sweep<'_> {
                         let (x, y) = centre(r);
                         let (kb, ko) = (sc.bounds[b].0, sc.bounds[o].0);
                         let (pb, po) = (piece(kb), piece(ko));
-                        let (zb, zo) = (pb.inv_depth(x, y), po.inv_depth(x, y));
+                        let (zb, zo) = (pb.at(x, y), po.at(x, y));
                         let tol = COPLANAR * pb.scale.max(po.scale);
                         if (zb - zo).abs() <= tol {
                             kb < ko
@@ -614,16 +697,26 @@ impl Sweep<'_> {
         if wide {
             // (1) the lines that bound what is visible, and the winners' own lines, must
             // not cross inside the slab: cut where they do
-            sc.bounding.clear();
+            // their ranks marked, then read in rank order: sorted, each once
+            sc.marked.clear();
+            sc.marked.resize(order.len(), false);
             for &(w, lo, hi) in &sc.runs {
-                sc.bounding.extend([order[lo], order[hi]]);
+                sc.marked[lo] = true;
+                sc.marked[hi] = true;
                 if let Some(w) = w {
                     let (a, b) = span(w);
-                    sc.bounding.extend([order[a], order[b]]);
+                    sc.marked[a] = true;
+                    sc.marked[b] = true;
                 }
             }
-            sc.bounding.sort_unstable_by(ends_cmp);
-            sc.bounding.dedup();
+            sc.bounding.clear();
+            sc.bounding.extend(
+                order
+                    .iter()
+                    .zip(&sc.marked)
+                    .filter(|(_, &m)| m)
+                    .map(|(e, _)| *e),
+            );
             if !in_order_at_both_ends(&sc.bounding) {
                 let cuts = crossings(&sc.bounding, xa, xb);
                 if !cuts.is_empty() {
@@ -666,7 +759,7 @@ impl Sweep<'_> {
                         }
                         let pb = piece(sc.bounds[b].0);
                         let tol = COPLANAR * pb.scale.max(pw.scale);
-                        let d = |x: f64, y: f64| pb.inv_depth(x, y) - pw.inv_depth(x, y);
+                        let d = |x: f64, y: f64| pb.at(x, y) - pw.at(x, y);
                         // the winner nearer at the run's corners is nearer all over it
                         // (the difference is affine): the common case, a piece behind
                         let run_corners = [
@@ -758,7 +851,10 @@ impl Sweep<'_> {
         for &(w, lo, hi) in &sc.runs {
             let Some(w) = w else { continue };
             let source = sc.bounds[w].0;
-            let (lower, upper) = (sc.by_rank[lo], sc.by_rank[hi]);
+            let (lower, upper) = (
+                sc.lines[sc.by_rank[lo] as usize],
+                sc.lines[sc.by_rank[hi] as usize],
+            );
             let (ya_lower, ya_upper) = (order[lo].0, order[hi].0);
             let chains = &self.chains;
             let continued = self.open.iter().position(|&k| {
@@ -800,6 +896,157 @@ impl Sweep<'_> {
         // what this slab did not continue is closed
         self.closed.append(&mut self.open);
         std::mem::swap(&mut self.open, &mut self.next);
+    }
+
+    /// Each of `active`'s two edges across the slab `xa..xb`, lower first, into
+    /// `sc.bounds`: the two edges that cross its middle.
+    fn bounds_found(&self, sc: &mut Scratch, active: &[usize], xa: f64, xb: f64) {
+        let xm = 0.5 * (xa + xb);
+        for &k in active {
+            let piece = self.prepared[k]
+                .as_ref()
+                .expect("an active piece is prepared");
+            let mut across = [None; 2];
+            let mut n = 0;
+            for l in &piece.edges {
+                // p is left of (or level with) q
+                if l.p[0] < xm && xm < l.q[0] && n < 2 {
+                    across[n] = Some(*l);
+                    n += 1;
+                }
+            }
+            if let [Some(l0), Some(l1)] = across {
+                if l0.at(xm) <= l1.at(xm) {
+                    sc.bounds.push((k, l0, l1));
+                } else {
+                    sc.bounds.push((k, l1, l0));
+                }
+            }
+        }
+    }
+
+    /// [`Sweep::bounds_found`] for a slab of the sweep itself (no corner inside it),
+    /// with the lines' ends into `sc.ends`: each piece's lower and upper edge followed
+    /// along its chains from the slab before, and a line's `y` at this slab's left end
+    /// the one found at the last one's right end.
+    fn bounds_followed(&mut self, sc: &mut Scratch, active: &[usize], xa: f64, xb: f64) {
+        let xm = 0.5 * (xa + xb);
+        sc.ends.clear();
+        for &k in active {
+            let piece = self.prepared[k]
+                .as_ref()
+                .expect("an active piece is prepared");
+            let mut lines = [None; 2];
+            let mut ends = [(0.0, 0.0); 2];
+            for (side, chain) in piece.chains.iter().enumerate() {
+                let follow = &mut self.follow[k][side];
+                let mut i = follow.0 as usize;
+                while i < chain.len() && piece.edges[chain[i] as usize].q[0] <= xa {
+                    i += 1;
+                }
+                follow.0 = i as u8;
+                let Some(&e) = chain.get(i) else { break };
+                let l = piece.edges[e as usize];
+                if !(l.p[0] < xm && xm < l.q[0]) {
+                    break;
+                }
+                let ya = if follow.1 == e && follow.2 == xa {
+                    follow.3
+                } else {
+                    l.at(xa)
+                };
+                let yb = l.at(xb);
+                *follow = (i as u8, e, xb, yb);
+                lines[side] = Some(l);
+                ends[side] = (ya, yb);
+            }
+            match lines {
+                [Some(l0), Some(l1)] => {
+                    sc.bounds.push((k, l0, l1));
+                    sc.ends.extend(ends);
+                }
+                _ => {
+                    // not two chains across the middle (a piece thinner than rounding):
+                    // its edges found as in a slab within a slab
+                    let at = sc.bounds.len();
+                    self.bounds_found(sc, &[k], xa, xb);
+                    for b in &sc.bounds[at..] {
+                        sc.ends
+                            .extend([(b.1.at(xa), b.1.at(xb)), (b.2.at(xa), b.2.at(xb))]);
+                    }
+                }
+            }
+        }
+    }
+
+    /// `sc.sorted` (each line's key and index, in the order of `sc.lines`) ordered by its
+    /// keys and indices, starting from the order of the slab before ([`Sweep::by_y`]),
+    /// which is then this slab's.
+    fn in_order(&mut self, sc: &mut Scratch) {
+        let bound_of = &mut self.bound_of;
+        for (b, bound) in sc.bounds.iter().enumerate() {
+            bound_of[bound.0] = b as u32;
+        }
+        // the pieces that left, out; those that came, in (at the end)
+        self.by_y.retain(|&(k, _)| {
+            let kept = bound_of[k as usize] != u32::MAX;
+            if !kept {
+                self.listed[k as usize] = false;
+            }
+            kept
+        });
+        let kept = self.by_y.len();
+        for bound in &sc.bounds {
+            if !self.listed[bound.0] {
+                self.listed[bound.0] = true;
+                self.by_y.extend([(bound.0 as u32, 0), (bound.0 as u32, 1)]);
+            }
+        }
+        let line = |&(k, side): &(u32, u8)| (2 * bound_of[k as usize] + u32::from(side)) as usize;
+        let key = |i: usize| sc.sorted[i].0;
+        let before = |a: usize, b: usize| {
+            key(a)
+                .cmp(&key(b))
+                .then_with(|| ends_cmp(&sc.ends[a], &sc.ends[b]))
+                .then(a.cmp(&b))
+                == std::cmp::Ordering::Less
+        };
+        let v = &mut self.by_y;
+        if v.len() - kept > 8 {
+            // many new ones (a strip's first slab): sorted as they are
+            v.sort_unstable_by(|a, b| {
+                let (la, lb) = (line(a), line(b));
+                if before(la, lb) {
+                    std::cmp::Ordering::Less
+                } else if la == lb {
+                    std::cmp::Ordering::Equal
+                } else {
+                    std::cmp::Ordering::Greater
+                }
+            });
+        }
+        for i in 1..v.len() {
+            let x = v[i];
+            let lx = line(&x);
+            let mut j = i;
+            while j > 0 && before(lx, line(&v[j - 1])) {
+                v[j] = v[j - 1];
+                j -= 1;
+            }
+            v[j] = x;
+        }
+        let sorted = &mut sc.sorted;
+        let mut by_line = std::mem::take(&mut sc.ordered);
+        by_line.clear();
+        by_line.extend(v.iter().map(|e| {
+            let i = line(e);
+            (sorted[i].0, i as u32)
+        }));
+        std::mem::swap(sorted, &mut by_line);
+        sc.ordered = by_line;
+        for bound in &sc.bounds {
+            bound_of[bound.0] = u32::MAX;
+        }
     }
 
     /// The slab `xa..xb` done as the slabs between `cuts` (ascending, inside it).
@@ -892,6 +1139,43 @@ pub fn strip_by_strip_on(
     rows: u32,
     threads: usize,
 ) -> (Vec<Fragment>, SegmentStats) {
+    let mut stats = SegmentStats::default();
+    let mut out = Vec::new();
+    strip_by_strip_into(tris, channels, rows, threads, |band| {
+        stats.add(&band.stats);
+        out.extend(band.fragments);
+    });
+    out.sort_by_key(|f| f.source);
+    (out, stats)
+}
+
+/// One band of strips resolved: what [`strip_by_strip_into`] hands on.
+#[derive(Debug)]
+pub struct Band {
+    /// Its place among the frame's bands, top first.
+    pub index: usize,
+    /// The `y` range it covers, `top..end` (on row lines).
+    pub rows: (f64, f64),
+    /// Its fragments, strip by strip from the top, each strip's in source order. Each
+    /// lies within one strip.
+    pub fragments: Vec<Fragment>,
+    /// What its strips' sweeps did.
+    pub stats: SegmentStats,
+}
+
+/// [`strip_by_strip_on`] without holding the frame's fragments: each band's are handed to
+/// `sink` as soon as the bands above it have been, top to bottom, on the calling thread
+/// (so the same bands, in the same order, at any thread count). The threads work on at
+/// most `2 × threads` bands ahead of the last one handed on, so what is held besides the
+/// triangles and their index (their planes, `y` ranges and order by top: 64 bytes each)
+/// is bounded by the bands in flight, not by the frame.
+pub fn strip_by_strip_into(
+    tris: &[ScreenTriangle],
+    channels: usize,
+    rows: u32,
+    threads: usize,
+    mut sink: impl FnMut(Band),
+) {
     let frame = StripFrame::new(tris, rows);
     let bands = frame.bands();
     let threads = match threads {
@@ -900,51 +1184,93 @@ pub fn strip_by_strip_on(
     }
     .min(bands.len())
     .max(1);
-    let mut done: Vec<(usize, Vec<Fragment>, SegmentStats)> = if threads == 1 {
-        bands
-            .iter()
-            .enumerate()
-            .map(|(i, &(y0, y1))| {
-                let (f, s) = frame.band(y0, y1, channels);
-                (i, f, s)
-            })
-            .collect()
-    } else {
-        let next = std::sync::atomic::AtomicUsize::new(0);
-        std::thread::scope(|scope| {
-            let workers: Vec<_> = (0..threads)
-                .map(|_| {
-                    scope.spawn(|| {
-                        let mut mine = Vec::new();
-                        loop {
-                            let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                            let Some(&(y0, y1)) = bands.get(i) else {
-                                break mine;
-                            };
-                            let (f, s) = frame.band(y0, y1, channels);
-                            mine.push((i, f, s));
-                        }
-                    })
-                })
-                .collect();
-            workers
-                .into_iter()
-                .flat_map(|w| match w.join() {
-                    Ok(done) => done,
-                    Err(panic) => std::panic::resume_unwind(panic),
-                })
-                .collect()
-        })
+    let resolve = |index: usize| {
+        let (top, end) = bands[index];
+        let (fragments, stats) = frame.band(top, end, channels);
+        Band {
+            index,
+            rows: (top, end),
+            fragments,
+            stats,
+        }
     };
-    done.sort_by_key(|d| d.0);
-    let mut stats = SegmentStats::default();
-    let mut out = Vec::with_capacity(done.iter().map(|d| d.1.len()).sum());
-    for (_, fragments, s) in done {
-        stats.add(&s);
-        out.extend(fragments);
+    if threads == 1 {
+        (0..bands.len()).map(resolve).for_each(sink);
+        return;
     }
-    out.sort_by_key(|f| f.source);
-    (out, stats)
+    use std::sync::{mpsc, Condvar, Mutex};
+    /// The next band to take, the next to hand on, and whether to stop (a thread
+    /// panicked).
+    struct Window {
+        next: usize,
+        handed: usize,
+        stop: bool,
+    }
+    let ahead = 2 * threads;
+    let window = Mutex::new(Window {
+        next: 0,
+        handed: 0,
+        stop: false,
+    });
+    let moved = Condvar::new();
+    let lock = || {
+        window
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner())
+    };
+    let panicked = std::thread::scope(|scope| {
+        let (send, receive) = mpsc::channel();
+        for _ in 0..threads {
+            let send = send.clone();
+            let (lock, moved, resolve, count) = (&lock, &moved, &resolve, bands.len());
+            scope.spawn(move || loop {
+                let index = {
+                    let mut w = lock();
+                    while !w.stop && w.next < count && w.next >= w.handed + ahead {
+                        w = moved
+                            .wait(w)
+                            .unwrap_or_else(|poisoned| poisoned.into_inner());
+                    }
+                    if w.stop || w.next >= count {
+                        break;
+                    }
+                    w.next += 1;
+                    w.next - 1
+                };
+                let done =
+                    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| resolve(index)));
+                let failed = done.is_err();
+                if send.send(done).is_err() || failed {
+                    break;
+                }
+            });
+        }
+        drop(send);
+        let mut waiting = std::collections::BTreeMap::new();
+        for done in receive {
+            match done {
+                Ok(band) => {
+                    waiting.insert(band.index, band);
+                }
+                Err(panic) => {
+                    lock().stop = true;
+                    moved.notify_all();
+                    return Some(panic);
+                }
+            }
+            let mut handed = lock().handed;
+            while let Some(band) = waiting.remove(&handed) {
+                sink(band);
+                handed += 1;
+            }
+            lock().handed = handed;
+            moved.notify_all();
+        }
+        None
+    });
+    if let Some(panic) = panicked {
+        std::panic::resume_unwind(panic);
+    }
 }
 
 /// A frame's triangles ready to be resolved strip by strip: their planes, and the
@@ -968,8 +1294,10 @@ impl<'a> StripFrame<'a> {
                 (ys[0].min(ys[1]).min(ys[2]), ys[0].max(ys[1]).max(ys[2]))
             })
             .collect();
-        let mut by_top: Vec<usize> = (0..tris.len()).filter(|&k| planes[k].is_some()).collect();
-        by_top.sort_by(|&a, &b| spans[a].0.total_cmp(&spans[b].0).then(a.cmp(&b)));
+        // sized once: the index is 64 bytes a triangle, not up to twice as many
+        let mut by_top: Vec<usize> = Vec::with_capacity(tris.len());
+        by_top.extend((0..tris.len()).filter(|&k| planes[k].is_some()));
+        by_top.sort_unstable_by(|&a, &b| spans[a].0.total_cmp(&spans[b].0).then(a.cmp(&b)));
         StripFrame {
             tris,
             rows: f64::from(rows.max(1)),
