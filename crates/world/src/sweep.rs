@@ -347,6 +347,8 @@ struct Chain {
     lower_line: Line,
     upper_line: Line,
     x1: f64,
+    /// The lower and upper lines' `y` at `x1` (as the slab that reached it found them).
+    y1: [f64; 2],
 }
 
 impl Chain {
@@ -355,7 +357,7 @@ impl Chain {
     fn outline(&self) -> Vec<[f64; 2]> {
         let x1 = self.x1;
         let mut v: Vec<[f64; 2]> = Vec::with_capacity(self.lower.len() + self.upper.len() + 2);
-        let ends = [[x1, self.lower_line.at(x1)], [x1, self.upper_line.at(x1)]];
+        let ends = [[x1, self.y1[0]], [x1, self.y1[1]]];
         for p in self
             .lower
             .iter()
@@ -762,13 +764,12 @@ impl Sweep<'_> {
                         let d = |x: f64, y: f64| pb.at(x, y) - pw.at(x, y);
                         // the winner nearer at the run's corners is nearer all over it
                         // (the difference is affine): the common case, a piece behind
-                        let run_corners = [
-                            (xa, run.0 .0),
-                            (xb, run.0 .1),
-                            (xa, run.1 .0),
-                            (xb, run.1 .1),
+                        let at_corners = [
+                            d(xa, run.0 .0),
+                            d(xb, run.0 .1),
+                            d(xa, run.1 .0),
+                            d(xb, run.1 .1),
                         ];
-                        let at_corners = run_corners.map(|(x, y)| d(x, y));
                         if at_corners.iter().all(|&v| v <= tol) {
                             // not nearer anywhere on the run; but a coplanar piece that
                             // comes first wins all they share (the lower index), and the
@@ -856,13 +857,14 @@ impl Sweep<'_> {
                 sc.lines[sc.by_rank[hi] as usize],
             );
             let (ya_lower, ya_upper) = (order[lo].0, order[hi].0);
+            let y1 = [order[lo].1, order[hi].1];
             let chains = &self.chains;
             let continued = self.open.iter().position(|&k| {
                 let c = &chains[k];
                 c.source == source
                     && c.x1 == xa
-                    && c.lower_line.at(xa) == ya_lower
-                    && c.upper_line.at(xa) == ya_upper
+                    && c.y1[0] == ya_lower
+                    && c.y1[1] == ya_upper
                     && ya_lower < ya_upper
             });
             match continued {
@@ -878,6 +880,7 @@ impl Sweep<'_> {
                         c.upper_line = upper;
                     }
                     c.x1 = xb;
+                    c.y1 = y1;
                     self.next.push(k);
                 }
                 None => {
@@ -889,6 +892,7 @@ impl Sweep<'_> {
                         lower_line: lower,
                         upper_line: upper,
                         x1: xb,
+                        y1,
                     });
                 }
             }
