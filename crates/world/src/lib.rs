@@ -31,6 +31,7 @@ pub mod bezier;
 mod boolean;
 pub mod camera;
 pub mod clip;
+mod cover;
 pub mod embedded;
 pub mod events;
 pub mod face;

@@ -30,7 +30,11 @@
 //!    other over the whole overlap, so exactly one of them keeps it.
 //! 4. **Difference.** `visible(T) = proj(T) − ⋃ pieces`, one `i_overlay` difference per
 //!    triangle with all contours oriented alike and the non-zero fill rule (overlapping
-//!    pieces add up, never cancel). A triangle hidden by nothing is output as it is.
+//!    pieces add up, never cancel). A triangle hidden by nothing is output as it is,
+//!    and one that its pieces together cover is hidden without the boolean (the pieces'
+//!    edges that no other piece shares from the other side bound what they cover: when
+//!    none meets the triangle and its centroid lies in a piece, all of it is covered;
+//!    `crate::cover`, conservative: else the boolean decides).
 //! 5. **Holes.** The Y-processor takes simple polygons without holes. A result with holes
 //!    is cut by the horizontal line through the middle of its first hole's y-range into
 //!    the parts above and below (intersections with two half-planes, again with
@@ -364,6 +368,7 @@ impl Shared<'_> {
         let mut candidates = Vec::new();
         let mut pieces: Vec<Contour> = Vec::new();
         let mut contours = Vec::new();
+        let mut edges = Vec::new();
         for k in range {
             let tri = &tris[k];
             let before = tally.fragments.len();
@@ -403,7 +408,9 @@ impl Shared<'_> {
                         pieces.push(piece);
                     }
                 }
-                let cut = if covered {
+                // the pieces together covering all of it (the far side of a mesh under
+                // the near side's triangles): hidden, without the boolean
+                let cut = if covered || crate::cover::covers(&tri.points, &pieces, &mut edges) {
                     Some(Vec::new())
                 } else if pieces.is_empty() {
                     None
