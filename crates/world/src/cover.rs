@@ -12,11 +12,12 @@
 //! left over. If none of those meets the triangle, that number is the same all over it,
 //! and one point of it inside a piece shows it covered. The answer is conservative:
 //! `false` whenever an edge left over touches the triangle, however little (then the
-//! boolean decides); where floating point tells a touch from a miss wrongly, what could be
-//! left uncovered is thinner than rounding, far under the slivers the boolean drops
-//! (`boolean::SLIVER_AREA`).
+//! boolean decides). Touches and sides are told by the exact predicates scene validation
+//! uses (`cwisim_scene::predicates`); only the centroid is rounded, and it lies in the
+//! triangle's inside, where the count is the same everywhere.
 
-use crate::boolean::{cross, signed_area, Contour, Pt};
+use crate::boolean::{signed_area, Contour, Pt};
+use cwisim_scene::predicates::{orient, segments_meet};
 
 /// Whether the convex, anticlockwise pieces `pieces` cover all of the triangle `t` (see
 /// the [module docs](self)); `false` when that is not shown. `edges` is scratch space.
@@ -64,39 +65,25 @@ pub(crate) fn covers(t: &[Pt; 3], pieces: &[Contour], edges: &mut Vec<(Pt, Pt, b
     ];
     pieces
         .iter()
-        .any(|p| (0..p.len()).all(|i| cross(p[i], p[(i + 1) % p.len()], c) >= 0.0))
+        .any(|p| (0..p.len()).all(|i| orient(p[i], p[(i + 1) % p.len()], c) >= 0))
 }
 
 /// Whether the segment `a`–`b` meets the triangle `t` (its inside or its edges,
-/// touching included).
+/// touching included), exactly.
 fn meets(a: Pt, b: Pt, t: &[Pt; 3]) -> bool {
-    let turn = signed_area(t).signum();
-    let inside = |p: Pt| (0..3).all(|i| turn * cross(t[i], t[(i + 1) % 3], p) >= 0.0);
-    if inside(a) || inside(b) {
-        return true;
+    // beside the triangle's box: apart (comparing coordinates is exact)
+    let beside = (0..2).any(|k| {
+        let (lo, hi) = (a[k].min(b[k]), a[k].max(b[k]));
+        hi < t[0][k].min(t[1][k]).min(t[2][k]) || lo > t[0][k].max(t[1][k]).max(t[2][k])
+    });
+    if beside {
+        return false;
     }
-    (0..3).any(|i| segments_meet(a, b, t[i], t[(i + 1) % 3]))
-}
-
-/// Whether the closed segments `a`–`b` and `c`–`d` meet.
-fn segments_meet(a: Pt, b: Pt, c: Pt, d: Pt) -> bool {
-    let (d1, d2) = (cross(c, d, a), cross(c, d, b));
-    let (d3, d4) = (cross(a, b, c), cross(a, b, d));
-    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0))
-        && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0))
-    {
-        return true;
-    }
-    let on = |p: Pt, q: Pt, r: Pt| {
-        r[0] >= p[0].min(q[0])
-            && r[0] <= p[0].max(q[0])
-            && r[1] >= p[1].min(q[1])
-            && r[1] <= p[1].max(q[1])
-    };
-    (d1 == 0.0 && on(c, d, a))
-        || (d2 == 0.0 && on(c, d, b))
-        || (d3 == 0.0 && on(a, b, c))
-        || (d4 == 0.0 && on(a, b, d))
+    let turn = orient(t[0], t[1], t[2]);
+    let inside = |p: Pt| (0..3).all(|i| orient(t[i], t[(i + 1) % 3], p) * turn >= 0);
+    inside(a)
+        || inside(b)
+        || (0..3).any(|i| segments_meet((a, b), (t[i], t[(i + 1) % 3])).is_some())
 }
 
 #[cfg(test)]

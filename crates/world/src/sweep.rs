@@ -255,14 +255,11 @@ fn corners(a: (Ends, Ends), b: (Ends, Ends)) -> ([(f64, f64); 12], usize) {
     (out, n)
 }
 
-/// A piece prepared: its `1/depth` as `gx·x + gy·y + c`, its box, its edges.
+/// A piece prepared: its `1/depth` plane, its box, its edges.
 struct Prepared {
-    gx: f64,
-    gy: f64,
-    c: f64,
+    plane: Plane,
     x0: f64,
     x1: f64,
-    scale: f64,
     /// Its corners' `x` (every edge's two ends, each once).
     corner_xs: ArrayVec<f64, 5>,
     /// Its lower and upper edges (indices in `edges`, left to right; upright ones in
@@ -335,12 +332,14 @@ impl Prepared {
         }
         Prepared {
             chains,
-            gx: plane[0],
-            gy: plane[1],
-            c: plane[2],
+            plane: Plane {
+                gx: plane[0],
+                gy: plane[1],
+                c: plane[2],
+                scale,
+            },
             x0: xs.clone().fold(f64::INFINITY, f64::min),
             x1: xs.fold(f64::NEG_INFINITY, f64::max),
-            scale,
             corner_xs: corners.iter().map(|p| p[0]).collect(),
             edges,
         }
@@ -442,14 +441,7 @@ fn visible_parts(
     by_start.sort_unstable_by(|&a, &b| start(a).total_cmp(&start(b)).then(a.cmp(&b)));
     let planes: Vec<Plane> = prepared
         .iter()
-        .map(|p| {
-            p.as_ref().map_or(Plane::default(), |p| Plane {
-                gx: p.gx,
-                gy: p.gy,
-                c: p.c,
-                scale: p.scale,
-            })
-        })
+        .map(|p| p.as_ref().map_or(Plane::default(), |p| p.plane))
         .collect();
     let mut sweep = Sweep {
         prepared,
@@ -464,7 +456,7 @@ fn visible_parts(
         by_y: Vec::new(),
         listed: vec![false; prepared.len()],
         bound_of: vec![u32::MAX; prepared.len()],
-        follow: vec![[(0, u8::MAX, f64::NAN, 0.0); 2]; prepared.len()],
+        follow: vec![[Followed::START; 2]; prepared.len()],
     };
     let mut active: Vec<usize> = Vec::new();
     let mut entering = 0;
@@ -520,6 +512,27 @@ fn visible_parts(
     out
 }
 
+/// One of a piece's chains followed from slab to slab: the place in it, the edge there,
+/// and that edge's `y` at the `x` last asked (so that the next slab, which starts there,
+/// need not work it out again).
+#[derive(Clone, Copy, Debug)]
+struct Followed {
+    place: u8,
+    edge: u8,
+    x: f64,
+    y: f64,
+}
+
+impl Followed {
+    /// Before the first slab: no edge, no `x` asked.
+    const START: Followed = Followed {
+        place: 0,
+        edge: u8::MAX,
+        x: f64::NAN,
+        y: 0.0,
+    };
+}
+
 /// The sweep's state: the chains open at the current slab's left end, those it
 /// continues or starts, and those closed; scratch space for the slabs.
 struct Sweep<'a> {
@@ -545,9 +558,8 @@ struct Sweep<'a> {
     listed: Vec<bool>,
     /// Each piece's place in the slab's bounds (`u32::MAX`: none), while ordering.
     bound_of: Vec<u32>,
-    /// Each piece's lower and upper edge followed from slab to slab: the place in its
-    /// chain, the edge, and its `y` at the `x` last asked.
-    follow: Vec<[(u8, u8, f64, f64); 2]>,
+    /// Each piece's lower and upper edge, followed from slab to slab.
+    follow: Vec<[Followed; 2]>,
 }
 
 impl Sweep<'_> {
@@ -591,13 +603,15 @@ impl Sweep<'_> {
         let wide = xb - xa > 2.0 * MIN_WIDTH && self.nesting < MAX_NESTING;
         let planes = self.planes;
         let piece = |k: usize| &planes[k];
+        // a slab of the sweep itself (not one within a slab, no lines added): it starts
+        // where the last one ended, and what that one found runs on
+        let top = self.nesting == 1 && extra.is_empty();
         // each piece's two edges across the slab, lower first, and their ends
         sc.bounds.clear();
         sc.lines.clear();
         sc.ends.clear();
-        if self.nesting == 1 && extra.is_empty() {
-            // a slab of the sweep itself: the edges and their ends followed from the
-            // slab before
+        if top {
+            // the edges and their ends followed from the slab before
             self.bounds_followed(sc, active, xa, xb);
         } else {
             self.bounds_found(sc, active, xa, xb);
@@ -621,8 +635,8 @@ impl Sweep<'_> {
                 .enumerate()
                 .map(|(i, e)| (ordered(e.0 + e.1), i as u32)),
         );
-        if self.nesting == 1 && extra.is_empty() {
-            // a slab of the sweep itself: its lines in the order of the slab before
+        if top {
+            // its lines in the order of the slab before
             // (each piece's lower and upper line run on from slab to slab), with the new
             // pieces' after them, then put in order by insertion — a few steps, where a
             // sort of lines in no order mispredicts at every other comparison
@@ -974,23 +988,28 @@ impl Sweep<'_> {
             let mut ends = [(0.0, 0.0); 2];
             for (side, chain) in piece.chains.iter().enumerate() {
                 let follow = &mut self.follow[k][side];
-                let mut i = follow.0 as usize;
+                let mut i = follow.place as usize;
                 while i < chain.len() && piece.edges[chain[i] as usize].q[0] <= xa {
                     i += 1;
                 }
-                follow.0 = i as u8;
+                follow.place = i as u8;
                 let Some(&e) = chain.get(i) else { break };
                 let l = piece.edges[e as usize];
                 if !(l.p[0] < xm && xm < l.q[0]) {
                     break;
                 }
-                let ya = if follow.1 == e && follow.2 == xa {
-                    follow.3
+                let ya = if follow.edge == e && follow.x == xa {
+                    follow.y
                 } else {
                     l.at(xa)
                 };
                 let yb = l.at(xb);
-                *follow = (i as u8, e, xb, yb);
+                *follow = Followed {
+                    place: i as u8,
+                    edge: e,
+                    x: xb,
+                    y: yb,
+                };
                 lines[side] = Some(l);
                 ends[side] = (ya, yb);
             }
