@@ -186,6 +186,17 @@ impl Instruction {
         }
     }
 
+    /// The `[I, dI, ddI]` slots of an instruction of at most one channel per slot
+    /// (`0.0` in a slot it does not carry), read without a branch on which it carries;
+    /// `None` for more channels.
+    #[inline]
+    pub fn grey_values(&self) -> Option<[f64; 3]> {
+        match &self.values {
+            Values::Grey { v, .. } => Some(*v),
+            Values::Wide(_) => None,
+        }
+    }
+
     /// The values of slot `slot` (0 = `I`, 1 = `dI`, 2 = `ddI`), one per channel; empty
     /// for a slot the instruction does not carry.
     #[inline]

@@ -27,6 +27,9 @@ pub trait Arith: Clone + Send + Sync + 'static {
     type Out: Sample;
     /// The reset value of every register.
     const ZERO: Self::Reg;
+    /// The adders' identity: adding it to any register leaves its bits as they are and
+    /// counts no overflow (`-0.0` for a float, `0` for fixed point).
+    const IDENTITY: Self::Reg;
     /// Whether [`Self::operand`] may count an overflow; when false, converting an operand
     /// has no effect but its value (an engine may skip an unused conversion).
     const OPERAND_OVERFLOWS: bool = true;
@@ -177,6 +180,7 @@ impl<T: Sample> Arith for Native<T> {
     type Reg = T;
     type Out = T;
     const ZERO: T = T::ZERO;
+    const IDENTITY: T = T::IDENTITY;
     const OPERAND_OVERFLOWS: bool = false;
 
     #[inline]
@@ -232,6 +236,7 @@ impl Arith for F32Arith {
     type Reg = f32;
     type Out = f64;
     const ZERO: f32 = 0.0;
+    const IDENTITY: f32 = -0.0;
 
     #[inline]
     fn operand(&self, _reg: Register, x: f64, overflows: &mut u64) -> f32 {
@@ -722,6 +727,7 @@ impl Arith for FixedArith {
     type Reg = i64;
     type Out = f64;
     const ZERO: i64 = 0;
+    const IDENTITY: i64 = 0;
 
     #[inline]
     fn operand(&self, reg: Register, x: f64, overflows: &mut u64) -> i64 {

@@ -46,6 +46,7 @@ mod clock;
 pub mod engine;
 pub mod fast;
 pub mod feed;
+mod lanes;
 pub mod machine;
 pub mod numeric;
 pub mod output;

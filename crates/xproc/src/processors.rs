@@ -10,9 +10,11 @@
 //! except one bit: whether negative accumulation is on (`Acc_mode`).
 
 use crate::arith::{Arith, Wave};
+use crate::lanes::{batches, Batch, MAX_LEN, SPARE};
 use crate::numeric::Register;
 use crate::stats::{IssueTally, Work};
 use cwisim_isa::{Instruction, Opcode, MAX_CHANNELS};
+use std::hint::select_unpredictable;
 
 const HAS_I: u8 = 1;
 const HAS_DI: u8 = 2;
@@ -80,16 +82,23 @@ pub(crate) struct Processors<A: Arith> {
     work: Work,
     /// Scratch space for a scanline converted for output.
     out: Vec<A::Out>,
+    /// Plain `Eval`s pending, run side by side ([`crate::lanes`]).
+    batch: Batch<A::Reg>,
+    /// Whether `Eval`s are batched: on a grey array of `f64` registers
+    /// ([`crate::lanes::batches`]).
+    batches: bool,
 }
 
 impl<A: Arith> Processors<A> {
     /// `width` processors of `channels` channels, cleared, negative accumulation off.
     pub(crate) fn new(width: usize, channels: usize, arith: A) -> Self {
         let (w, c) = (width, channels);
+        // a grey array batches `Eval`s: their lanes' spare accumulators follow its own
+        let spare = if c == 1 && batches::<A>() { SPARE } else { 0 };
         Processors {
             arith,
             channels: c,
-            acc: vec![A::ZERO; w * c],
+            acc: vec![A::ZERO; w * c + spare],
             regs: [
                 vec![A::ZERO; w * c],
                 vec![A::ZERO; w * c],
@@ -106,7 +115,17 @@ impl<A: Arith> Processors<A> {
             tally: IssueTally::default(),
             work: Work::default(),
             out: Vec::new(),
+            batch: Batch::new(A::ZERO),
+            batches: c == 1 && batches::<A>(),
         }
+    }
+
+    /// The same processors with every `Eval` run by its own chain: the reference the
+    /// lanes are tested against.
+    #[cfg(test)]
+    pub(crate) fn without_batches(mut self) -> Self {
+        self.batches = false;
+        self
     }
 
     /// Processors of the same size and arithmetic, cleared.
@@ -142,6 +161,7 @@ impl<A: Arith> Processors<A> {
     /// The instructions since the last `Refresh` and their work, taken (at the end of a
     /// trace: a scanline never refreshed).
     pub(crate) fn take_open_scanline(&mut self) -> (IssueTally, Work) {
+        self.run_batch();
         (
             std::mem::take(&mut self.tally),
             std::mem::take(&mut self.work),
@@ -303,6 +323,50 @@ impl<A: Arith> Processors<A> {
         self.work.overflows += ovf;
     }
 
+    /// A plain `Eval` of `order` (1–3) on a grey array, at most [`MAX_LEN`] processors:
+    /// counted and its operands converted now, its chain run with the batch
+    /// ([`crate::lanes`]), which runs first if the `Eval` does not fit in it.
+    #[inline(always)]
+    fn queue(&mut self, instr: &Instruction, order: u8, values: [f64; 3]) {
+        let (x, dx) = (instr.x as usize, instr.dx as usize);
+        let ar = &self.arith;
+        // a lane advances all three registers, those beyond its order by the identity:
+        // the operand of `slot`, or `A::IDENTITY` (counting nothing) beyond the order
+        let operand = |slot: usize, reg: Register, ovf: &mut u64| {
+            let mut o = 0;
+            let r = ar.operand(reg, values[slot], &mut o);
+            let carried = usize::from(order) > slot;
+            *ovf += select_unpredictable(carried, o, 0);
+            select_unpredictable(carried, r, A::IDENTITY)
+        };
+        let mut ovf = 0;
+        let v = operand(0, Register::I, &mut ovf);
+        let d = operand(1, Register::DI, &mut ovf);
+        let dd = operand(2, Register::DDI, &mut ovf);
+        self.work.updates += dx as u64;
+        self.work.overflows += ovf;
+        self.touch(x, x + dx);
+        self.evals += 1;
+        if !self.batch.try_push(order, x, dx, v, d, dd) {
+            self.run_batch();
+            let taken = self.batch.try_push(order, x, dx, v, d, dd);
+            debug_assert!(taken, "an empty batch takes any Eval");
+        }
+    }
+
+    /// Runs the pending `Eval`s, if any, and adds what they counted to the scanline's work.
+    #[inline(always)]
+    fn run_batch(&mut self) {
+        if self.batch.is_empty() {
+            return;
+        }
+        let counts = self
+            .batch
+            .run(&self.arith, &mut self.acc, self.negative_enabled);
+        self.work.dropped += counts.dropped;
+        self.work.overflows += counts.overflows;
+    }
+
     /// Hands the scanline out and clears what it touched.
     fn refresh<F: FnMut(LineEnd<'_, A::Out>)>(&mut self, on_line: &mut F) {
         let c = self.channels;
@@ -339,6 +403,16 @@ impl<A: Arith> Processors<A> {
         if dx == 0 && is_eval(instr.op) {
             self.empty_eval::<C>(instr);
             return;
+        }
+        if C == 1 && self.batches {
+            // `Eval1`–`Eval3` as 0–2, every other opcode above: no branch on the order
+            let order = (instr.op as u8).wrapping_sub(Opcode::Eval1 as u8);
+            if order < 3 && !self.any_flags && !self.dis_pending && dx <= MAX_LEN {
+                if let Some(values) = instr.grey_values() {
+                    return self.queue(instr, order + 1, values);
+                }
+            }
+            self.run_batch();
         }
         let mut w = Work::default();
         match instr.op {

@@ -12,6 +12,9 @@ use std::fmt::Debug;
 pub trait Sample: Copy + Debug + Send + Sync + 'static {
     /// The reset value.
     const ZERO: Self;
+    /// The adder's identity: `x.add(IDENTITY)` is `x`, bit for bit, for every `x`
+    /// (`-0.0` for a float: `+0.0` would turn `-0.0` into `+0.0`).
+    const IDENTITY: Self;
     /// Converts an operand.
     fn from_f64(v: f64) -> Self;
     /// Converts for output.
@@ -24,6 +27,7 @@ pub trait Sample: Copy + Debug + Send + Sync + 'static {
 
 impl Sample for f64 {
     const ZERO: f64 = 0.0;
+    const IDENTITY: f64 = -0.0;
     #[inline]
     fn from_f64(v: f64) -> f64 {
         v
