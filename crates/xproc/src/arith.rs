@@ -341,7 +341,7 @@ impl F32Arith {
     /// The overflow events of an `f32` chain that has run on `acc` from `wave`: its
     /// `v`/`d` adds again, counted, and each accumulator add that left a non-finite value.
     #[cold]
-    fn recount<const ORDER: usize, const C: usize>(
+    pub(crate) fn recount<const ORDER: usize, const C: usize>(
         acc: &[f32],
         wave: Wave<f32>,
         neg_ok: bool,

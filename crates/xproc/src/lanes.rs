@@ -15,7 +15,7 @@
 //! span's end keeps stepping (the loop is branch-free) but adds the adders' identity, which
 //! changes no bit, and what it counts there is masked out.
 
-use crate::arith::{Arith, Counts, Wave};
+use crate::arith::{Arith, Counts, F32Arith, Wave};
 use cwisim_isa::MAX_CHANNELS;
 use std::any::Any;
 
@@ -108,7 +108,10 @@ impl<R: Copy + 'static> Batch<R> {
     ) -> Counts {
         let counts = match f64_side_by_side(acc, self, neg_ok) {
             Some(counts) => counts,
-            None => self.one_by_one(ar, acc, neg_ok),
+            None => match f32_side_by_side(acc, self, neg_ok) {
+                Some(counts) => counts,
+                None => self.one_by_one(ar, acc, neg_ok),
+            },
         };
         self.n = 0;
         self.len = [0; LANES];
@@ -141,12 +144,60 @@ impl<R: Copy + 'static> Batch<R> {
     }
 }
 
-/// Whether the processors of arithmetic `A` batch their `Eval`s: `f64` registers on a
-/// machine with lanes for them ([`f64_side_by_side`]). In any other format, or without
-/// vector registers, a batch in plain code costs more than the `Eval`s' own chains.
+/// Whether the processors of arithmetic `A` batch their `Eval`s: `f64` or `f32`
+/// registers on a machine with lanes for them ([`f64_side_by_side`],
+/// [`f32_side_by_side`]). In fixed point, or without vector registers, a batch in plain
+/// code costs more than the `Eval`s' own chains.
 pub(crate) fn batches<A: Arith>() -> bool {
-    cfg!(target_arch = "x86_64")
-        && std::any::TypeId::of::<A::Reg>() == std::any::TypeId::of::<f64>()
+    use std::any::TypeId;
+    let reg = TypeId::of::<A::Reg>();
+    cfg!(target_arch = "x86_64") && (reg == TypeId::of::<f64>() || reg == TypeId::of::<f32>())
+}
+
+/// [`f64_side_by_side`] for `f32` registers ([`F32Arith`]: `f32` adds, a non-finite
+/// result an overflow event), four lanes to a 128-bit register (SSE2). The lanes add
+/// without counting and note whether any value they made is not finite; only then are
+/// the events counted again, lane by lane ([`F32Arith::recount`]: an accumulator's add
+/// overflowed iff the value it left is not finite, and each accumulator in a lane's span
+/// holds that lane's one add — the other lanes add `-0.0` there at most).
+#[allow(
+    clippy::ptr_arg,
+    reason = "a `Vec<f32>` is told apart by its type, a slice cannot be"
+)]
+fn f32_side_by_side<R: Copy + 'static>(
+    acc: &mut Vec<R>,
+    b: &Batch<R>,
+    neg_ok: bool,
+) -> Option<Counts> {
+    #[cfg(all(target_arch = "x86_64", target_feature = "sse2"))]
+    {
+        let b = (b as &dyn Any).downcast_ref::<Batch<f32>>()?;
+        let acc = (acc as &mut dyn Any).downcast_mut::<Vec<f32>>()?;
+        // SAFETY: the function needs SSE2, which every x86-64 has (the cfg above holds).
+        let (dropped, non_finite) = unsafe { x86::side_by_side_f32(acc, b, neg_ok) };
+        let mut overflows = 0;
+        if non_finite {
+            for l in 0..LANES {
+                let wave = Wave {
+                    v: [b.v[l], 0.0, 0.0, 0.0],
+                    d: [b.d[l], 0.0, 0.0, 0.0],
+                    dd: [b.dd[l], 0.0, 0.0, 0.0],
+                };
+                let span = &acc[b.x[l]..b.x[l] + b.len[l]];
+                overflows += match b.order[l] {
+                    1 => F32Arith::recount::<1, 1>(span, wave, neg_ok),
+                    2 => F32Arith::recount::<2, 1>(span, wave, neg_ok),
+                    _ => F32Arith::recount::<3, 1>(span, wave, neg_ok),
+                };
+            }
+        }
+        Some(Counts { dropped, overflows })
+    }
+    #[cfg(not(all(target_arch = "x86_64", target_feature = "sse2")))]
+    {
+        let _ = (acc, b, neg_ok);
+        None
+    }
 }
 
 /// The batch's lanes side by side, one processor of every lane a step, for as many
@@ -332,21 +383,87 @@ mod x86 {
             overflows: 0,
         }
     }
+
+    /// The `f32` lanes, four to a register: the dropped contributions, and whether any
+    /// value the lanes made (a running `v` or `d`, or an accumulator they added to) is
+    /// not finite, past a lane's end included (a false alarm only costs a recount).
+    #[target_feature(enable = "sse2")]
+    pub(super) fn side_by_side_f32(acc: &mut [f32], b: &Batch<f32>, neg_ok: bool) -> (u64, bool) {
+        let steps = b.len.into_iter().max().unwrap_or(0);
+        let top = b.x.into_iter().max().unwrap_or(0) + steps;
+        // Every access below is to `acc[b.x[l] + s]` with `s < steps`: below `top`.
+        assert!(
+            top <= acc.len(),
+            "a lane reaches past the spare accumulators"
+        );
+        let base = acc.as_mut_ptr();
+        let lane = |l: usize| base.wrapping_add(b.x[l]);
+        let (p0, p1, p2, p3) = (lane(0), lane(1), lane(2), lane(3));
+        let four = |r: &[f32; LANES]| _mm_setr_ps(r[0], r[1], r[2], r[3]);
+        let (mut v, mut d, dd) = (four(&b.v), four(&b.d), four(&b.dd));
+        let len = four(&b.len.map(|n| n as f32));
+        let identity = _mm_set1_ps(-0.0);
+        let one = _mm_set1_ps(1.0);
+        let threshold = _mm_set1_ps(if neg_ok { f32::NEG_INFINITY } else { 0.0 });
+        // `(bits & exponent) + 2^23` carries into the sign bit iff the exponent is all ones
+        let exponent = _mm_set1_epi32(0x7f80_0000);
+        let carry = _mm_set1_epi32(0x0080_0000);
+        let non_finite =
+            |x: __m128| _mm_add_epi32(_mm_and_si128(_mm_castps_si128(x), exponent), carry);
+        let mut step = _mm_setzero_ps();
+        let mut dropped = _mm_setzero_si128();
+        let mut bad = _mm_setzero_si128();
+        for s in 0..steps {
+            let active = _mm_cmplt_ps(step, len);
+            let negative = _mm_cmplt_ps(v, threshold);
+            let take = _mm_andnot_ps(negative, active);
+            let add = _mm_or_ps(_mm_and_ps(take, v), _mm_andnot_ps(take, identity));
+            let drop = _mm_castps_si128(_mm_and_ps(active, negative));
+            dropped = _mm_sub_epi32(dropped, drop);
+            v = _mm_add_ps(v, d);
+            d = _mm_add_ps(d, dd);
+            step = _mm_add_ps(step, one);
+            let add = [
+                _mm_cvtss_f32(add),
+                _mm_cvtss_f32(_mm_shuffle_ps::<0b01_01_01_01>(add, add)),
+                _mm_cvtss_f32(_mm_movehl_ps(add, add)),
+                _mm_cvtss_f32(_mm_shuffle_ps::<0b11_11_11_11>(add, add)),
+            ];
+            // SAFETY: as in `side_by_side_sse2`. One lane's add is stored before the
+            // next lane's is read: past its end a lane may reach another's processor.
+            let sums = unsafe {
+                let mut sums = [0.0f32; LANES];
+                for (l, p) in [p0, p1, p2, p3].into_iter().enumerate() {
+                    sums[l] = *p.add(s) + add[l];
+                    *p.add(s) = sums[l];
+                }
+                _mm_setr_ps(sums[0], sums[1], sums[2], sums[3])
+            };
+            bad = _mm_or_si128(bad, _mm_or_si128(non_finite(v), non_finite(d)));
+            bad = _mm_or_si128(bad, non_finite(sums));
+        }
+        let mut counts = [0i32; LANES];
+        // SAFETY: `counts` is 16 bytes, as an unaligned store needs.
+        unsafe { _mm_storeu_si128(counts.as_mut_ptr().cast(), dropped) };
+        let bad = _mm_movemask_ps(_mm_castsi128_ps(bad)) != 0;
+        (counts.iter().map(|&c| c as u64).sum(), bad)
+    }
 }
 
 #[cfg(test)]
 mod tests {
-    use crate::arith::Native;
+    use crate::arith::{Arith, F32Arith, Native};
     use crate::processors::{LineEnd, Processors};
     use cwisim_isa::{Instruction, Intensity};
     use proptest::prelude::*;
 
     const WIDTH: usize = 100;
+    const F64: Native<f64> = Native::new();
 
     /// Every scanline the processors hand out (values as bits, tally, work), and the
     /// open scanline's tally and work at the end.
-    fn replay(trace: &[Instruction], batches: bool) -> Vec<String> {
-        let mut p = Processors::new(WIDTH, 1, Native::<f64>::new());
+    fn replay<A: Arith<Out = f64>>(arith: A, trace: &[Instruction], batches: bool) -> Vec<String> {
+        let mut p = Processors::new(WIDTH, 1, arith);
         if !batches {
             p = p.without_batches();
         }
@@ -421,7 +538,8 @@ mod tests {
         fn evals_side_by_side_are_the_evals_one_by_one(
             trace in proptest::collection::vec(instruction(), 0..120),
         ) {
-            prop_assert_eq!(replay(&trace, true), replay(&trace, false));
+            prop_assert_eq!(replay(F64, &trace, true), replay(F64, &trace, false));
+            prop_assert_eq!(replay(F32Arith, &trace, true), replay(F32Arith, &trace, false));
         }
     }
 
@@ -439,7 +557,16 @@ mod tests {
                 Instruction::eval2(70 - len.min(3), 1, g(-0.0), g(-1.0)),
                 Instruction::refresh(),
             ];
-            assert_eq!(replay(&trace, true), replay(&trace, false), "len {len}");
+            assert_eq!(
+                replay(F64, &trace, true),
+                replay(F64, &trace, false),
+                "len {len}"
+            );
+            let f32 = (
+                replay(F32Arith, &trace, true),
+                replay(F32Arith, &trace, false),
+            );
+            assert_eq!(f32.0, f32.1, "f32, len {len}");
         }
     }
 }
@@ -448,8 +575,8 @@ mod tests {
 /// run here whatever the batch path picks on this machine (AVX2 only where it is).
 #[cfg(all(test, target_arch = "x86_64"))]
 mod kernels {
-    use super::{x86, Batch, LANES, MAX_LEN, SPARE};
-    use crate::arith::Native;
+    use super::{f32_side_by_side, x86, Batch, LANES, MAX_LEN, SPARE};
+    use crate::arith::{F32Arith, Native};
     use proptest::prelude::*;
 
     const WIDTH: usize = 90;
@@ -480,6 +607,23 @@ mod kernels {
         proptest::collection::vec(prop_oneof![Just(0.0), -1.0..1.0f64], WIDTH + SPARE)
     }
 
+    /// `b` in `f32`, with the lanes' values scaled by `scale` (large ones overflow).
+    fn narrowed(b: &Batch<f64>, scale: f32) -> Batch<f32> {
+        let mut n = Batch::new(0.0f32);
+        for l in 0..b.n {
+            let (v, d, dd) = (b.v[l] as f32, b.d[l] as f32, b.dd[l] as f32);
+            n.try_push(
+                b.order[l],
+                b.x[l],
+                b.len[l],
+                v * scale,
+                d * scale,
+                dd * scale,
+            );
+        }
+        n
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(3000))]
 
@@ -493,6 +637,18 @@ mod kernels {
             let got = unsafe { x86::side_by_side_sse2(&mut sse2, &b, neg_ok) };
             prop_assert_eq!(got, counts);
             prop_assert_eq!(bits(&sse2), bits(&want));
+            // `f32`, at values that stay finite and at values that overflow
+            for scale in [1.0f32, 1e38] {
+                let b = narrowed(&b, scale);
+                let acc: Vec<f32> = acc.iter().map(|&a| a as f32 * scale).collect();
+                let mut want = acc.clone();
+                let counts = b.one_by_one(&F32Arith, &mut want, neg_ok);
+                let mut lanes = acc.clone();
+                let got = f32_side_by_side(&mut lanes, &b, neg_ok);
+                prop_assert_eq!(got, Some(counts));
+                let bits = |a: &[f32]| a.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+                prop_assert_eq!(bits(&lanes), bits(&want));
+            }
             if std::is_x86_feature_detected!("avx2") {
                 let mut avx2 = acc.clone();
                 // SAFETY: detected just above.
