@@ -3,11 +3,13 @@
 //! One `Eval`'s chain is serial (each processor's `v` is the one before's plus `d`,
 //! rounded as the hardware's adders round), but `Eval`s whose ranges are apart are
 //! independent. On a grey array the processors ([`crate::processors`]) keep up to
-//! [`LANES`] consecutive plain `Eval`s (no preload, lock or mask in play, at most
-//! [`MAX_LEN`] processors each, pairwise apart) in a [`Batch`] and run them as lanes of
-//! one loop ([`Batch::run`]): one step advances every lane by one processor, so the lanes'
-//! chains overlap and the loop's exit is decided once for the batch, not once per `Eval`
-//! (a random span length mispredicts it).
+//! [`LANES`] plain `Eval`s (no preload, lock or mask in play, of more than [`SHORT`] and
+//! at most [`MAX_LEN`] processors each, pairwise apart) in a [`Batch`] and run them as
+//! lanes of one loop ([`Batch::run`]): one step advances every lane by one processor, so
+//! the lanes' chains overlap and the loop's exit is decided once for the batch, not once
+//! per `Eval` (a random span length mispredicts it). Lanes pay where such `Eval`s come
+//! several at a time; the processors use them on a scanline when most of the scanline
+//! before was made of them.
 //!
 //! Nothing is reordered that could be seen: each lane is exactly its `Eval`'s chain
 //! ([`crate::arith::chain_steps`], operation for operation), two lanes never touch the same
@@ -23,6 +25,11 @@ use std::any::Any;
 pub(crate) const LANES: usize = 4;
 /// The longest span a lane takes; a longer `Eval` runs alone.
 pub(crate) const MAX_LEN: usize = 64;
+/// The longest span that runs at once rather than in a lane: a lane as short would keep
+/// its slot idle for most of the batch's steps, and an `Eval` of one or two processors
+/// has no chain to hide. Such an `Eval` (or one longer than [`MAX_LEN`]) runs ahead of
+/// the batch if it meets none of its spans, else after it.
+pub(crate) const SHORT: usize = 2;
 /// Spare accumulators past the array's end, which a lane past its span's end may reach.
 pub(crate) const SPARE: usize = MAX_LEN;
 
@@ -72,15 +79,7 @@ impl<R: Copy + 'static> Batch<R> {
     pub(crate) fn try_push(&mut self, order: u8, x: usize, len: usize, v: R, d: R, dd: R) -> bool {
         debug_assert!((1..=MAX_LEN).contains(&len) && (1..=3).contains(&order));
         let n = self.n;
-        let end = x + len;
-        if n == LANES {
-            return false;
-        }
-        let mut meets = false;
-        for k in 0..n {
-            meets |= (x < self.x[k] + self.len[k]) & (self.x[k] < end);
-        }
-        if meets {
+        if n == LANES || self.meets(x, x + len) {
             return false;
         }
         self.x[n] = x;
@@ -91,6 +90,16 @@ impl<R: Copy + 'static> Batch<R> {
         self.dd[n] = dd;
         self.n = n + 1;
         true
+    }
+
+    /// Whether `[x, end)` meets a pending `Eval`'s span.
+    #[inline(always)]
+    pub(crate) fn meets(&self, x: usize, end: usize) -> bool {
+        let mut meets = false;
+        for k in 0..self.n {
+            meets |= (x < self.x[k] + self.len[k]) & (self.x[k] < end);
+        }
+        meets
     }
 
     /// Runs the pending `Eval`s into `acc` (a grey array's accumulators followed by
@@ -106,20 +115,20 @@ impl<R: Copy + 'static> Batch<R> {
         acc: &mut Vec<R>,
         neg_ok: bool,
     ) -> Counts {
-        let counts = match f64_side_by_side(acc, self, neg_ok) {
-            Some(counts) => counts,
-            None => match f32_side_by_side(acc, self, neg_ok) {
-                Some(counts) => counts,
-                None => self.one_by_one(ar, acc, neg_ok),
-            },
+        // one lane alone is its own chain: nothing to hide its latency behind
+        let lanes = if self.n > 1 {
+            f64_side_by_side(acc, self, neg_ok).or_else(|| f32_side_by_side(acc, self, neg_ok))
+        } else {
+            None
         };
+        let counts = lanes.unwrap_or_else(|| self.one_by_one(ar, acc, neg_ok));
         self.n = 0;
         self.len = [0; LANES];
         counts
     }
 
-    /// The pending `Eval`s in order, each by its own chain: what [`Self::run`] does
-    /// where there are no lanes ([`batches`] is false there, so only tests come here).
+    /// The pending `Eval`s in order, each by its own chain: what [`Self::run`] does with
+    /// one, and where there are no lanes ([`batches`] is false there).
     fn one_by_one<A: Arith<Reg = R>>(&self, ar: &A, acc: &mut [R], neg_ok: bool) -> Counts {
         let mut total = Counts::default();
         for l in 0..self.n {
@@ -463,10 +472,12 @@ mod tests {
     /// Every scanline the processors hand out (values as bits, tally, work), and the
     /// open scanline's tally and work at the end.
     fn replay<A: Arith<Out = f64>>(arith: A, trace: &[Instruction], batches: bool) -> Vec<String> {
-        let mut p = Processors::new(WIDTH, 1, arith);
-        if !batches {
-            p = p.without_batches();
-        }
+        let p = Processors::new(WIDTH, 1, arith);
+        let mut p = if batches {
+            p.always_in_lanes()
+        } else {
+            p.without_batches()
+        };
         let mut out = Vec::new();
         for instr in trace {
             p.execute(instr, &mut |end: LineEnd<'_, f64>| {

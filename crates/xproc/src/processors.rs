@@ -10,7 +10,7 @@
 //! except one bit: whether negative accumulation is on (`Acc_mode`).
 
 use crate::arith::{Arith, Wave};
-use crate::lanes::{batches, Batch, MAX_LEN, SPARE};
+use crate::lanes::{batches, Batch, MAX_LEN, SHORT, SPARE};
 use crate::numeric::Register;
 use crate::stats::{IssueTally, Work};
 use cwisim_isa::{Instruction, Opcode, MAX_CHANNELS};
@@ -83,10 +83,18 @@ pub(crate) struct Processors<A: Arith> {
     /// Scratch space for a scanline converted for output.
     out: Vec<A::Out>,
     /// Plain `Eval`s pending, run side by side ([`crate::lanes`]).
-    batch: Batch<A::Reg>,
-    /// Whether `Eval`s are batched: on a grey array of `f64` registers
+    batch: Box<Batch<A::Reg>>,
+    /// Whether `Eval`s may be batched: on a grey array of `f64` or `f32` registers
     /// ([`crate::lanes::batches`]).
     batches: bool,
+    /// Whether this scanline's plain `Eval`s run in lanes: chosen at each `Refresh` from
+    /// the scanline before ([`Processors::choose_lanes`]).
+    lanes_on: bool,
+    /// This scanline's `Eval`s a lane takes (plain, of `SHORT + 1` to `MAX_LEN`
+    /// processors) and took; `Eval1`s only when in lanes.
+    batchable: u32,
+    /// Every scanline runs in lanes, whatever the one before was (for tests).
+    always_lanes: bool,
 }
 
 impl<A: Arith> Processors<A> {
@@ -115,8 +123,11 @@ impl<A: Arith> Processors<A> {
             tally: IssueTally::default(),
             work: Work::default(),
             out: Vec::new(),
-            batch: Batch::new(A::ZERO),
+            batch: Box::new(Batch::new(A::ZERO)),
             batches: c == 1 && batches::<A>(),
+            lanes_on: false,
+            batchable: 0,
+            always_lanes: false,
         }
     }
 
@@ -125,6 +136,15 @@ impl<A: Arith> Processors<A> {
     #[cfg(test)]
     pub(crate) fn without_batches(mut self) -> Self {
         self.batches = false;
+        self
+    }
+
+    /// The same processors running every scanline in lanes, whatever the one before
+    /// was (for tests).
+    #[cfg(test)]
+    pub(crate) fn always_in_lanes(mut self) -> Self {
+        self.lanes_on = self.batches;
+        self.always_lanes = true;
         self
     }
 
@@ -323,9 +343,10 @@ impl<A: Arith> Processors<A> {
         self.work.overflows += ovf;
     }
 
-    /// A plain `Eval` of `order` (1–3) on a grey array, at most [`MAX_LEN`] processors:
-    /// counted and its operands converted now, its chain run with the batch
-    /// ([`crate::lanes`]), which runs first if the `Eval` does not fit in it.
+    /// A plain `Eval` of `order` (1–3) of more than [`SHORT`] and at most [`MAX_LEN`]
+    /// processors on a scanline that runs in lanes, `values` its operands: counted and
+    /// its operands converted now, its chain run with the batch ([`crate::lanes`]), which
+    /// runs first if the `Eval` does not fit in it.
     #[inline(always)]
     fn queue(&mut self, instr: &Instruction, order: u8, values: [f64; 3]) {
         let (x, dx) = (instr.x as usize, instr.dx as usize);
@@ -352,6 +373,7 @@ impl<A: Arith> Processors<A> {
             let taken = self.batch.try_push(order, x, dx, v, d, dd);
             debug_assert!(taken, "an empty batch takes any Eval");
         }
+        self.batchable += 1;
     }
 
     /// Runs the pending `Eval`s, if any, and adds what they counted to the scanline's work.
@@ -367,8 +389,35 @@ impl<A: Arith> Processors<A> {
         self.work.overflows += counts.overflows;
     }
 
+    /// Counts an `Eval2` or `Eval3` of `dx` processors run by its own chain that a lane
+    /// would have taken, for the next scanline's choice ([`Self::choose_lanes`]).
+    #[inline(always)]
+    fn count_batchable(&mut self, dx: usize) {
+        let plain = !self.any_flags && !self.dis_pending;
+        self.batchable += u32::from(plain & (dx > SHORT) & (dx <= MAX_LEN));
+    }
+
+    /// Whether the next scanline runs its plain `Eval`s in lanes: if most of this one's
+    /// `Eval`s were what a lane takes, counting the `Eval1`s a lane takes only when they
+    /// ran in lanes (a frame's scanlines resemble their neighbours; an `Eval1` has no
+    /// chain of its own to hide, so `Eval1`s alone do not start lanes).
+    /// Lanes pay where short chains come several at a time; where most `Eval`s are single
+    /// pixels, `Eval0`s or behind a preload, a pending batch only costs each a check.
+    /// Either way the results are the same, bit for bit: only the time differs.
+    fn choose_lanes(&mut self) {
+        let ops = &self.tally.opcodes;
+        let evals = ops.get(Opcode::Eval0)
+            + ops.get(Opcode::Eval1)
+            + ops.get(Opcode::Eval2)
+            + ops.get(Opcode::Eval3);
+        let most = 2 * u64::from(self.batchable) > evals;
+        self.lanes_on = self.batches && (self.always_lanes || most);
+        self.batchable = 0;
+    }
+
     /// Hands the scanline out and clears what it touched.
     fn refresh<F: FnMut(LineEnd<'_, A::Out>)>(&mut self, on_line: &mut F) {
+        self.choose_lanes();
         let c = self.channels;
         let (lo, hi) = self.touched.take().unwrap_or((0, 0));
         on_line(LineEnd {
@@ -404,15 +453,21 @@ impl<A: Arith> Processors<A> {
             self.empty_eval::<C>(instr);
             return;
         }
-        if C == 1 && self.batches {
+        if C == 1 && self.lanes_on {
             // `Eval1`–`Eval3` as 0–2, every other opcode above: no branch on the order
             let order = (instr.op as u8).wrapping_sub(Opcode::Eval1 as u8);
-            if order < 3 && !self.any_flags && !self.dis_pending && dx <= MAX_LEN {
+            let plain = order < 3 && !self.any_flags && !self.dis_pending;
+            if plain && dx > SHORT && dx <= MAX_LEN {
                 if let Some(values) = instr.grey_values() {
                     return self.queue(instr, order + 1, values);
                 }
             }
-            self.run_batch();
+            // Pending lanes run before anything that could see them: anything but a
+            // plain `Eval` apart from all of them (one too short for a lane, or too
+            // long), which runs at once.
+            if !plain || self.batch.meets(x, x + dx) {
+                self.run_batch();
+            }
         }
         let mut w = Work::default();
         match instr.op {
@@ -459,8 +514,14 @@ impl<A: Arith> Processors<A> {
             Opcode::Eval1 | Opcode::Eval2 | Opcode::Eval3 => {
                 match instr.op {
                     Opcode::Eval1 => self.eval::<1, C>(instr),
-                    Opcode::Eval2 => self.eval::<2, C>(instr),
-                    _ => self.eval::<3, C>(instr),
+                    Opcode::Eval2 => {
+                        self.count_batchable(dx);
+                        self.eval::<2, C>(instr)
+                    }
+                    _ => {
+                        self.count_batchable(dx);
+                        self.eval::<3, C>(instr)
+                    }
                 };
                 self.touch(x, x + dx);
                 self.evals += 1;
