@@ -90,8 +90,8 @@ pub(crate) struct Processors<A: Arith> {
     /// Whether this scanline's plain `Eval`s run in lanes: chosen at each `Refresh` from
     /// the scanline before ([`Processors::choose_lanes`]).
     lanes_on: bool,
-    /// This scanline's `Eval`s a lane takes (plain, of `SHORT + 1` to `MAX_LEN`
-    /// processors) and took; `Eval1`s only when in lanes.
+    /// This scanline's `Eval`s of `SHORT + 1` to `MAX_LEN` processors that lanes took,
+    /// and its `Eval2`s and `Eval3`s of that length that ran by their own chains.
     batchable: u32,
     /// Every scanline runs in lanes, whatever the one before was (for tests).
     always_lanes: bool,
@@ -390,27 +390,37 @@ impl<A: Arith> Processors<A> {
     }
 
     /// Counts an `Eval2` or `Eval3` of `dx` processors run by its own chain that a lane
-    /// would have taken, for the next scanline's choice ([`Self::choose_lanes`]).
+    /// would take (whether a preload, lock or mask was in play the tally tells:
+    /// [`Self::choose_lanes`]).
     #[inline(always)]
     fn count_batchable(&mut self, dx: usize) {
-        let plain = !self.any_flags && !self.dis_pending;
-        self.batchable += u32::from(plain & (dx > SHORT) & (dx <= MAX_LEN));
+        self.batchable += u32::from(dx.wrapping_sub(SHORT + 1) < MAX_LEN - SHORT);
     }
 
-    /// Whether the next scanline runs its plain `Eval`s in lanes: if most of this one's
-    /// `Eval`s were what a lane takes, counting the `Eval1`s a lane takes only when they
-    /// ran in lanes (a frame's scanlines resemble their neighbours; an `Eval1` has no
-    /// chain of its own to hide, so `Eval1`s alone do not start lanes).
+    /// Whether the next scanline runs its plain `Eval`s in lanes: if this one had no
+    /// preload, lock or mask and most of its `Eval`s were what a lane takes, counting
+    /// `Eval1`s only when they ran in lanes (a frame's scanlines resemble their
+    /// neighbours; an `Eval1` has no chain of its own to hide, so `Eval1`s alone do not
+    /// start lanes).
     /// Lanes pay where short chains come several at a time; where most `Eval`s are single
     /// pixels, `Eval0`s or behind a preload, a pending batch only costs each a check.
     /// Either way the results are the same, bit for bit: only the time differs.
     fn choose_lanes(&mut self) {
         let ops = &self.tally.opcodes;
-        let evals = ops.get(Opcode::Eval0)
-            + ops.get(Opcode::Eval1)
-            + ops.get(Opcode::Eval2)
-            + ops.get(Opcode::Eval3);
-        let most = 2 * u64::from(self.batchable) > evals;
+        let count = |list: &[Opcode]| list.iter().map(|&op| ops.get(op)).sum::<u64>();
+        let evals = count(&[Opcode::Eval0, Opcode::Eval1, Opcode::Eval2, Opcode::Eval3]);
+        // preloads, locks and masks keep the `Eval`s after them out of lanes
+        let flagged = count(&[
+            Opcode::SetI,
+            Opcode::SetdI,
+            Opcode::SetddI,
+            Opcode::SetPI,
+            Opcode::SetPdI,
+            Opcode::SetPddI,
+            Opcode::Eval0,
+            Opcode::Dis,
+        ]);
+        let most = flagged == 0 && 2 * u64::from(self.batchable) > evals;
         self.lanes_on = self.batches && (self.always_lanes || most);
         self.batchable = 0;
     }
