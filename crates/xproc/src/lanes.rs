@@ -255,20 +255,67 @@ fn f64_side_by_side<R: Copy + 'static>(
 mod x86 {
     use super::{Batch, Counts, LANES};
     use std::arch::x86_64::*;
+    use std::marker::PhantomData;
+    use std::ops::Add;
+
+    /// The four lanes' accumulators, from each lane's first processor, for the batch's
+    /// steps: the one place the kernels reach into the array, which it borrows.
+    struct Accumulators<'a, T> {
+        first: [*mut T; LANES],
+        /// The longest lane's length.
+        steps: usize,
+        _acc: PhantomData<&'a mut [T]>,
+    }
+
+    impl<'a, T: Copy + Add<Output = T>> Accumulators<'a, T> {
+        /// `b`'s lanes in `acc`, checked to stay in it for every step (a lane past its
+        /// end included): every lane starts at most at the last processor, and `acc`
+        /// has `SPARE ≥ MAX_LEN` accumulators after it.
+        fn of(acc: &'a mut [T], b: &Batch<T>) -> Self {
+            let steps = b.len.into_iter().max().unwrap_or(0);
+            let top = b.x.into_iter().max().unwrap_or(0) + steps;
+            assert!(
+                top <= acc.len(),
+                "a lane reaches past the spare accumulators"
+            );
+            let base = acc.as_mut_ptr();
+            Accumulators {
+                first: b.x.map(|x| base.wrapping_add(x)),
+                steps,
+                _acc: PhantomData,
+            }
+        }
+
+        /// Adds `add[l]` to lane `l`'s accumulator at step `s`, one lane after another
+        /// (past its end a lane may reach another's processor, so a lane's add is stored
+        /// before the next lane's is read); returns the sums.
+        ///
+        /// # Safety
+        ///
+        /// `s < self.steps`.
+        #[inline(always)]
+        unsafe fn add(&mut self, s: usize, add: [T; LANES]) -> [T; LANES] {
+            debug_assert!(s < self.steps);
+            let mut sums = add;
+            for (l, p) in self.first.iter().enumerate() {
+                // SAFETY: `x + s < x + steps <= top <= acc.len()` for each lane's first
+                // processor `x` (`s < steps` is the caller's promise, the rest checked in
+                // `of`), so the pointer is in the `acc` this struct borrows mutably; no
+                // reference aliases it.
+                unsafe {
+                    let at = p.add(s);
+                    sums[l] = *at + add[l];
+                    *at = sums[l];
+                }
+            }
+            sums
+        }
+    }
 
     /// Two lanes to a register.
     #[target_feature(enable = "sse2")]
     pub(super) fn side_by_side_sse2(acc: &mut [f64], b: &Batch<f64>, neg_ok: bool) -> Counts {
-        let steps = b.len.into_iter().max().unwrap_or(0);
-        let top = b.x.into_iter().max().unwrap_or(0) + steps;
-        // Every access below is to `acc[b.x[l] + s]` with `s < steps`: below `top`.
-        assert!(
-            top <= acc.len(),
-            "a lane reaches past the spare accumulators"
-        );
-        let base = acc.as_mut_ptr();
-        let lane = |l: usize| base.wrapping_add(b.x[l]);
-        let (p0, p1, p2, p3) = (lane(0), lane(1), lane(2), lane(3));
+        let mut accs = Accumulators::of(acc, b);
         let pair = |r: &[f64; LANES], h: usize| _mm_setr_pd(r[2 * h], r[2 * h + 1]);
         let (mut va, mut vb) = (pair(&b.v, 0), pair(&b.v, 1));
         let (mut da, mut db) = (pair(&b.d, 0), pair(&b.d, 1));
@@ -281,7 +328,7 @@ mod x86 {
         let threshold = _mm_set1_pd(if neg_ok { f64::NEG_INFINITY } else { 0.0 });
         let mut step = _mm_setzero_pd();
         let mut dropped = _mm_setzero_si128();
-        for s in 0..steps {
+        for s in 0..accs.steps {
             // what each lane adds: its `v` if in its span and not dropped, else the identity
             let (aa, drop_a) = added(va, step, lena, threshold, identity);
             let (ab, drop_b) = added(vb, step, lenb, threshold, identity);
@@ -298,15 +345,8 @@ mod x86 {
                 _mm_cvtsd_f64(ab),
                 _mm_cvtsd_f64(_mm_unpackhi_pd(ab, ab)),
             ];
-            // SAFETY: `b.x[l] + s < top <= acc.len()` (asserted above), so each pointer
-            // is in `acc`, which nothing else borrows while this runs; the four lanes'
-            // accesses are made one after another.
-            unsafe {
-                *p0.add(s) += add[0];
-                *p1.add(s) += add[1];
-                *p2.add(s) += add[2];
-                *p3.add(s) += add[3];
-            }
+            // SAFETY: `s < accs.steps`, the loop's bound.
+            unsafe { accs.add(s, add) };
         }
         let mut counts = [0i64; 2];
         // SAFETY: `counts` is 16 bytes, as an unaligned store needs.
@@ -339,16 +379,7 @@ mod x86 {
     /// All four lanes in one register.
     #[target_feature(enable = "avx2")]
     pub(super) fn side_by_side_avx2(acc: &mut [f64], b: &Batch<f64>, neg_ok: bool) -> Counts {
-        let steps = b.len.into_iter().max().unwrap_or(0);
-        let top = b.x.into_iter().max().unwrap_or(0) + steps;
-        // Every access below is to `acc[b.x[l] + s]` with `s < steps`: below `top`.
-        assert!(
-            top <= acc.len(),
-            "a lane reaches past the spare accumulators"
-        );
-        let base = acc.as_mut_ptr();
-        let lane = |l: usize| base.wrapping_add(b.x[l]);
-        let (p0, p1, p2, p3) = (lane(0), lane(1), lane(2), lane(3));
+        let mut accs = Accumulators::of(acc, b);
         let four = |r: &[f64; LANES]| _mm256_setr_pd(r[0], r[1], r[2], r[3]);
         let (mut v, mut d, dd) = (four(&b.v), four(&b.d), four(&b.dd));
         let len = four(&b.len.map(|n| n as f64));
@@ -358,7 +389,7 @@ mod x86 {
         let threshold = _mm256_set1_pd(if neg_ok { f64::NEG_INFINITY } else { 0.0 });
         let mut step = _mm256_setzero_pd();
         let mut dropped = _mm256_setzero_si256();
-        for s in 0..steps {
+        for s in 0..accs.steps {
             let active = _mm256_cmp_pd::<_CMP_LT_OQ>(step, len);
             let negative = _mm256_cmp_pd::<_CMP_LT_OQ>(v, threshold);
             let take = _mm256_andnot_pd(negative, active);
@@ -376,13 +407,8 @@ mod x86 {
                 _mm_cvtsd_f64(hi),
                 _mm_cvtsd_f64(_mm_unpackhi_pd(hi, hi)),
             ];
-            // SAFETY: as in `side_by_side_sse2`.
-            unsafe {
-                *p0.add(s) += add[0];
-                *p1.add(s) += add[1];
-                *p2.add(s) += add[2];
-                *p3.add(s) += add[3];
-            }
+            // SAFETY: `s < accs.steps`, the loop's bound.
+            unsafe { accs.add(s, add) };
         }
         let mut counts = [0i64; 4];
         // SAFETY: `counts` is 32 bytes, as an unaligned store needs.
@@ -398,16 +424,7 @@ mod x86 {
     /// not finite, past a lane's end included (a false alarm only costs a recount).
     #[target_feature(enable = "sse2")]
     pub(super) fn side_by_side_f32(acc: &mut [f32], b: &Batch<f32>, neg_ok: bool) -> (u64, bool) {
-        let steps = b.len.into_iter().max().unwrap_or(0);
-        let top = b.x.into_iter().max().unwrap_or(0) + steps;
-        // Every access below is to `acc[b.x[l] + s]` with `s < steps`: below `top`.
-        assert!(
-            top <= acc.len(),
-            "a lane reaches past the spare accumulators"
-        );
-        let base = acc.as_mut_ptr();
-        let lane = |l: usize| base.wrapping_add(b.x[l]);
-        let (p0, p1, p2, p3) = (lane(0), lane(1), lane(2), lane(3));
+        let mut accs = Accumulators::of(acc, b);
         let four = |r: &[f32; LANES]| _mm_setr_ps(r[0], r[1], r[2], r[3]);
         let (mut v, mut d, dd) = (four(&b.v), four(&b.d), four(&b.dd));
         let len = four(&b.len.map(|n| n as f32));
@@ -422,7 +439,7 @@ mod x86 {
         let mut step = _mm_setzero_ps();
         let mut dropped = _mm_setzero_si128();
         let mut bad = _mm_setzero_si128();
-        for s in 0..steps {
+        for s in 0..accs.steps {
             let active = _mm_cmplt_ps(step, len);
             let negative = _mm_cmplt_ps(v, threshold);
             let take = _mm_andnot_ps(negative, active);
@@ -438,16 +455,9 @@ mod x86 {
                 _mm_cvtss_f32(_mm_movehl_ps(add, add)),
                 _mm_cvtss_f32(_mm_shuffle_ps::<0b11_11_11_11>(add, add)),
             ];
-            // SAFETY: as in `side_by_side_sse2`. One lane's add is stored before the
-            // next lane's is read: past its end a lane may reach another's processor.
-            let sums = unsafe {
-                let mut sums = [0.0f32; LANES];
-                for (l, p) in [p0, p1, p2, p3].into_iter().enumerate() {
-                    sums[l] = *p.add(s) + add[l];
-                    *p.add(s) = sums[l];
-                }
-                _mm_setr_ps(sums[0], sums[1], sums[2], sums[3])
-            };
+            // SAFETY: `s < accs.steps`, the loop's bound.
+            let sums = unsafe { accs.add(s, add) };
+            let sums = _mm_setr_ps(sums[0], sums[1], sums[2], sums[3]);
             bad = _mm_or_si128(bad, _mm_or_si128(non_finite(v), non_finite(d)));
             bad = _mm_or_si128(bad, non_finite(sums));
         }
