@@ -13,7 +13,8 @@
 //!
 //! Nothing is reordered that could be seen: each lane is exactly its `Eval`'s chain
 //! ([`crate::arith::chain_steps`], operation for operation), two lanes never touch the same
-//! processor, and the batch runs before any other instruction executes. A lane past its
+//! processor, and the batch runs before any instruction that could see its processors
+//! (only a plain `Eval` apart from every pending span runs before it). A lane past its
 //! span's end keeps stepping (the loop is branch-free) but adds the adders' identity, which
 //! changes no bit, and what it counts there is masked out.
 
@@ -479,14 +480,25 @@ mod tests {
     const WIDTH: usize = 100;
     const F64: Native<f64> = Native::new();
 
+    /// Which scanlines run in lanes.
+    #[derive(Clone, Copy)]
+    enum Lanes {
+        /// Every one.
+        Always,
+        /// Those the processors choose from the scanline before.
+        Chosen,
+        /// None: every `Eval` by its own chain, the reference.
+        Never,
+    }
+
     /// Every scanline the processors hand out (values as bits, tally, work), and the
     /// open scanline's tally and work at the end.
-    fn replay<A: Arith<Out = f64>>(arith: A, trace: &[Instruction], batches: bool) -> Vec<String> {
+    fn replay<A: Arith<Out = f64>>(arith: A, trace: &[Instruction], lanes: Lanes) -> Vec<String> {
         let p = Processors::new(WIDTH, 1, arith);
-        let mut p = if batches {
-            p.always_in_lanes()
-        } else {
-            p.without_batches()
+        let mut p = match lanes {
+            Lanes::Always => p.always_in_lanes(),
+            Lanes::Chosen => p,
+            Lanes::Never => p.without_batches(),
         };
         let mut out = Vec::new();
         for instr in trace {
@@ -559,9 +571,47 @@ mod tests {
         fn evals_side_by_side_are_the_evals_one_by_one(
             trace in proptest::collection::vec(instruction(), 0..120),
         ) {
-            prop_assert_eq!(replay(F64, &trace, true), replay(F64, &trace, false));
-            prop_assert_eq!(replay(F32Arith, &trace, true), replay(F32Arith, &trace, false));
+            let reference = replay(F64, &trace, Lanes::Never);
+            prop_assert_eq!(&replay(F64, &trace, Lanes::Always), &reference);
+            prop_assert_eq!(&replay(F64, &trace, Lanes::Chosen), &reference);
+            let reference = replay(F32Arith, &trace, Lanes::Never);
+            prop_assert_eq!(&replay(F32Arith, &trace, Lanes::Always), &reference);
+            prop_assert_eq!(&replay(F32Arith, &trace, Lanes::Chosen), &reference);
         }
+    }
+
+    /// The processors choose lanes for a scanline after one made of `Eval`s a lane
+    /// takes, and not after one of single pixels or one with a lock; the image and
+    /// counts are the reference's either way.
+    #[test]
+    fn lanes_are_chosen_from_the_scanline_before() {
+        let g = Intensity::grey;
+        let short = |k: u32| Instruction::eval2(k * 12, 9, g(0.5 - f64::from(k) * 0.1), g(-0.03));
+        let mut trace = Vec::new();
+        for line in 0..6 {
+            match line {
+                // single pixels, then a lock: lanes stay off after both
+                1 => trace.extend((0..20).map(|k| Instruction::eval1(k * 3, 1, g(0.25)))),
+                3 => trace.push(Instruction::eval0(97, 2, g(1.0))),
+                _ => {}
+            }
+            trace.extend((0..8).map(short));
+            trace.push(Instruction::refresh());
+        }
+        let mut p = Processors::new(WIDTH, 1, F64);
+        let mut chosen = Vec::new();
+        for instr in &trace {
+            p.execute(instr, &mut |_: LineEnd<'_, f64>| {});
+            if instr.op == cwisim_isa::Opcode::Refresh {
+                chosen.push(p.lanes_on());
+            }
+        }
+        // after each scanline: lanes for the next one?
+        assert_eq!(chosen, [true, false, true, false, true, true]);
+        assert_eq!(
+            replay(F64, &trace, Lanes::Chosen),
+            replay(F64, &trace, Lanes::Never)
+        );
     }
 
     /// Four lanes of every length from 1 to 64 ending at the array's last processor
@@ -579,13 +629,13 @@ mod tests {
                 Instruction::refresh(),
             ];
             assert_eq!(
-                replay(F64, &trace, true),
-                replay(F64, &trace, false),
+                replay(F64, &trace, Lanes::Always),
+                replay(F64, &trace, Lanes::Never),
                 "len {len}"
             );
             let f32 = (
-                replay(F32Arith, &trace, true),
-                replay(F32Arith, &trace, false),
+                replay(F32Arith, &trace, Lanes::Always),
+                replay(F32Arith, &trace, Lanes::Never),
             );
             assert_eq!(f32.0, f32.1, "f32, len {len}");
         }

@@ -139,6 +139,12 @@ impl<A: Arith> Processors<A> {
         self
     }
 
+    /// Whether the current scanline runs in lanes (for tests).
+    #[cfg(test)]
+    pub(crate) fn lanes_on(&self) -> bool {
+        self.lanes_on
+    }
+
     /// The same processors running every scanline in lanes, whatever the one before
     /// was (for tests).
     #[cfg(test)]
