@@ -14,8 +14,9 @@
 //! fragments must be the same), the peak heap each allocated (a counting allocator, the
 //! fragments included) and the sweep's own when its bands are handed on and dropped
 //! (`strip_by_strip_into`), their fragments, and the largest difference between the
-//! visible areas they give a triangle (they must agree: the run stops if not). The
-//! figures are in `docs/VISIBILITY.md`.
+//! visible areas they give a triangle (they must agree: the run stops if not), and a hash
+//! of each engine's fragments, bit for bit (two builds that give the same fragments give
+//! the same hashes). The figures are in `docs/VISIBILITY.md`.
 
 use cwisim_scene::Shading;
 use cwisim_world::embedded::embedded;
@@ -69,6 +70,25 @@ fn stacked_quads(layers: usize, like: ScreenTriangle) -> Vec<ScreenTriangle> {
         }
     }
     out
+}
+
+/// A hash of the fragments, bit for bit (each one's source, corners and intensities, in
+/// order): equal between two builds when they give the same fragments.
+fn bits(fragments: &[Fragment]) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    for f in fragments {
+        f.source.hash(&mut h);
+        for v in &f.polygon.vertices {
+            v.map(f64::to_bits).hash(&mut h);
+        }
+        for i in &f.polygon.intensity {
+            for c in i {
+                c.to_bits().hash(&mut h);
+            }
+        }
+    }
+    h.finish()
 }
 
 fn median(mut v: Vec<Duration>) -> Duration {
@@ -147,6 +167,11 @@ fn main() {
         heap_streamed as f64 / 1e6,
         by_pairs.len(),
         by_strips.len()
+    );
+    println!(
+        "fragments' bits (pairs / strips): {:016x} / {:016x}",
+        bits(&by_pairs),
+        bits(&by_strips)
     );
     assert!(
         worst <= 1e-7,

@@ -25,6 +25,12 @@
 //!    and their `1/depth`) are cut at the same points of their shared edge, so their
 //!    pieces join without the hair-thin gaps that would otherwise remain visible.
 //!    Pieces of area ≤ 1e-13 px² are skipped (they cannot hide more than that).
+//!    Two quick answers come first: a pair that an edge of one separates from the other
+//!    is apart (in a mesh, most candidates are neighbours sharing an edge), and a
+//!    candidate farther than `T` at all six corners of the two, by a margin far above
+//!    rounding, hides nothing (`d` is affine, so it is largest at one of them; the far
+//!    side of a mesh seen from both sides is a candidate of every near triangle). Either
+//!    way nothing is clipped, and the clips would have found no piece.
 //! 3. **Coplanar pairs.** When `|d| ≤ 1e-12 · max(invz_S, invz_T)` at every vertex of the
 //!    overlap, the two are taken as coplanar and the **lower index wins**: it hides the
 //!    other over the whole overlap, so exactly one of them keeps it.
@@ -80,10 +86,11 @@
 //! 600 layers took more than 24 GB). Three shortcuts leave out only what could not change
 //! a fragment: an exact copy of an earlier triangle (the same vertices and `1/depth`) is
 //! hidden at once, without looking at its candidates (`copies_hidden`: coincident layers
-//! are made of these); a piece that holds all three vertices of the triangle (a convex
-//! piece: all of it) hides it without a boolean, and its remaining candidates are skipped
-//! (`candidates_skipped`); a piece equal to one already taken is dropped before the
-//! boolean.
+//! are made of these; the copies are found before the pass by sorting the triangles on
+//! a hash of their corners, so what is kept through it is one flag a triangle); a piece
+//! that holds all three vertices of the triangle (a convex piece: all of it) hides it
+//! without a boolean, and its remaining candidates are skipped (`candidates_skipped`); a
+//! piece equal to one already taken is dropped before the boolean.
 //!
 //! Time still grows faster than the layers — the booleans of nearly coincident layers
 //! have many crossing edges — measured in `docs/VISIBILITY.md`
@@ -119,7 +126,7 @@ use arrayvec::ArrayVec;
 use cwisim_scene::Polygon;
 use cwisim_scene::Vector;
 use i_overlay::core::overlay_rule::OverlayRule;
-use std::collections::HashMap;
+use rustc_hash::FxHashMap as HashMap;
 use std::hash::{Hash, Hasher};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
@@ -249,13 +256,7 @@ pub fn exact_fragments_on(
     // (per thread) whatever the depth complexity (see "Depth complexity" in the module
     // docs).
     let index = BoxIndex::new(tris, &usable);
-    // the first usable triangle of each exact geometry
-    let mut copies: HashMap<[u64; 9], usize> = HashMap::new();
-    for (k, t) in tris.iter().enumerate() {
-        if usable[k] {
-            copies.entry(copy_key(t)).or_insert(k);
-        }
-    }
+    let later_copy = later_copies(tris, &usable);
     let shared = Shared {
         tris,
         channels,
@@ -263,7 +264,7 @@ pub fn exact_fragments_on(
         planes: &planes,
         grid: &grid,
         index: &index,
-        copies: &copies,
+        later_copy: &later_copy,
     };
     let n = tris.len();
     let chunks = if threads > 1 {
@@ -333,8 +334,8 @@ struct Shared<'a> {
     planes: &'a [Plane],
     grid: &'a Grid,
     index: &'a BoxIndex,
-    /// The first usable triangle of each exact geometry ([`copy_key`]).
-    copies: &'a HashMap<[u64; 9], usize>,
+    /// Whether each triangle is an exact copy of an earlier usable one ([`later_copies`]).
+    later_copy: &'a [bool],
 }
 
 /// What one chunk of triangles gave: its fragments in order, its counts, and the areas of
@@ -356,14 +357,14 @@ impl Shared<'_> {
             planes,
             grid,
             index,
-            copies,
+            later_copy,
         } = *self;
         let mut tally = Tally {
             fragments: Vec::new(),
             stats: VisibilityStats::default(),
             losses: Losses::default(),
         };
-        let mut seen: HashMap<u64, usize> = HashMap::new();
+        let mut seen: HashMap<u64, usize> = HashMap::default();
         let mut stamp = Vec::new();
         let mut candidates = Vec::new();
         let mut pieces: Vec<Contour> = Vec::new();
@@ -377,13 +378,11 @@ impl Shared<'_> {
                 // any order) is coplanar with it over all of it, and the lower index wins:
                 // hidden, without looking at anything else (coincident layers are made of
                 // these).
-                if let Some(&first) = copies.get(&copy_key(tri)) {
-                    if first != k && area(&tri.points) > PIECE_AREA {
-                        tally.stats.occluding_pairs += 1;
-                        tally.stats.hidden += 1;
-                        tally.stats.copies_hidden += 1;
-                        continue;
-                    }
+                if later_copy[k] && area(&tri.points) > PIECE_AREA {
+                    tally.stats.occluding_pairs += 1;
+                    tally.stats.hidden += 1;
+                    tally.stats.copies_hidden += 1;
+                    continue;
                 }
                 index.candidates(k, &mut candidates, &mut stamp);
                 seen.clear();
@@ -452,6 +451,22 @@ fn piece_hiding(
     if apart(ti, tj) || apart(tj, ti) {
         return None;
     }
+    if farther_all_over(tris, planes, front, back) {
+        return None;
+    }
+    clipped_piece(tris, planes, front, back)
+}
+
+/// [`piece_hiding`] for two triangles not [`apart`]: their overlap clipped to where
+/// `front` is nearer.
+fn clipped_piece(
+    tris: &[ScreenTriangle],
+    planes: &[Plane],
+    front: usize,
+    back: usize,
+) -> Option<Contour> {
+    let (i, j) = (front.min(back), front.max(back));
+    let (ti, tj) = (&tris[i], &tris[j]);
     let (mut overlap, mut spare) = (Small::new(), Small::new());
     inside_triangle(&tj.points, ti, &mut overlap, &mut spare);
     if area(&overlap) <= PIECE_AREA {
@@ -481,6 +496,39 @@ fn piece_hiding(
         clip(&points, nearer).to_vec()
     };
     Some(positive(piece))
+}
+
+/// How far below the triangle behind, relative to the size of the terms that make up
+/// the two `1/depth` planes' values, a candidate must be at every corner for
+/// [`farther_all_over`] to pass over it: a thousand times the coplanar tolerance, and
+/// many orders of magnitude above rounding.
+const FARTHER: f64 = 1e-9;
+
+/// Whether triangle `front` is farther than triangle `back` all over both (so over their
+/// overlap), by a margin: then it hides none of `back`, and [`piece_hiding`]'s clips would
+/// find as much. The two `1/depth` planes' difference is affine, so over the hull of the
+/// six corners — which holds the overlap — it is largest at a corner; each value there
+/// is worked out with the size of its terms, and the margin is [`FARTHER`] of the largest
+/// size. The values that [`piece_hiding`] finds at the overlap's corners (points in the
+/// hull, whose terms are no larger) are within rounding of the exact ones, so they are
+/// all negative and far from coplanar: it would return `None`.
+///
+/// About half the pairs that are not apart end here in a mesh seen from both sides (the
+/// far side's triangles are candidates of the near side's): no polygon is clipped.
+fn farther_all_over(tris: &[ScreenTriangle], planes: &[Plane], front: usize, back: usize) -> bool {
+    let (pf, pb) = (&planes[front], &planes[back]);
+    let mut size = 0.0f64;
+    let mut nearest = f64::NEG_INFINITY;
+    for p in tris[front].points.iter().chain(&tris[back].points) {
+        let terms = |pl: &Plane| {
+            let (gx, gy) = (pl.gx * (p[0] - pl.o[0]), pl.gy * (p[1] - pl.o[1]));
+            (pl.at_o + gx + gy, pl.at_o.abs() + gx.abs() + gy.abs())
+        };
+        let ((zf, sf), (zb, sb)) = (terms(pf), terms(pb));
+        nearest = nearest.max(zf - zb);
+        size = size.max(sf).max(sb);
+    }
+    nearest < -FARTHER * size
 }
 
 /// Front-to-back order for the array's `Eval0` visibility: the indices of `tris` sorted
@@ -598,6 +646,30 @@ fn copy_key(t: &ScreenTriangle) -> [u64; 9] {
     corners.sort_unstable();
     let [a, b, c] = corners;
     [a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1], c[2]]
+}
+
+/// Whether each triangle is usable and an exact copy ([`copy_key`]) of a usable one of
+/// lower index. Found by sorting the usable triangles by a hash of their keys (then
+/// index), the keys compared only within a run of equal hashes: one pass over the
+/// triangles in order and a sort of 16 bytes each, where a map of the keys held 80
+/// bytes a triangle through the whole pass and was looked up at random (a cache miss a
+/// triangle).
+fn later_copies(tris: &[ScreenTriangle], usable: &[bool]) -> Vec<bool> {
+    use std::hash::BuildHasher;
+    let hasher = rustc_hash::FxBuildHasher;
+    let mut keyed: Vec<(u64, usize)> = (0..tris.len())
+        .filter(|&k| usable[k])
+        .map(|k| (hasher.hash_one(copy_key(&tris[k])), k))
+        .collect();
+    keyed.sort_unstable();
+    let mut later = vec![false; tris.len()];
+    for run in keyed.chunk_by(|a, b| a.0 == b.0) {
+        for (i, &(_, k)) in run.iter().enumerate().skip(1) {
+            let key = copy_key(&tris[k]);
+            later[k] = run[..i].iter().any(|&(_, j)| copy_key(&tris[j]) == key);
+        }
+    }
+    later
 }
 
 /// A hash of a contour's coordinates, bit for bit.
@@ -892,6 +964,7 @@ impl BoxIndex {
 mod tests {
     use super::*;
     use crate::boolean::{grid_extent, tidy};
+    use proptest::prelude::*;
 
     fn tri(points: [Pt; 3], inv_depth: [f64; 3]) -> ScreenTriangle {
         let mut intensity = [[0.0; MAX_CHANNELS]; 3];
@@ -1245,5 +1318,88 @@ mod tests {
         assert_eq!(frags[0].source, 1);
         assert_eq!(frags[0].polygon.vertices, good.points.to_vec());
         assert_eq!((stats.hidden, stats.occluding_pairs), (2, 0));
+    }
+
+    /// Triangles near one another in `[0, 8]²` with `1/depth` in `(0, 1]`, some of them
+    /// steep (`1/depth` changing a thousandfold across them), some coplanar with others.
+    fn pair() -> impl Strategy<Value = (ScreenTriangle, ScreenTriangle)> {
+        let point = || (0u32..=16, 0u32..=16).prop_map(|(x, y)| [x as f64 * 0.5, y as f64 * 0.5]);
+        let depth = prop_oneof![
+            (1u32..=1000).prop_map(|d| d as f64 * 1e-3),
+            (1u32..=1000).prop_map(|d| 1.0 - d as f64 * 1e-12),
+        ];
+        let one = || {
+            (
+                [point(), point(), point()],
+                [depth.clone(), depth.clone(), depth.clone()],
+            )
+                .prop_map(|(points, inv_depth)| tri(points, inv_depth))
+        };
+        (one(), one(), any::<bool>()).prop_map(|(a, mut b, same_plane)| {
+            if same_plane {
+                // b in a's plane, where it lies
+                let plane = Plane::of(&a);
+                b.inv_depth = b.points.map(|p| plane.at(p));
+            }
+            (a, b)
+        })
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(3000))]
+
+        /// The shortcut passes over a candidate only where the clips would find it hides
+        /// nothing, either way round.
+        #[test]
+        fn a_candidate_farther_all_over_hides_nothing_of_what_the_clips_find(
+            (a, b) in pair(),
+        ) {
+            let tris = [a, b];
+            let planes: Vec<Plane> = tris.iter().map(Plane::of).collect();
+            prop_assume!(tris.iter().all(drawable));
+            for (front, back) in [(0, 1), (1, 0)] {
+                if farther_all_over(&tris, &planes, front, back) {
+                    prop_assert!(clipped_piece(&tris, &planes, front, back).is_none());
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_shortcut_takes_a_farther_triangle_and_not_one_in_its_plane_or_crossing_it() {
+        let (near, far) = (
+            tri([[0.0, 0.0], [8.0, 0.0], [0.0, 8.0]], [0.5; 3]),
+            tri([[1.0, 1.0], [9.0, 1.0], [1.0, 9.0]], [0.25; 3]),
+        );
+        let tris = [near, far, near, tri(far.points, [0.1, 0.9, 0.9])];
+        let planes: Vec<Plane> = tris.iter().map(Plane::of).collect();
+        assert!(farther_all_over(&tris, &planes, 1, 0));
+        assert!(!farther_all_over(&tris, &planes, 0, 1));
+        // the same plane: the lower index wins what they share, the clips decide
+        assert!(!farther_all_over(&tris, &planes, 2, 0));
+        // crossing surfaces: nearer in part
+        assert!(!farther_all_over(&tris, &planes, 3, 0));
+        assert!(clipped_piece(&tris, &planes, 3, 0).is_some());
+    }
+
+    #[test]
+    fn later_copies_are_copies_of_a_usable_triangle_of_lower_index_in_any_vertex_order() {
+        let a = tri([[0.0, 0.0], [4.0, 0.0], [0.0, 4.0]], [0.5, 0.25, 0.125]);
+        let turned = tri(
+            [a.points[1], a.points[2], a.points[0]],
+            [a.inv_depth[1], a.inv_depth[2], a.inv_depth[0]],
+        );
+        let other_depth = tri(a.points, [0.5, 0.25, 0.25]);
+        let mut broken = a;
+        broken.inv_depth[0] = f64::NAN;
+        // the unusable one comes first and counts for nothing; the usable copies after
+        // the first are later copies, whatever their vertex order
+        let tris = [broken, other_depth, a, turned, a, broken];
+        let usable: Vec<bool> = tris.iter().map(drawable).collect();
+        assert_eq!(
+            later_copies(&tris, &usable),
+            vec![false, false, false, true, true, false]
+        );
+        assert!(later_copies(&[], &[]).is_empty());
     }
 }
