@@ -369,7 +369,7 @@ impl Shared<'_> {
         let mut candidates = Vec::new();
         let mut pieces: Vec<Contour> = Vec::new();
         let mut contours = Vec::new();
-        let mut edges = Vec::new();
+        let mut cover_scratch = crate::cover::Scratch::default();
         for k in range {
             let tri = &tris[k];
             let before = tally.fragments.len();
@@ -409,14 +409,15 @@ impl Shared<'_> {
                 }
                 // the pieces together covering all of it (the far side of a mesh under
                 // the near side's triangles): hidden, without the boolean
-                let cut = if covered || crate::cover::covers(&tri.points, &pieces, &mut edges) {
-                    Some(Vec::new())
-                } else if pieces.is_empty() {
-                    None
-                } else {
-                    let subject = vec![positive(tri.points.to_vec())];
-                    Some(overlay(grid, &subject, &pieces, OverlayRule::Difference))
-                };
+                let cut =
+                    if covered || crate::cover::covers(&tri.points, &pieces, &mut cover_scratch) {
+                        Some(Vec::new())
+                    } else if pieces.is_empty() {
+                        None
+                    } else {
+                        let subject = vec![positive(tri.points.to_vec())];
+                        Some(overlay(grid, &subject, &pieces, OverlayRule::Difference))
+                    };
                 let shapes = cut.unwrap_or_else(|| vec![vec![tri.points.to_vec()]]);
                 contours.clear();
                 for shape in shapes {
