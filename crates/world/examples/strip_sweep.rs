@@ -16,7 +16,9 @@
 //! (`strip_by_strip_into`), their fragments, and the largest difference between the
 //! visible areas they give a triangle (they must agree: the run stops if not), and a hash
 //! of each engine's fragments, bit for bit (two builds that give the same fragments give
-//! the same hashes). The figures are in `docs/VISIBILITY.md`.
+//! the same hashes). With `PAIRS_ONLY=1` it runs the pair-by-pair engine alone, `RUNS`
+//! times, and prints each run's time and hash (to set two builds side by side). The
+//! figures are in `docs/VISIBILITY.md`.
 
 use cwisim_scene::Shading;
 use cwisim_world::embedded::embedded;
@@ -125,6 +127,18 @@ fn main() {
         tris = stacked_quads(l.parse().expect("QUADS=LAYERS"), tris[0]);
     }
     let channels = w.channels();
+    if std::env::var("PAIRS_ONLY").is_ok() {
+        for _ in 0..runs {
+            let t = Instant::now();
+            let (f, _) = exact_fragments_on(&tris, channels, 1);
+            println!(
+                "pair by pair {:.1} ms, fragments' bits {:016x}",
+                t.elapsed().as_secs_f64() * 1e3,
+                bits(&f)
+            );
+        }
+        return;
+    }
     let (mut pairs, mut strips, mut strips2) = (Vec::new(), Vec::new(), Vec::new());
     let (mut by_pairs, mut by_strips) = (Vec::new(), Vec::new());
     let (mut heap_pairs, mut heap_strips) = (0, 0);

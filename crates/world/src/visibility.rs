@@ -368,6 +368,7 @@ impl Shared<'_> {
         let mut stamp = Vec::new();
         let mut candidates = Vec::new();
         let mut pieces: Vec<Contour> = Vec::new();
+        let mut spare_pieces: Vec<Contour> = Vec::new();
         let mut contours = Vec::new();
         let mut cover_scratch = crate::cover::Scratch::default();
         for k in range {
@@ -386,16 +387,17 @@ impl Shared<'_> {
                 }
                 index.candidates(k, &mut candidates, &mut stamp);
                 seen.clear();
-                pieces.clear();
+                spare_pieces.append(&mut pieces);
                 let mut covered = false;
                 for (n, &c) in candidates.iter().enumerate() {
-                    let Some(piece) = piece_hiding(tris, planes, c, k) else {
+                    let Some(piece) = piece_hiding(tris, planes, c, k, &mut spare_pieces) else {
                         continue;
                     };
                     tally.stats.occluding_pairs += 1;
                     // one piece holding all of the triangle hides it: no boolean, and the
                     // remaining candidates cannot change that
                     if contains_triangle(&piece, &tri.points) {
+                        spare_pieces.push(piece);
                         covered = true;
                         tally.stats.candidates_skipped += (candidates.len() - n - 1) as u64;
                         break;
@@ -405,6 +407,8 @@ impl Shared<'_> {
                     let first = *seen.entry(bits_hash(&piece)).or_insert(pieces.len());
                     if first == pieces.len() || !same_bits(&pieces[first], &piece) {
                         pieces.push(piece);
+                    } else {
+                        spare_pieces.push(piece);
                     }
                 }
                 // the pieces together covering all of it (the far side of a mesh under
@@ -440,12 +444,14 @@ impl Shared<'_> {
 /// The piece of triangle `front` that hides part of triangle `back`, or `None` where it
 /// hides nothing (more than [`PIECE_AREA`]). The pair is looked at as `(i, j)`, `i < j`,
 /// whichever of the two is asked about, so both directions come from the same overlap,
-/// bit for bit.
+/// bit for bit. The piece is made in a contour taken from `spare` when it has one (their
+/// allocations are used again from triangle to triangle).
 fn piece_hiding(
     tris: &[ScreenTriangle],
     planes: &[Plane],
     front: usize,
     back: usize,
+    spare: &mut Vec<Contour>,
 ) -> Option<Contour> {
     let (i, j) = (front.min(back), front.max(back));
     let (ti, tj) = (&tris[i], &tris[j]);
@@ -455,7 +461,7 @@ fn piece_hiding(
     if farther_all_over(tris, planes, front, back) {
         return None;
     }
-    clipped_piece(tris, planes, front, back)
+    clipped_piece(tris, planes, front, back, spare)
 }
 
 /// [`piece_hiding`] for two triangles not [`apart`]: their overlap clipped to where
@@ -465,7 +471,14 @@ fn clipped_piece(
     planes: &[Plane],
     front: usize,
     back: usize,
+    spare: &mut Vec<Contour>,
 ) -> Option<Contour> {
+    let mut contour = |points: &[Pt]| {
+        let mut v = spare.pop().unwrap_or_default();
+        v.clear();
+        v.extend_from_slice(points);
+        positive(v)
+    };
     let (i, j) = (front.min(back), front.max(back));
     let (ti, tj) = (&tris[i], &tris[j]);
     let (mut overlap, mut spare) = (Small::new(), Small::new());
@@ -482,21 +495,21 @@ fn clipped_piece(
     });
     if coplanar {
         // the lower index (i) wins the whole overlap
-        return (front == i).then(|| positive(ti.points.to_vec()));
+        return (front == i).then(|| contour(&ti.points));
     }
     let sign = if front == j { 1.0 } else { -1.0 };
     let nearer = |p: Pt| sign * d(p);
+    let points = tris[front].points;
+    if dv.iter().all(|&v| sign * v >= 0.0) {
+        // nearer all over the overlap: the clip would keep all of it (at most six
+        // corners, each kept, none added), whose area is over the bound already
+        return Some(contour(&points));
+    }
     clip_into(&overlap, nearer, &mut spare);
     if area(&spare) <= PIECE_AREA {
         return None;
     }
-    let points = tris[front].points;
-    let piece = if dv.iter().all(|&v| sign * v >= 0.0) {
-        points.to_vec()
-    } else {
-        clip(&points, nearer).to_vec()
-    };
-    Some(positive(piece))
+    Some(contour(&clip(&points, nearer)))
 }
 
 /// How far below the triangle behind, relative to the size of the terms that make up
@@ -1360,7 +1373,7 @@ mod tests {
             prop_assume!(tris.iter().all(drawable));
             for (front, back) in [(0, 1), (1, 0)] {
                 if farther_all_over(&tris, &planes, front, back) {
-                    prop_assert!(clipped_piece(&tris, &planes, front, back).is_none());
+                    prop_assert!(clipped_piece(&tris, &planes, front, back, &mut Vec::new()).is_none());
                 }
             }
         }
@@ -1380,7 +1393,7 @@ mod tests {
         assert!(!farther_all_over(&tris, &planes, 2, 0));
         // crossing surfaces: nearer in part
         assert!(!farther_all_over(&tris, &planes, 3, 0));
-        assert!(clipped_piece(&tris, &planes, 3, 0).is_some());
+        assert!(clipped_piece(&tris, &planes, 3, 0, &mut Vec::new()).is_some());
     }
 
     #[test]
