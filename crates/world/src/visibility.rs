@@ -444,14 +444,14 @@ impl Shared<'_> {
 /// The piece of triangle `front` that hides part of triangle `back`, or `None` where it
 /// hides nothing (more than [`PIECE_AREA`]). The pair is looked at as `(i, j)`, `i < j`,
 /// whichever of the two is asked about, so both directions come from the same overlap,
-/// bit for bit. The piece is made in a contour taken from `spare` when it has one (their
+/// bit for bit. The piece is made in a contour taken from `pool` when it has one (their
 /// allocations are used again from triangle to triangle).
 fn piece_hiding(
     tris: &[ScreenTriangle],
     planes: &[Plane],
     front: usize,
     back: usize,
-    spare: &mut Vec<Contour>,
+    pool: &mut Vec<Contour>,
 ) -> Option<Contour> {
     let (i, j) = (front.min(back), front.max(back));
     let (ti, tj) = (&tris[i], &tris[j]);
@@ -461,7 +461,7 @@ fn piece_hiding(
     if farther_all_over(tris, planes, front, back) {
         return None;
     }
-    clipped_piece(tris, planes, front, back, spare)
+    clipped_piece(tris, planes, front, back, pool)
 }
 
 /// [`piece_hiding`] for two triangles not [`apart`]: their overlap clipped to where
@@ -471,10 +471,10 @@ fn clipped_piece(
     planes: &[Plane],
     front: usize,
     back: usize,
-    spare: &mut Vec<Contour>,
+    pool: &mut Vec<Contour>,
 ) -> Option<Contour> {
     let mut contour = |points: &[Pt]| {
-        let mut v = spare.pop().unwrap_or_default();
+        let mut v = pool.pop().unwrap_or_default();
         v.clear();
         v.extend_from_slice(points);
         positive(v)
