@@ -214,6 +214,19 @@ mod tests {
         out
     }
 
+    /// A 3 × 3 mesh over `[0, 8]²` without its middle square: a ring of pieces around a
+    /// hole.
+    fn ring() -> Vec<Contour> {
+        mesh(3, &[])
+            .into_iter()
+            .filter(|p| {
+                let c = p.iter().fold([0.0, 0.0], |s, v| [s[0] + v[0], s[1] + v[1]]);
+                let c = [c[0] / p.len() as f64, c[1] / p.len() as f64];
+                !(c[0] > 8.0 / 3.0 && c[0] < 16.0 / 3.0 && c[1] > 8.0 / 3.0 && c[1] < 16.0 / 3.0)
+            })
+            .collect()
+    }
+
     #[test]
     fn a_mesh_covers_a_triangle_under_it_and_a_hole_or_an_edge_does_not() {
         let mut scratch = Scratch::default();
@@ -244,14 +257,7 @@ mod tests {
         assert!(!covers(&t, &turned, &mut scratch));
         // a triangle in a hole of the pieces (a ring of them): not covered, though no
         // edge of theirs meets it and the ring's outline holds it
-        let ring: Vec<Contour> = mesh(3, &[])
-            .into_iter()
-            .filter(|p| {
-                let c = p.iter().fold([0.0, 0.0], |s, v| [s[0] + v[0], s[1] + v[1]]);
-                let c = [c[0] / p.len() as f64, c[1] / p.len() as f64];
-                !(c[0] > 8.0 / 3.0 && c[0] < 16.0 / 3.0 && c[1] > 8.0 / 3.0 && c[1] < 16.0 / 3.0)
-            })
-            .collect();
+        let ring = ring();
         assert!(!covers(
             &[[3.5, 3.5], [4.5, 3.5], [4.0, 4.5]],
             &ring,
@@ -299,14 +305,7 @@ mod tests {
         // a ring of pieces whose hole holds the triangle, and a piece over the
         // triangle's middle reaching out of it: not covered, though no edge of the ring
         // meets the triangle and the middle's centre lies in a piece
-        let mut ring: Vec<Contour> = mesh(3, &[])
-            .into_iter()
-            .filter(|p| {
-                let c = p.iter().fold([0.0, 0.0], |s, v| [s[0] + v[0], s[1] + v[1]]);
-                let c = [c[0] / p.len() as f64, c[1] / p.len() as f64];
-                !(c[0] > 8.0 / 3.0 && c[0] < 16.0 / 3.0 && c[1] > 8.0 / 3.0 && c[1] < 16.0 / 3.0)
-            })
-            .collect();
+        let mut ring = ring();
         let small = [[3.5, 3.5], [4.5, 3.5], [4.0, 4.5]];
         ring.push(positive(vec![[3.9, 3.6], [4.1, 3.6], [4.0, 4.9]]));
         assert!(!covers(&small, &ring, &mut scratch));
