@@ -104,6 +104,37 @@ fn first_bad_index(text: &str) -> Option<u64> {
     None
 }
 
+/// The line of the first `keyword` statement (`v`, `vn` or `vt`) whose values, read
+/// as tobj reads them, are `found`, bit for bit: where a value tobj kept came from.
+///
+/// tobj's mesh holds each position, normal and texture coordinate in the order the
+/// faces first use it (once for each combination of indices), not the file's order,
+/// so a value is located by what it is, not by where it stands in the mesh.
+fn line_of_values(text: &str, keyword: &str, found: &[f64]) -> Option<u64> {
+    text.lines().enumerate().find_map(|(n, line)| {
+        let mut words = line.split_whitespace();
+        if words.next() != Some(keyword) {
+            return None;
+        }
+        let mut values: Vec<f64> = Vec::with_capacity(found.len());
+        for _ in 0..found.len() {
+            values.push(words.next()?.parse().ok()?);
+        }
+        // a position's fourth number, alone, divides the three before it
+        if keyword == "v" {
+            if let (Some(w), None) = (words.next(), words.next()) {
+                let w: f64 = w.parse().ok()?;
+                values.iter_mut().for_each(|x| *x /= w);
+            }
+        }
+        let same = values
+            .iter()
+            .zip(found)
+            .all(|(a, b)| a.to_bits() == b.to_bits());
+        same.then_some(n as u64 + 1)
+    })
+}
+
 /// Reads an OBJ file into positions, faces and (when complete) per-corner normals.
 pub(crate) fn read(path: &Path) -> Result<Raw, SceneError> {
     let io = |e: std::io::Error| SceneError {
@@ -197,40 +228,32 @@ pub(crate) fn read(path: &Path) -> Result<Raw, SceneError> {
             return Err(error(path, line, what));
         }
     };
-    // the `v` and `vn` lines, to locate non-finite values
+    // the `v`, `vn` and `vt` lines, to locate a value refused
     let text = String::from_utf8_lossy(&bytes);
-    let statement_line = |keyword: &str, index: usize| -> Option<u64> {
-        text.lines()
-            .enumerate()
-            .filter(|(_, l)| l.split_whitespace().next() == Some(keyword))
-            .nth(index)
-            .map(|(n, _)| n as u64 + 1)
-    };
+    let line_of = |keyword: &str, found: &[f64]| line_of_values(&text, keyword, found);
     let mut positions = Vec::new();
     let mut faces = Vec::new();
     let mut normals: Vec<Vec<DVec3>> = Vec::new();
     let mut all_have_normals = true;
     let mut uvs: Vec<Vec<[f64; 2]>> = Vec::new();
     let mut all_have_uv = true;
-    let (mut v_seen, mut vn_seen, mut vt_seen) = (0usize, 0usize, 0usize);
     for model in &models {
         let m = &model.mesh;
         let base = positions.len() as u32;
-        for (i, p) in m.positions.chunks_exact(3).enumerate() {
+        for p in m.positions.chunks_exact(3) {
             let v = DVec3::new(p[0], p[1], p[2]);
             if !v.is_finite() {
                 return Err(SceneError {
                     kind: SceneErrorKind::NonFinite,
                     ..error(
                         path,
-                        statement_line("v", v_seen + i),
+                        line_of("v", p),
                         format!("expected finite coordinates, found {v}"),
                     )
                 });
             }
             positions.push(v);
         }
-        v_seen += m.positions.len() / 3;
         let mesh_normals: Vec<DVec3> = m
             .normals
             .chunks_exact(3)
@@ -241,12 +264,11 @@ pub(crate) fn read(path: &Path) -> Result<Raw, SceneError> {
                 kind: SceneErrorKind::NonFinite,
                 ..error(
                     path,
-                    statement_line("vn", vn_seen + bad),
+                    line_of("vn", &m.normals[3 * bad..3 * bad + 3]),
                     "expected a finite normal".into(),
                 )
             });
         }
-        vn_seen += mesh_normals.len();
         let arities: Vec<u32> = if m.face_arities.is_empty() {
             vec![3; m.indices.len() / 3]
         } else {
@@ -262,7 +284,7 @@ pub(crate) fn read(path: &Path) -> Result<Raw, SceneError> {
                     kind: SceneErrorKind::NonFinite,
                     ..error(
                         path,
-                        statement_line("vt", vt_seen + bad / 2),
+                        line_of("vt", &m.texcoords[bad / 2 * 2..bad / 2 * 2 + 2]),
                         "expected finite texture coordinates".into(),
                     )
                 });
@@ -274,7 +296,7 @@ pub(crate) fn read(path: &Path) -> Result<Raw, SceneError> {
                     kind: SceneErrorKind::Limit,
                     ..error(
                         path,
-                        statement_line("vt", vt_seen + bad / 2),
+                        line_of("vt", &m.texcoords[bad / 2 * 2..bad / 2 * 2 + 2]),
                         format!(
                             "expected texture coordinates within ±1e9, found {:e}",
                             m.texcoords[bad]
@@ -283,7 +305,6 @@ pub(crate) fn read(path: &Path) -> Result<Raw, SceneError> {
                 });
             }
         }
-        vt_seen += m.texcoords.len() / 2;
         let mut at = 0usize;
         for arity in arities {
             let range = at..at + arity as usize;
@@ -401,5 +422,40 @@ mod tests {
             (Some(3), SceneErrorKind::NonFinite),
             "{e}"
         );
+    }
+
+    /// Found by `mutated_obj_files`: a refused value was located by its place in tobj's
+    /// mesh, which is the order faces first use a value (once for each combination of
+    /// indices), not the file's. A vertex used first, or with several normals, was put on
+    /// another line or on none.
+    #[test]
+    fn a_refused_value_is_located_on_its_own_line() {
+        for (k, (obj, line)) in [
+            // the fourth vertex, used first: it was put on line 1
+            ("v 0 0 0\nv 1 0 0\nv 0 1 0\nv inf 0 1\nf 4 2 3\n", 4),
+            // a vertex with two normals is two of the mesh's positions: no line was found
+            (
+                "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1e999 0 1\nvn 0 0 1\nvn 0 1 0\n\
+                 f 1//1 2//1 3//1\nf 1//2 2//2 3//2\nf 1//1 2//1 4//1\n",
+                4,
+            ),
+            // scaled by its fourth number to a value that is not finite
+            ("v 0 0 0\nv 1e300 0 1 1e-300\nv 0 1 0\nf 3 2 1\n", 2),
+            // a normal and texture coordinates out of order
+            (
+                "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn nan 0 1\nf 1//2 2//1 3//1\n",
+                5,
+            ),
+            (
+                "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 0 2e9\nf 1/2 2/1 3/1\n",
+                5,
+            ),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let e = read(&write(&format!("order{k}.obj"), obj)).unwrap_err();
+            assert_eq!(e.line, Some(line), "{k}: {e}");
+        }
     }
 }
