@@ -6,6 +6,12 @@
 # `cargo test --workspace` needs nothing installed by hand; .ci/run runs it first so that
 # its output stands apart from the tests'.
 set -euo pipefail
+# One install at a time: the tests of one binary run on threads, and each that finds a
+# tool missing runs this script (apt-get takes its locks once, and refuses a second
+# caller). The lock is shared with the project's other install script; what is missing
+# is looked at once it is held, so a caller that waited finds the tools installed.
+exec 9>"${TMPDIR:-/tmp}/cwisim-apt-install.lock"
+flock 9
 missing=()
 command -v iverilog >/dev/null 2>&1 && command -v vvp >/dev/null 2>&1 || missing+=(iverilog)
 command -v verilator >/dev/null 2>&1 || missing+=(verilator)
@@ -25,8 +31,9 @@ if [ "$(id -u)" -ne 0 ]; then
     sudo="sudo"
 fi
 echo "== installing Debian's ${missing[*]} (apt-get) for cwisim rtl's co-simulation, synthesis and place and route"
-$sudo apt-get update -qq
-DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq "${missing[@]}" >/dev/null
+# and wait, rather than fail, while another program (an upgrade) holds apt's lock
+$sudo apt-get -o DPkg::Lock::Timeout=600 update -qq
+DEBIAN_FRONTEND=noninteractive $sudo apt-get -o DPkg::Lock::Timeout=600 install -y -qq "${missing[@]}" >/dev/null
 iverilog -V 2>/dev/null | head -n 1
 verilator --version
 yosys -V
