@@ -326,10 +326,13 @@ fn the_memory_budget_holds_tradeoff_fit_refine_and_inspect() {
     // each holds whole images (8 bytes a value): past the budget it is refused before the
     // first is made, naming what; within it, it runs
     let dir = scratch("budgets-memory-studies");
-    let cases: [(&str, &str, &[&str]); 4] = [
+    // (refine's pot is projected first: its 928 triangles' visibility, 620 KiB, within
+    // 1 MiB, its two frames at 400 × 400 not)
+    let cases: [(&str, &str, &str, &[&str]); 4] = [
         (
             "tradeoff",
             "tradeoff's images",
+            "512K",
             &[
                 "tradeoff",
                 "fig25",
@@ -346,6 +349,7 @@ fn the_memory_budget_holds_tradeoff_fit_refine_and_inspect() {
         (
             "fit",
             "fit's images",
+            "512K",
             &[
                 "fit",
                 "fig25",
@@ -359,12 +363,13 @@ fn the_memory_budget_holds_tradeoff_fit_refine_and_inspect() {
         ),
         (
             "refine",
-            "refine's 2 frame(s) of 200×200×1 values",
+            "refine's 2 frame(s) of 400×400×1 values",
+            "1M",
             &[
                 "refine",
                 "pot",
                 "--size",
-                "200x200",
+                "400x400",
                 "--phases",
                 "flat,gouraud",
                 "--csv",
@@ -374,15 +379,24 @@ fn the_memory_budget_holds_tradeoff_fit_refine_and_inspect() {
         (
             "inspect",
             "the page's images",
+            "512K",
             &["inspect", "fig25", "--size", "400x400", "-o", "p.html"],
         ),
     ];
-    for (command, says, args) in cases {
-        let out = cwisim_env(&dir, &[("CWISIM_MAX_MEMORY", "512K")], args);
+    for (command, says, budget, args) in cases {
+        let out = cwisim_env(&dir, &[("CWISIM_MAX_MEMORY", budget)], args);
         let (_, stderr) = text(&out);
         assert_eq!(out.status.code(), Some(2), "{command}: {stderr}");
         assert!(
-            stderr.contains(says) && stderr.contains("over the budget of 512.0 KiB"),
+            stderr.contains(says)
+                && stderr.contains(&format!(
+                    "over the budget of {}",
+                    if budget == "1M" {
+                        "1.0 MiB"
+                    } else {
+                        "512.0 KiB"
+                    }
+                )),
             "{command}: {stderr}"
         );
         let out = cwisim_env(&dir, &[("CWISIM_MAX_MEMORY", "256M")], args);
@@ -440,4 +454,32 @@ fn a_session_past_the_budget_is_refused_before_its_later_runs() {
     assert!(!dir.join("s.png").exists());
     let out = cwisim_env(&dir, &[("CWISIM_MAX_MEMORY", "64M")], &args);
     assert!(out.status.success(), "{:?}", text(&out));
+}
+
+#[test]
+fn a_mesh_whose_visibility_passes_the_budget_is_refused_before_it_is_projected() {
+    let dir = scratch("budget-visibility");
+    // the teapot at 64 quads a patch: 261,632 triangles, 118.8 MiB as exact visibility
+    // counts them on one thread without their surfaces, more with them (Phong keeps them)
+    let draw = |budget: &str, extra: &[&str]| {
+        let mut args = vec!["render", "teapot", "--tessellate", "64", "--threads", "1"];
+        args.extend_from_slice(extra);
+        args.extend_from_slice(&["-o", "t.png"]);
+        cwisim_env(&dir, &[("CWISIM_MAX_MEMORY", budget)], &args)
+    };
+    let stderr = refused(
+        &draw("100M", &[]),
+        "exact visibility of the scene's 261632 triangles needs 118.8 MiB",
+    );
+    assert!(stderr.contains("CWISIM_MAX_MEMORY"), "{stderr}");
+    refused(
+        &draw("100M", &["--shading", "phong"]),
+        "exact visibility of the scene's 261632 triangles needs 166.7 MiB",
+    );
+    // front to back, the triangles alone (176 bytes each)
+    refused(
+        &draw("40M", &["--visibility", "eval0"]),
+        "projecting the scene's 261632 triangles needs 43.9 MiB",
+    );
+    assert!(!dir.join("t.png").exists());
 }

@@ -36,7 +36,7 @@ use cwisim_scene::{Antialias, ScreenScene};
 use cwisim_world::face::ScreenTriangle;
 use cwisim_ypipe::coverage::Slice;
 use cwisim_ypipe::dofill::sampled_span;
-use cwisim_ypipe::scan::{edge_list, scan_rows_of, EdgeNode, Visit};
+use cwisim_ypipe::scan::{edge_list, scan_rows_of, EdgeList, Visit};
 use cwisim_ypipe::scene_trapezia;
 use cwisim_ypipe::trapezoid::Trapezium;
 use std::io;
@@ -49,7 +49,7 @@ pub struct PhongFrame<'a> {
     aa: Antialias,
     tolerance: f64,
     trapezia: Vec<Trapezium>,
-    edges: Vec<EdgeNode>,
+    edges: EdgeList,
 }
 
 impl<'a> PhongFrame<'a> {

@@ -133,6 +133,34 @@ impl PhongSurfaces {
     }
 }
 
+/// Refuses, before a triangle is projected, a scene whose screen triangles and their
+/// visibility would hold more than the memory budget: the triangles with their surfaces
+/// (`keep_surfaces`) or without, and exact visibility's own figure a triangle
+/// ([`cwisim_world::visibility::exact_memory`]).
+fn check_visibility_memory(
+    w: &cwisim_world::WorldScene,
+    settings: &Settings,
+    keep_surfaces: bool,
+) -> Result<(), RenderError> {
+    use cwisim_world::face::ScreenTriangle;
+    let triangles: u64 = w.meshes.iter().map(|m| m.triangle_count() as u64).sum();
+    let triangle_bytes = if keep_surfaces {
+        std::mem::size_of::<ScreenTriangle>()
+    } else {
+        std::mem::size_of::<ScreenTriangle<()>>()
+    } as u64;
+    let (what, bytes) = match settings.visibility {
+        Visibility::Exact => (
+            "exact visibility of",
+            cwisim_world::visibility::exact_memory(triangles, triangle_bytes, settings.threads),
+        ),
+        Visibility::Eval0 => ("projecting", triangles.saturating_mul(triangle_bytes)),
+    };
+    cwisim_scene::budget::Budget::current()
+        .check_memory(&format!("{what} the scene's {triangles} triangles"), bytes)
+        .map_err(|e| RenderError::Usage(e.to_string()))
+}
+
 /// The lights of world scene `w` that cast shadows under `settings`, refusing a
 /// `--shadows` that would change nothing: `on` in a scene without lights, `off` in one
 /// where no light casts shadows.
@@ -295,19 +323,21 @@ impl PolygonScene {
                     "textures are drawn on exact visible surfaces only: use --visibility exact (eval0 claims hold one value per pixel run, not a texture)".into(),
                 ))
             }
-            AnyScene::World(w) => {
+            AnyScene::World(mut w) => {
                 prepared.transparent_meshes = w
                     .spec
                     .meshes
                     .iter()
                     .filter(|m| m.material.transmittance > 0.0)
                     .count() as u64;
-                let start = Instant::now();
-                let (tris, project) = cwisim_world::project::project(&w, settings.shading)?;
-                prepared.transform_time = start.elapsed();
                 let casters = world_casters(&w, settings)?;
+                let keep_surfaces = per_pixel || !casters.is_empty();
+                check_visibility_memory(&w, settings, keep_surfaces)?;
                 let start = Instant::now();
-                let (polygons, vis) = if per_pixel || !casters.is_empty() {
+                let (polygons, vis, project) = if keep_surfaces {
+                    let (tris, project) = cwisim_world::project::project(&w, settings.shading)?;
+                    prepared.transform_time = start.elapsed();
+                    let start = Instant::now();
                     // the fragments with their source triangles: per-pixel shading and
                     // shadows need them
                     let (fragments, stats) = match settings.visibility {
@@ -357,16 +387,25 @@ impl PolygonScene {
                     (
                         shadowed.fragments.into_iter().map(|f| f.polygon).collect(),
                         stats,
+                        project,
                     )
                 } else {
-                    let resolved = cwisim_world::resolve_on(
+                    // nothing reads the triangles' corners in the world after lighting:
+                    // they are not kept
+                    let (tris, project) =
+                        cwisim_world::project::project_plain(&w, settings.shading)?;
+                    // nor the meshes: what follows reads the scene's size alone
+                    drop(std::mem::take(&mut w.meshes));
+                    prepared.transform_time = start.elapsed();
+                    let start = Instant::now();
+                    let (polygons, vis) = cwisim_world::resolve_on(
                         &tris,
                         w.channels(),
                         settings.visibility,
                         settings.threads,
                     );
                     prepared.visibility_time = start.elapsed();
-                    resolved
+                    (polygons, vis, project)
                 };
                 prepared.screen = w.screen(polygons);
                 prepared.project = Some(project);

@@ -16,7 +16,6 @@ use cwisim_render::{
     registry, render, ArrayConfig, PolygonScene, Renderer, Settings, Size, Source, Taps,
 };
 use cwisim_scene::{Antialias, Shading};
-use cwisim_world::scene::MAX_TESSELLATION;
 use cwisim_world::Visibility;
 use cwisim_xproc::{ImageSink, Machine, Numeric, Timing};
 use cwisim_ypipe::exact::scene_box_filtered;
@@ -60,7 +59,7 @@ pub struct Row {
     /// Quads per Bézier patch side (scenes with Bézier meshes, when the grid varies it).
     pub tessellate: Option<u32>,
     /// The root tolerance of a renderer that draws the patches directly (`nishita`);
-    /// its rows are measured against the reference at the finest tessellation.
+    /// its rows are measured against the reference at [`REFERENCE_TESSELLATION`].
     pub root_tolerance: Option<f64>,
     /// `nishita`'s normal-difference angle, degrees (`--normal-angle`); `None` where the
     /// test is off or the renderer draws no patches.
@@ -1121,8 +1120,8 @@ type Reference = std::sync::Arc<std::sync::Mutex<Option<std::sync::Arc<Vec<f64>>
 
 impl References {
     /// The reference `setting` is measured against: its own geometry's, or for patches
-    /// drawn directly (on a world scene) the finest tessellation's — the closest the
-    /// exact reference comes to the true surface.
+    /// drawn directly (on a world scene) [`REFERENCE_TESSELLATION`]'s — close to the
+    /// true surface at a cost a sweep can pay.
     fn get(
         &self,
         scene: Option<&Path>,
@@ -1152,11 +1151,17 @@ impl References {
     }
 }
 
+/// The tessellation of the exact reference that settings drawing Bézier patches
+/// directly (`nishita`) are measured against: 64 × 64 quads a patch (261,632 triangles
+/// for the teapot). The scene's own limit, [`cwisim_world::scene::MAX_TESSELLATION`],
+/// is finer, at four times the triangles, the time and the memory of every reference.
+pub const REFERENCE_TESSELLATION: u32 = 64;
+
 /// The tessellation of the reference a setting is measured against (see
 /// [`References::get`]).
 fn reference_tessellation(setting: &Setting, world: bool) -> Option<u32> {
     if setting.renderer.patches && world {
-        Some(MAX_TESSELLATION)
+        Some(REFERENCE_TESSELLATION)
     } else {
         setting.settings.tessellate
     }

@@ -14,8 +14,12 @@ use cwisim_scene::Vector;
 /// `intensity` is the per-vertex intensity vector (its first `channels` entries used).
 /// Across the triangle the intensity is the affine interpolation of the three vertex
 /// values in screen space (Gouraud as the X-processors do it): [`ScreenTriangle::intensity_at`].
+///
+/// `S` is what it keeps of its corners in the world: a [`Surface`] (the default) where
+/// per-pixel shading, textures or shadows will read it, `()` where only visibility and
+/// the corners' intensities will (192 bytes a triangle fewer: [`crate::project::project_plain`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ScreenTriangle {
+pub struct ScreenTriangle<S = Surface> {
     /// The vertices `[x, y]` in pixels.
     pub points: [[f64; 2]; 3],
     /// `1 / depth` at each vertex (> 0: in front of the camera).
@@ -27,8 +31,8 @@ pub struct ScreenTriangle {
     /// Which face of that mesh.
     pub face: u32,
     /// Where its corners are in the world, and their shading normals: what per-pixel
-    /// (Phong) shading interpolates.
-    pub surface: Surface,
+    /// (Phong) shading interpolates (`()` where nothing will).
+    pub surface: S,
 }
 
 /// A screen triangle's corners in the world: positions, and unit shading normals turned
@@ -44,7 +48,7 @@ pub struct Surface {
     pub uv: [[f64; 2]; 3],
 }
 
-impl ScreenTriangle {
+impl<S> ScreenTriangle<S> {
     /// Twice the signed area (positive: counter-clockwise with y downward, i.e. clockwise
     /// as seen on the screen).
     pub fn doubled_area(&self) -> f64 {

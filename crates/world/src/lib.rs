@@ -253,8 +253,8 @@ pub struct Prepared {
 
 /// The polygons to send for lit screen triangles, in order: exact visible fragments,
 /// or the whole triangles front to back ([`Visibility`]).
-pub fn resolve(
-    tris: &[face::ScreenTriangle],
+pub fn resolve<S: Sync>(
+    tris: &[face::ScreenTriangle<S>],
     channels: usize,
     visibility: Visibility,
 ) -> (Vec<Polygon>, Option<VisibilityStats>) {
@@ -265,8 +265,8 @@ pub fn resolve(
 /// ([`visibility::exact_fragments_on`]; 0: one per core): the same polygons and
 /// statistics, bit for bit, at any thread count. Front-to-back order is a sort, on one
 /// thread.
-pub fn resolve_on(
-    tris: &[face::ScreenTriangle],
+pub fn resolve_on<S: Sync>(
+    tris: &[face::ScreenTriangle<S>],
     channels: usize,
     visibility: Visibility,
     threads: usize,
@@ -289,14 +289,14 @@ pub fn resolve_on(
     }
 }
 
-/// Projects, lights and resolves the visibility of a world scene ([`project::project`],
-/// then [`resolve`]).
+/// Projects, lights and resolves the visibility of a world scene
+/// ([`project::project_plain`], then [`resolve`]).
 pub fn to_screen(
     scene: &WorldScene,
     shading: Shading,
     visibility: Visibility,
 ) -> Result<Prepared, SceneError> {
-    let (tris, project) = project::project(scene, shading)?;
+    let (tris, project) = project::project_plain(scene, shading)?;
     let (polygons, visibility) = resolve(&tris, scene.channels(), visibility);
     Ok(Prepared {
         screen: scene.screen(polygons),

@@ -298,8 +298,9 @@ pub struct BezierSource {
     pub tessellate: u32,
 }
 
-/// The finest tessellation of a Bézier patch: 64 × 64 quads.
-pub const MAX_TESSELLATION: u32 = 64;
+/// The finest tessellation of a Bézier patch: 128 × 128 quads (the teapot then has
+/// 1,047,552 triangles: about 0.9 GB to draw with `vanrij`, PERFORMANCE.md).
+pub const MAX_TESSELLATION: u32 = 128;
 /// The most triangles a Bézier mesh may tessellate into: 2^22.
 pub const MAX_BEZIER_TRIANGLES: u64 = 1 << 22;
 

@@ -138,6 +138,29 @@ const COPLANAR: f64 = 1e-12;
 /// The most channels an intensity vector holds.
 const MAX_CHANNELS: usize = std::mem::size_of::<Vector>() / std::mem::size_of::<f64>();
 
+/// What [`exact_fragments_on`] holds a triangle at its peak on one thread, beyond the
+/// triangles themselves: their planes, boxes and index, a flag or two, and the fragments
+/// it returns. 262–274 bytes were measured on the teapot at 4 to 32 quads a patch
+/// (`tests/visibility_memory.rs` holds it to this). Surfaces stacked deep hold more: a
+/// triangle's candidates and pieces grow with the layers over it (about 580 bytes a
+/// triangle under 16 layers).
+pub const PAIRS_BYTES_PER_TRIANGLE: u64 = 300;
+
+/// What each thread past the first adds a triangle (its stamps in the index).
+pub const PAIRS_BYTES_PER_TRIANGLE_PER_THREAD: u64 = 16;
+
+/// The memory that `triangles` screen triangles of `triangle_bytes` each and their exact
+/// visibility on `threads` threads (0: one per core) hold, as
+/// [`PAIRS_BYTES_PER_TRIANGLE`] counts it: what a caller checks against the memory
+/// budget before projecting them.
+pub fn exact_memory(triangles: u64, triangle_bytes: u64, threads: usize) -> u64 {
+    let extra = cwisim_scene::budget::resolve_threads(threads).saturating_sub(1) as u64;
+    let per_triangle = triangle_bytes
+        .saturating_add(PAIRS_BYTES_PER_TRIANGLE)
+        .saturating_add(extra.saturating_mul(PAIRS_BYTES_PER_TRIANGLE_PER_THREAD));
+    triangles.saturating_mul(per_triangle)
+}
+
 /// One visible piece of a screen triangle.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Fragment {
@@ -155,9 +178,9 @@ impl Fragment {
     /// # Panics
     ///
     /// If `tri` has no area (no barycentric coordinates): a visible part has some.
-    pub fn of_triangle(
+    pub fn of_triangle<S>(
         source: usize,
-        tri: &ScreenTriangle,
+        tri: &ScreenTriangle<S>,
         vertices: Vec<[f64; 2]>,
         channels: usize,
     ) -> Fragment {
@@ -217,8 +240,8 @@ pub struct VisibilityStats {
 /// # Panics
 ///
 /// If `channels` exceeds the length of an intensity [`Vector`].
-pub fn exact_fragments(
-    tris: &[ScreenTriangle],
+pub fn exact_fragments<S: Sync>(
+    tris: &[ScreenTriangle<S>],
     channels: usize,
 ) -> (Vec<Fragment>, VisibilityStats) {
     exact_fragments_on(tris, channels, 1)
@@ -234,8 +257,8 @@ pub fn exact_fragments(
 /// # Panics
 ///
 /// If `channels` exceeds the length of an intensity [`Vector`].
-pub fn exact_fragments_on(
-    tris: &[ScreenTriangle],
+pub fn exact_fragments_on<S: Sync>(
+    tris: &[ScreenTriangle<S>],
     channels: usize,
     threads: usize,
 ) -> (Vec<Fragment>, VisibilityStats) {
@@ -327,8 +350,8 @@ pub fn exact_fragments_on(
 const CHUNKS_PER_THREAD: usize = 8;
 
 /// What every chunk of [`exact_fragments_on`] reads.
-struct Shared<'a> {
-    tris: &'a [ScreenTriangle],
+struct Shared<'a, S> {
+    tris: &'a [ScreenTriangle<S>],
     channels: usize,
     usable: &'a [bool],
     planes: &'a [Plane],
@@ -347,7 +370,7 @@ struct Tally {
     losses: Losses,
 }
 
-impl Shared<'_> {
+impl<S> Shared<'_, S> {
     /// The fragments of the triangles `range`.
     fn chunk(&self, range: std::ops::Range<usize>) -> Tally {
         let Shared {
@@ -446,8 +469,8 @@ impl Shared<'_> {
 /// whichever of the two is asked about, so both directions come from the same overlap,
 /// bit for bit. The piece is made in a contour taken from `pool` when it has one (their
 /// allocations are used again from triangle to triangle).
-fn piece_hiding(
-    tris: &[ScreenTriangle],
+fn piece_hiding<S>(
+    tris: &[ScreenTriangle<S>],
     planes: &[Plane],
     front: usize,
     back: usize,
@@ -466,8 +489,8 @@ fn piece_hiding(
 
 /// [`piece_hiding`] for two triangles not [`apart`]: their overlap clipped to where
 /// `front` is nearer.
-fn clipped_piece(
-    tris: &[ScreenTriangle],
+fn clipped_piece<S>(
+    tris: &[ScreenTriangle<S>],
     planes: &[Plane],
     front: usize,
     back: usize,
@@ -529,7 +552,12 @@ const FARTHER: f64 = 1e-9;
 ///
 /// About half the pairs that are not apart end here in a mesh seen from both sides (the
 /// far side's triangles are candidates of the near side's): no polygon is clipped.
-fn farther_all_over(tris: &[ScreenTriangle], planes: &[Plane], front: usize, back: usize) -> bool {
+fn farther_all_over<S>(
+    tris: &[ScreenTriangle<S>],
+    planes: &[Plane],
+    front: usize,
+    back: usize,
+) -> bool {
     let (pf, pb) = (&planes[front], &planes[back]);
     let mut size = 0.0f64;
     let mut nearest = f64::NEG_INFINITY;
@@ -551,7 +579,7 @@ fn farther_all_over(tris: &[ScreenTriangle], planes: &[Plane], front: usize, bac
 ///
 /// The centroid is the 3D triangle's: its depth is the mean of the vertex depths
 /// `1 / inv_depth[k]` (depth being affine in 3D).
-pub fn front_to_back(tris: &[ScreenTriangle]) -> Vec<usize> {
+pub fn front_to_back<S>(tris: &[ScreenTriangle<S>]) -> Vec<usize> {
     let depth: Vec<f64> = tris
         .iter()
         .map(|t| {
@@ -570,7 +598,7 @@ pub fn front_to_back(tris: &[ScreenTriangle]) -> Vec<usize> {
 
 /// Every triangle whole, in [`front_to_back`] order, as a fragment of itself (its
 /// vertices' intensities, the first `channels` entries).
-pub fn front_to_back_fragments(tris: &[ScreenTriangle], channels: usize) -> Vec<Fragment> {
+pub fn front_to_back_fragments<S>(tris: &[ScreenTriangle<S>], channels: usize) -> Vec<Fragment> {
     front_to_back(tris)
         .into_iter()
         .map(|k| {
@@ -590,7 +618,7 @@ pub fn front_to_back_fragments(tris: &[ScreenTriangle], channels: usize) -> Vec<
 // Geometry helpers.
 
 /// Whether a triangle can be drawn: finite coordinates and `1/depth`, nonzero area.
-fn drawable(t: &ScreenTriangle) -> bool {
+fn drawable<S>(t: &ScreenTriangle<S>) -> bool {
     let a = t.doubled_area();
     a != 0.0
         && a.is_finite()
@@ -610,7 +638,7 @@ struct Plane {
 
 impl Plane {
     /// A triangle's `1/depth` (relative to its first vertex); zero for a degenerate one.
-    fn of(t: &ScreenTriangle) -> Plane {
+    fn of<S>(t: &ScreenTriangle<S>) -> Plane {
         let [a, b, c] = t.points;
         let [z0, z1, z2] = t.inv_depth;
         let d = t.doubled_area();
@@ -640,7 +668,7 @@ impl Plane {
 /// exactly, at a vertex; the plane elsewhere. Triangles sharing a vertex (with the same
 /// `1/depth`) thus agree there to the bit, and so do the cut points that
 /// [`clip`] puts on a shared edge.
-fn inv_depth(t: &ScreenTriangle, plane: &Plane, p: Pt) -> f64 {
+fn inv_depth<S>(t: &ScreenTriangle<S>, plane: &Plane, p: Pt) -> f64 {
     match t.points.iter().position(|&q| q == p) {
         Some(k) => t.inv_depth[k],
         None => plane.at(p),
@@ -649,7 +677,7 @@ fn inv_depth(t: &ScreenTriangle, plane: &Plane, p: Pt) -> f64 {
 
 /// A triangle's vertices and `1/depth`, bit for bit, in a canonical order: equal for
 /// exact copies whatever their vertex order.
-fn copy_key(t: &ScreenTriangle) -> [u64; 9] {
+fn copy_key<S>(t: &ScreenTriangle<S>) -> [u64; 9] {
     let mut corners: [[u64; 3]; 3] = std::array::from_fn(|v| {
         [
             t.points[v][0].to_bits(),
@@ -668,7 +696,7 @@ fn copy_key(t: &ScreenTriangle) -> [u64; 9] {
 /// triangles in order and a sort of 16 bytes each, where a map of the keys held 80
 /// bytes a triangle through the whole pass and was looked up at random (a cache miss a
 /// triangle).
-fn later_copies(tris: &[ScreenTriangle], usable: &[bool]) -> Vec<bool> {
+fn later_copies<S>(tris: &[ScreenTriangle<S>], usable: &[bool]) -> Vec<bool> {
     use std::hash::BuildHasher;
     let hasher = rustc_hash::FxBuildHasher;
     let mut keyed: Vec<(u64, usize)> = (0..tris.len())
@@ -765,7 +793,7 @@ fn clip_into(poly: &[Pt], f: impl Fn(Pt) -> f64, out: &mut Small) {
 /// Whether an edge of triangle `t` has all three corners of `o` on its outside or on it:
 /// the two share no area. The common candidate pair of a mesh — two neighbours whose
 /// boxes overlap — ends here, without clipping.
-fn apart(t: &ScreenTriangle, o: &ScreenTriangle) -> bool {
+fn apart<S>(t: &ScreenTriangle<S>, o: &ScreenTriangle<S>) -> bool {
     let s = t.doubled_area().signum();
     (0..3).any(|k| {
         let (a, b) = (t.points[k], t.points[(k + 1) % 3]);
@@ -775,7 +803,7 @@ fn apart(t: &ScreenTriangle, o: &ScreenTriangle) -> bool {
 
 /// The convex polygon `poly` clipped to the triangle `t` (either orientation), into
 /// `out`; `spare` is scratch space.
-fn inside_triangle(poly: &[Pt], t: &ScreenTriangle, out: &mut Small, spare: &mut Small) {
+fn inside_triangle<S>(poly: &[Pt], t: &ScreenTriangle<S>, out: &mut Small, spare: &mut Small) {
     let s = t.doubled_area().signum();
     let edge = |k: usize| {
         let (a, b) = (t.points[k], t.points[(k + 1) % 3]);
@@ -828,7 +856,7 @@ struct BoxIndex {
 const BIG_BOX_CELLS: usize = 64;
 
 impl BoxIndex {
-    fn new(tris: &[ScreenTriangle], usable: &[bool]) -> BoxIndex {
+    fn new<S>(tris: &[ScreenTriangle<S>], usable: &[bool]) -> BoxIndex {
         let boxes: Vec<[f64; 4]> = tris
             .iter()
             .map(|t| {
@@ -1318,7 +1346,7 @@ mod tests {
             t([f64::NAN; 3]),
         ];
         assert_eq!(front_to_back(&tris), vec![3, 1, 0, 2, 4]);
-        assert!(front_to_back(&[]).is_empty());
+        assert!(front_to_back::<()>(&[]).is_empty());
     }
 
     #[test]
@@ -1414,6 +1442,6 @@ mod tests {
             later_copies(&tris, &usable),
             vec![false, false, false, true, true, false]
         );
-        assert!(later_copies(&[], &[]).is_empty());
+        assert!(later_copies::<()>(&[], &[]).is_empty());
     }
 }

@@ -77,12 +77,12 @@ fn bad_bezier_sources_are_refused_with_their_path() {
         (
             flat(ONE, "0"),
             SceneErrorKind::Limit,
-            "meshes[0].bezier.tessellate: expected quads per patch side in 1..=64, found 0",
+            "meshes[0].bezier.tessellate: expected quads per patch side in 1..=128, found 0",
         ),
         (
-            flat(ONE, "65"),
+            flat(ONE, "129"),
             SceneErrorKind::Limit,
-            "meshes[0].bezier.tessellate: expected quads per patch side in 1..=64, found 65",
+            "meshes[0].bezier.tessellate: expected quads per patch side in 1..=128, found 129",
         ),
         (
             flat(ONE, "3").replace("[-0.5, -0.5, 0]", "[-0.5, -0.5, 1e300]"),

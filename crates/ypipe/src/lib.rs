@@ -165,7 +165,7 @@ pub struct ScanPlan<'s> {
     scene: &'s ScreenScene,
     trapezia: Vec<trapezoid::Trapezium>,
     /// The trapezia's edge list, sorted (built once, shared by every band).
-    edges: Vec<scan::EdgeNode>,
+    edges: scan::EdgeList,
     shades: Vec<Shade>,
 }
 

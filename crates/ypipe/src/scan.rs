@@ -155,14 +155,60 @@ pub fn scan_rows(
     );
 }
 
+/// The edge list of a scene's trapezia (figure 2's), sorted on the top row, then
+/// Identifier, then side: each edge as its place among the trapezia's edges (`2k` the
+/// left edge of trapezium `k`, `2k + 1` its right one) and the pixel rows its trapezium
+/// touches, 24 bytes an edge. The scan makes an edge's [`EdgeNode`] from its trapezium
+/// when it reaches it (the same node, bit for bit, in every band), so that the list the
+/// bands share holds no copy of the edges; a band passes over the edges that ended above
+/// it by their rows alone.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct EdgeList {
+    edges: Vec<ListedEdge>,
+}
+
+/// One edge of an [`EdgeList`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct ListedEdge {
+    /// `2k` for the left edge of trapezium `k`, `2k + 1` for its right one.
+    edge: usize,
+    /// The first and the last pixel row its trapezium touches.
+    top_row: i64,
+    bottom_row: i64,
+}
+
+impl EdgeList {
+    /// Edges in the list: two a trapezium.
+    pub fn len(&self) -> usize {
+        self.edges.len()
+    }
+
+    /// Whether it has no edge (a scene without trapezia).
+    pub fn is_empty(&self) -> bool {
+        self.edges.is_empty()
+    }
+}
+
+impl ListedEdge {
+    /// Its trapezium's index and its side.
+    fn trapezium_side(self) -> (usize, Side) {
+        let side = if self.edge.is_multiple_of(2) {
+            Side::Left
+        } else {
+            Side::Right
+        };
+        (self.edge / 2, side)
+    }
+}
+
 /// The edge list of `trapezia`: both edges of every trapezium, sorted on the top row
 /// (then Identifier, side). Built once per scene and shared by the bands of
 /// [`scan_rows_of`]. (`channels` is the trapezia's: a node's intensity is taken in them
 /// on demand, [`EdgeNode::i_max`].)
-pub fn edge_list(trapezia: &[Trapezium], channels: usize) -> Vec<EdgeNode> {
+pub fn edge_list(trapezia: &[Trapezium], channels: usize) -> EdgeList {
     debug_assert!(channels <= cwisim_isa::MAX_CHANNELS);
-    // the sort keys alone are sorted (the nodes are big to move); the position in the
-    // input breaks ties, so the order is the stable sort's
+    // the sort keys alone are sorted; the position in the input breaks ties, so the
+    // order is the stable sort's
     let mut keys: Vec<(i64, u32, Side, usize)> = trapezia
         .iter()
         .enumerate()
@@ -175,16 +221,27 @@ pub fn edge_list(trapezia: &[Trapezium], channels: usize) -> Vec<EdgeNode> {
         })
         .collect();
     keys.sort_unstable();
-    keys.iter()
-        .map(|&(_, _, side, n)| EdgeNode::new(&trapezia[n / 2], n / 2, side))
-        .collect()
+    EdgeList {
+        edges: keys
+            .iter()
+            .map(|&(top_row, _, _, edge)| {
+                // `EdgeNode::bottom_row`'s, from the trapezium's bottom
+                let bottom_row = (ceil_i64(trapezia[edge / 2].y_bot) - 1).max(top_row);
+                ListedEdge {
+                    edge,
+                    top_row,
+                    bottom_row,
+                }
+            })
+            .collect(),
+    }
 }
 
 /// [`scan_rows`] with the scene's [`edge_list`] built already (`channels`, the
 /// trapezia's, as there: the scan itself takes no intensities).
 pub fn scan_rows_of(
     trapezia: &[Trapezium],
-    edge_list: &[EdgeNode],
+    edge_list: &EdgeList,
     rows: std::ops::Range<u32>,
     channels: usize,
     mut visit: impl FnMut(Visit<'_>),
@@ -211,7 +268,7 @@ pub enum SliceVisit<'a> {
 /// is not visited.
 pub fn scan_slices_of(
     trapezia: &[Trapezium],
-    edge_list: &[EdgeNode],
+    edge_list: &EdgeList,
     rows: std::ops::Range<u32>,
     mut visit: impl FnMut(SliceVisit<'_>),
 ) {
@@ -227,9 +284,15 @@ pub fn scan_slices_of(
         // 4.1: insert the nodes whose trapezium starts in this row (and, when a band
         // starts below a trapezium's top, those that started above and still go on)
         fresh.clear();
-        while next < edge_list.len() && edge_list[next].top_row() <= r {
-            let mut node = edge_list[next];
-            if node.bottom_row() >= r {
+        while next < edge_list.len() && edge_list.edges[next].top_row <= r {
+            let listed = edge_list.edges[next];
+            if listed.bottom_row >= r {
+                let (k, side) = listed.trapezium_side();
+                let mut node = EdgeNode::new(&trapezia[k], k, side);
+                debug_assert_eq!(
+                    (node.top_row(), node.bottom_row()),
+                    (listed.top_row, listed.bottom_row)
+                );
                 node.update_to(r);
                 let slot = match free.pop() {
                     Some(slot) => {
