@@ -143,7 +143,7 @@ fn check_visibility_memory(
     keep_surfaces: bool,
 ) -> Result<(), RenderError> {
     use cwisim_world::face::ScreenTriangle;
-    let triangles: u64 = w.meshes.iter().map(|m| m.triangle_count() as u64).sum();
+    let triangles = w.triangle_count() as u64;
     let triangle_bytes = if keep_surfaces {
         std::mem::size_of::<ScreenTriangle>()
     } else {

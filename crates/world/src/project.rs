@@ -101,8 +101,7 @@ fn project_keeping<S>(
     };
     // room for every triangle at once: growing by doubling would hold the old and the
     // new buffer together, half again the final size, at the largest step
-    let most: usize = scene.meshes.iter().map(Mesh::triangle_count).sum();
-    let mut out = Vec::with_capacity(most);
+    let mut out = Vec::with_capacity(scene.triangle_count());
     for (k, (mesh, mspec)) in scene.meshes.iter().zip(&spec.meshes).enumerate() {
         check_in_front(&camera, mesh, k)?;
         // every vertex on a representable screen position

@@ -473,6 +473,12 @@ impl WorldScene {
         self.spec.channels as usize
     }
 
+    /// Triangles of its meshes after fanning every face (before culling): what
+    /// projection makes at most.
+    pub fn triangle_count(&self) -> usize {
+        self.meshes.iter().map(Mesh::triangle_count).sum()
+    }
+
     /// The screen scene of `polygons` (what visibility made of this scene), at this
     /// scene's image size and channels.
     pub fn screen(&self, polygons: Vec<cwisim_scene::Polygon>) -> cwisim_scene::ScreenScene {
