@@ -472,14 +472,21 @@ fn a_mesh_whose_visibility_passes_the_budget_is_refused_before_it_is_projected()
         "exact visibility of the scene's 261632 triangles needs 118.8 MiB",
     );
     assert!(stderr.contains("CWISIM_MAX_MEMORY"), "{stderr}");
+    // Phong keeps the surfaces (368 bytes a triangle) and the mesh (43.1 MiB) all along
     refused(
         &draw("100M", &["--shading", "phong"]),
-        "exact visibility of the scene's 261632 triangles needs 166.7 MiB",
+        "exact visibility of the scene's 261632 triangles needs 209.8 MiB",
     );
-    // front to back, the triangles alone (176 bytes each)
+    // front to back, the triangles (176 bytes each, 43.9 MiB) and the mesh they are
+    // projected from
+    refused(
+        &draw("80M", &["--visibility", "eval0"]),
+        "projecting the scene's 261632 triangles needs 87.0 MiB",
+    );
+    // the mesh itself, before a patch is tessellated: 224 bytes a triangle
     refused(
         &draw("40M", &["--visibility", "eval0"]),
-        "projecting the scene's 261632 triangles needs 43.9 MiB",
+        "meshes[0].bezier.tessellate: tessellating the 32 patches 64 × 64 (262144 triangles) needs 56.0 MiB",
     );
     assert!(!dir.join("t.png").exists());
 }

@@ -135,8 +135,11 @@ impl PhongSurfaces {
 
 /// Refuses, before a triangle is projected, a scene whose screen triangles and their
 /// visibility would hold more than the memory budget: the triangles with their surfaces
-/// (`keep_surfaces`) or without, and exact visibility's own figure a triangle
-/// ([`cwisim_world::visibility::exact_memory`]).
+/// (`keep_surfaces`) or without, exact visibility's own figure a triangle
+/// ([`cwisim_world::visibility::exact_memory`]), and the built meshes
+/// ([`cwisim_world::mesh::Mesh::held_bytes`]) while they are held — while the triangles
+/// are projected, and all along when the surfaces are kept (else they are dropped once
+/// projected).
 fn check_visibility_memory(
     w: &cwisim_world::WorldScene,
     settings: &Settings,
@@ -149,12 +152,19 @@ fn check_visibility_memory(
     } else {
         std::mem::size_of::<ScreenTriangle<()>>()
     } as u64;
-    let (what, bytes) = match settings.visibility {
+    let meshes: u64 = w.meshes.iter().map(|m| m.held_bytes()).sum();
+    let projected = triangles.saturating_mul(triangle_bytes);
+    let (what, held) = match settings.visibility {
         Visibility::Exact => (
             "exact visibility of",
             cwisim_world::visibility::exact_memory(triangles, triangle_bytes, settings.threads),
         ),
-        Visibility::Eval0 => ("projecting", triangles.saturating_mul(triangle_bytes)),
+        Visibility::Eval0 => ("projecting", projected),
+    };
+    let bytes = if keep_surfaces {
+        meshes.saturating_add(held)
+    } else {
+        meshes.saturating_add(projected).max(held)
     };
     cwisim_scene::budget::Budget::current()
         .check_memory(&format!("{what} the scene's {triangles} triangles"), bytes)

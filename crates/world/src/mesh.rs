@@ -17,17 +17,25 @@ use crate::obj;
 use crate::scene::{BezierSource, MeshSpec, Revolution, Scale, Transform};
 use cwisim_scene::{SceneError, SceneErrorKind};
 use glam::{DMat3, DMat4, DQuat, DVec3, EulerRot};
+use smallvec::SmallVec;
 use std::path::Path;
+
+/// A face's corners: held in the face up to four (a triangle, a quad), on the heap past.
+pub type Corners = SmallVec<[u32; 4]>;
+
+/// One value per corner of a face, held in the face for a triangle: a dense mesh's faces
+/// are then one block, not three small ones a face (which the allocator keeps once freed).
+pub type PerCorner<T> = SmallVec<[T; 3]>;
 
 /// One face: its corners (indices into [`Mesh::positions`]) and a unit normal per corner.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Face {
     /// Vertex indices, counter-clockwise seen from the front.
-    pub corners: Vec<u32>,
+    pub corners: Corners,
     /// The shading normal at each corner (unit length).
-    pub normals: Vec<DVec3>,
+    pub normals: PerCorner<DVec3>,
     /// The texture coordinates `(u, v)` at each corner; empty when the mesh has none.
-    pub uv: Vec<[f64; 2]>,
+    pub uv: PerCorner<[f64; 2]>,
 }
 
 impl Face {
@@ -57,6 +65,29 @@ impl Mesh {
     /// Triangles after fanning every face.
     pub fn triangle_count(&self) -> usize {
         self.faces.iter().map(|f| f.corners.len() - 2).sum()
+    }
+
+    /// The bytes the mesh holds: its positions, its faces, and what a face keeps outside
+    /// itself (past four corners, or three normals or texture coordinates). What the
+    /// memory budget counts for a built mesh.
+    pub fn held_bytes(&self) -> u64 {
+        use std::mem::size_of;
+        fn outside<A: smallvec::Array>(v: &SmallVec<A>) -> usize {
+            if v.spilled() {
+                v.capacity() * size_of::<A::Item>()
+            } else {
+                0
+            }
+        }
+        let spilled: usize = self
+            .faces
+            .iter()
+            .map(|f| outside(&f.corners) + outside(&f.normals) + outside(&f.uv))
+            .sum();
+        (self.name.capacity()
+            + self.positions.capacity() * size_of::<DVec3>()
+            + self.faces.capacity() * size_of::<Face>()
+            + spilled) as u64
     }
 
     /// The geometric (Newell) normal of face `f`, not normalized: its length is twice the
@@ -93,15 +124,15 @@ fn newell(corners: &[u32], p: &[DVec3]) -> DVec3 {
     n
 }
 
-/// The raw geometry of a source, before placement: positions, faces, optional normals
-/// per corner, and how to name a face in messages.
+/// The raw geometry of a source, before placement: positions, faces (their normals the
+/// source's, untransformed, or none; texture coordinates at every face's corners or at
+/// none), and how to name a face in messages. The faces become the mesh's in place.
 #[derive(Debug)]
 pub(crate) struct Raw {
     pub positions: Vec<DVec3>,
-    pub faces: Vec<Vec<u32>>,
-    pub normals: Option<Vec<Vec<DVec3>>>,
-    /// Texture coordinates per face corner, when the source gives them.
-    pub uv: Option<Vec<Vec<[f64; 2]>>>,
+    pub faces: Vec<Face>,
+    /// Whether every face carries the source's normals (else none does).
+    pub normals_given: bool,
     /// An OBJ file's: each face's `f` line (1-based), to locate a face's fault there.
     pub face_lines: Option<Vec<u64>>,
 }
@@ -180,7 +211,8 @@ pub fn build(spec: &MeshSpec, k: usize, base: Option<&Path>) -> Result<Mesh, Bui
     }
     // checks: corners, degenerate and non-convex faces
     let mut areas = Vec::with_capacity(raw.faces.len());
-    for (f, corners) in raw.faces.iter().enumerate() {
+    for (f, face) in raw.faces.iter().enumerate() {
+        let corners = &face.corners;
         if corners.len() < 3 {
             return Err(face_error(
                 f,
@@ -216,27 +248,15 @@ pub fn build(spec: &MeshSpec, k: usize, base: Option<&Path>) -> Result<Mesh, Bui
         }
         areas.push(n);
     }
-    let uv = raw.uv;
-    let mut faces: Vec<Face> = match raw.normals {
-        Some(given) => raw
-            .faces
-            .into_iter()
-            .zip(given)
-            .map(|(corners, ns)| Face {
-                corners,
-                normals: ns
-                    .into_iter()
-                    .map(|n| (normal_matrix * n).normalize_or_zero())
-                    .collect(),
-                uv: Vec::new(),
-            })
-            .collect(),
-        None => smooth_normals(raw.faces, &areas, positions.len(), spec.crease_angle),
-    };
-    if let Some(uv) = uv {
-        for (face, corners) in faces.iter_mut().zip(uv) {
-            face.uv = corners;
+    let mut faces = raw.faces;
+    if raw.normals_given {
+        for face in &mut faces {
+            for n in &mut face.normals {
+                *n = (normal_matrix * *n).normalize_or_zero();
+            }
         }
+    } else {
+        smooth_normals(&mut faces, &areas, positions.len(), spec.crease_angle);
     }
     for (f, face) in faces.iter().enumerate() {
         if face
@@ -287,47 +307,53 @@ fn placement(t: &Transform) -> DMat4 {
     DMat4::from_scale_rotation_translation(scale, rotation, translation)
 }
 
-/// Normals per corner from the faces around each vertex within the crease angle.
-fn smooth_normals(
-    faces: Vec<Vec<u32>>,
-    newell: &[DVec3],
-    vertices: usize,
-    crease_degrees: f64,
-) -> Vec<Face> {
-    let mut around: Vec<Vec<u32>> = vec![Vec::new(); vertices];
-    for (f, corners) in faces.iter().enumerate() {
-        for &c in corners {
-            if around[c as usize].last() != Some(&(f as u32)) {
-                around[c as usize].push(f as u32);
+/// Normals per corner from the faces around each vertex within the crease angle, into
+/// each face.
+fn smooth_normals(faces: &mut [Face], newell: &[DVec3], vertices: usize, crease_degrees: f64) {
+    // the faces around each vertex in face order, vertex by vertex in one vector
+    // (`start[v]..start[v + 1]`), each face once (`last`: the last face counted at a vertex)
+    let mut last = vec![u32::MAX; vertices];
+    let mut start = vec![0u32; vertices + 1];
+    for (f, face) in faces.iter().enumerate() {
+        for &c in &face.corners {
+            if std::mem::replace(&mut last[c as usize], f as u32) != f as u32 {
+                start[c as usize + 1] += 1;
+            }
+        }
+    }
+    for v in 0..vertices {
+        start[v + 1] += start[v];
+    }
+    last.fill(u32::MAX);
+    let mut filled = start.clone();
+    let mut around = vec![0u32; start[vertices] as usize];
+    for (f, face) in faces.iter().enumerate() {
+        for &c in &face.corners {
+            if std::mem::replace(&mut last[c as usize], f as u32) != f as u32 {
+                around[filled[c as usize] as usize] = f as u32;
+                filled[c as usize] += 1;
             }
         }
     }
     let cos_crease = crease_degrees.to_radians().cos();
     let unit: Vec<DVec3> = newell.iter().map(|n| n.normalize()).collect();
-    faces
-        .into_iter()
-        .enumerate()
-        .map(|(f, corners)| {
-            let normals = corners
-                .iter()
-                .map(|&c| {
-                    let mut sum = DVec3::ZERO;
-                    for &g in &around[c as usize] {
-                        let g = g as usize;
-                        if g == f || unit[g].dot(unit[f]) > cos_crease {
-                            sum += newell[g];
-                        }
+    for (f, face) in faces.iter_mut().enumerate() {
+        face.normals = face
+            .corners
+            .iter()
+            .map(|&c| {
+                let mut sum = DVec3::ZERO;
+                let c = c as usize;
+                for &g in &around[start[c] as usize..start[c + 1] as usize] {
+                    let g = g as usize;
+                    if g == f || unit[g].dot(unit[f]) > cos_crease {
+                        sum += newell[g];
                     }
-                    sum.normalize_or(unit[f])
-                })
-                .collect();
-            Face {
-                corners,
-                normals,
-                uv: Vec::new(),
-            }
-        })
-        .collect()
+                }
+                sum.normalize_or(unit[f])
+            })
+            .collect();
+    }
 }
 
 fn inline(spec: &MeshSpec, k: usize) -> Result<Raw, BuildError> {
@@ -346,7 +372,7 @@ fn inline(spec: &MeshSpec, k: usize) -> Result<Raw, BuildError> {
     }
     let mut out_faces = Vec::with_capacity(faces.len());
     for (f, face) in faces.iter().enumerate() {
-        let mut corners = Vec::with_capacity(face.len());
+        let mut corners = Corners::with_capacity(face.len());
         for (c, &i) in face.iter().enumerate() {
             if i >= vertices.len() as u64 {
                 return Err(BuildError::Scene(SceneError::at_field(
@@ -380,17 +406,7 @@ fn inline(spec: &MeshSpec, k: usize) -> Result<Raw, BuildError> {
                 crate::scene::check_point(&format!("meshes[{k}].normals[{i}]"), *n)
                     .map_err(BuildError::Scene)?;
             }
-            Some(
-                out_faces
-                    .iter()
-                    .map(|corners| {
-                        corners
-                            .iter()
-                            .map(|&c| DVec3::from_array(ns[c as usize]))
-                            .collect()
-                    })
-                    .collect(),
-            )
+            Some(ns)
         }
     };
     let uv = match &spec.uv {
@@ -419,19 +435,28 @@ fn inline(spec: &MeshSpec, k: usize) -> Result<Raw, BuildError> {
                     )));
                 }
             }
-            Some(
-                out_faces
-                    .iter()
-                    .map(|corners| corners.iter().map(|&c| uv[c as usize]).collect())
-                    .collect(),
-            )
+            Some(uv)
         }
     };
+    let faces = out_faces
+        .into_iter()
+        .map(|corners: Corners| Face {
+            normals: normals.map_or_else(PerCorner::new, |ns| {
+                corners
+                    .iter()
+                    .map(|&c| DVec3::from_array(ns[c as usize]))
+                    .collect()
+            }),
+            uv: uv.map_or_else(PerCorner::new, |uv| {
+                corners.iter().map(|&c| uv[c as usize]).collect()
+            }),
+            corners,
+        })
+        .collect();
     Ok(Raw {
         positions: vertices.iter().map(|v| DVec3::from_array(*v)).collect(),
-        faces: out_faces,
-        normals,
-        uv,
+        faces,
+        normals_given: normals.is_some(),
         face_lines: None,
     })
 }
@@ -447,6 +472,11 @@ pub const MAX_SEGMENTS: u32 = 1024;
 /// Bézier patches, each tessellated `tessellate` × `tessellate` into triangles with the
 /// patch's own normals (the limit at degenerate poles); shared patch edges give
 /// bit-identical points, so the mesh has no cracks (`crate::bezier::tessellate`).
+/// The most a Bézier mesh's build holds at once, a triangle (its faces, the grid of the
+/// patch being tessellated, the positions): checked against the memory budget before a
+/// patch is tessellated, and held to a counting allocator by `tests/mesh_memory.rs`.
+pub const BEZIER_BUILD_BYTES_PER_TRIANGLE: u64 = 224;
+
 fn bezier(b: &BezierSource, k: usize) -> Result<Raw, BuildError> {
     let indices: Vec<[usize; 16]> = b
         .patches
@@ -455,15 +485,29 @@ fn bezier(b: &BezierSource, k: usize) -> Result<Raw, BuildError> {
         .collect();
     let patches = patches_from(&b.vertices, &indices)
         .map_err(|e| geometry(format!("meshes[{k}].bezier"), e))?;
+    let triangles: usize = patches.len() * 2 * (b.tessellate as usize).pow(2);
+    let n = b.tessellate;
+    cwisim_scene::budget::Budget::current()
+        .check_memory(
+            &format!(
+                "tessellating the {} patches {n} × {n} ({triangles} triangles)",
+                patches.len()
+            ),
+            triangles as u64 * BEZIER_BUILD_BYTES_PER_TRIANGLE,
+        )
+        .map_err(|e| {
+            BuildError::Scene(SceneError::at_field(
+                SceneErrorKind::Limit,
+                format!("meshes[{k}].bezier.tessellate"),
+                e.to_string(),
+            ))
+        })?;
     let mut raw = Raw {
         positions: Vec::new(),
-        faces: Vec::new(),
-        normals: Some(Vec::new()),
-        uv: Some(Vec::new()),
+        faces: Vec::with_capacity(triangles),
+        normals_given: true,
         face_lines: None,
     };
-    let normals = raw.normals.as_mut().expect("set above");
-    let uv = raw.uv.as_mut().expect("set above");
     for patch in &patches {
         let grid = tessellate(patch, b.tessellate as usize);
         let base = raw.positions.len() as u32;
@@ -478,9 +522,11 @@ fn bezier(b: &BezierSource, k: usize) -> Result<Raw, BuildError> {
             ]
         };
         for t in &grid.triangles {
-            raw.faces.push(t.iter().map(|&i| base + i).collect());
-            normals.push(t.iter().map(|&i| grid.normals[i as usize]).collect());
-            uv.push(t.iter().map(|&i| at(i)).collect());
+            raw.faces.push(Face {
+                corners: t.iter().map(|&i| base + i).collect(),
+                normals: t.iter().map(|&i| grid.normals[i as usize]).collect(),
+                uv: t.iter().map(|&i| at(i)).collect(),
+            });
         }
     }
     Ok(raw)
@@ -563,7 +609,6 @@ pub(crate) fn revolution(r: &Revolution, k: usize) -> Result<Raw, BuildError> {
     let total = *along.last().expect("at least 2 points");
     let uv_at = |i: usize, j: usize| [j as f64 / s as f64, along[i] / total];
     let mut faces = Vec::new();
-    let mut uvs = Vec::new();
     for i in 0..r.profile.len() - 1 {
         let (p, q) = (r.profile[i], r.profile[i + 1]);
         for j in 0..s {
@@ -575,8 +620,8 @@ pub(crate) fn revolution(r: &Revolution, k: usize) -> Result<Raw, BuildError> {
             if corners.first().map(|c| c.0) == corners.last().map(|c| c.0) {
                 corners.pop();
             }
-            let mut face: Vec<u32> = corners.iter().map(|c| c.0).collect();
-            let mut uv: Vec<[f64; 2]> = corners.iter().map(|c| c.1).collect();
+            let mut face: Corners = corners.iter().map(|c| c.0).collect();
+            let mut uv: PerCorner<[f64; 2]> = corners.iter().map(|c| c.1).collect();
             // orient: the outward normal of the profile segment, turned to this segment
             let a = std::f64::consts::TAU * (j as f64 + 0.5) / s as f64;
             let (dr, dh) = (q[0] - p[0], q[1] - p[1]);
@@ -585,15 +630,17 @@ pub(crate) fn revolution(r: &Revolution, k: usize) -> Result<Raw, BuildError> {
                 face.reverse();
                 uv.reverse();
             }
-            faces.push(face);
-            uvs.push(uv);
+            faces.push(Face {
+                corners: face,
+                normals: PerCorner::new(),
+                uv,
+            });
         }
     }
     Ok(Raw {
         positions,
         faces,
-        normals: None,
-        uv: Some(uvs),
+        normals_given: false,
         face_lines: None,
     })
 }

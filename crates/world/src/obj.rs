@@ -8,7 +8,7 @@
 //! `tobj` stops at the first bad line but does not say which; this module counts the
 //! lines it hands to `tobj`, so every error names the file and line.
 
-use crate::mesh::Raw;
+use crate::mesh::{Face, PerCorner, Raw};
 use cwisim_scene::{SceneError, SceneErrorKind};
 use glam::DVec3;
 use std::io::{BufRead, Cursor, Read};
@@ -232,10 +232,8 @@ pub(crate) fn read(path: &Path) -> Result<Raw, SceneError> {
     let text = String::from_utf8_lossy(&bytes);
     let line_of = |keyword: &str, found: &[f64]| line_of_values(&text, keyword, found);
     let mut positions = Vec::new();
-    let mut faces = Vec::new();
-    let mut normals: Vec<Vec<DVec3>> = Vec::new();
+    let mut faces: Vec<Face> = Vec::new();
     let mut all_have_normals = true;
-    let mut uvs: Vec<Vec<[f64; 2]>> = Vec::new();
     let mut all_have_uv = true;
     for model in &models {
         let m = &model.mesh;
@@ -308,26 +306,27 @@ pub(crate) fn read(path: &Path) -> Result<Raw, SceneError> {
         let mut at = 0usize;
         for arity in arities {
             let range = at..at + arity as usize;
-            faces.push(m.indices[range.clone()].iter().map(|i| base + i).collect());
+            let mut face = Face {
+                corners: m.indices[range.clone()].iter().map(|i| base + i).collect(),
+                normals: PerCorner::new(),
+                uv: PerCorner::new(),
+            };
             if has_uv {
-                uvs.push(
-                    m.texcoord_indices[range.clone()]
-                        .iter()
-                        .map(|&t| {
-                            let t = t as usize;
-                            [m.texcoords[2 * t], m.texcoords[2 * t + 1]]
-                        })
-                        .collect(),
-                );
+                face.uv = m.texcoord_indices[range.clone()]
+                    .iter()
+                    .map(|&t| {
+                        let t = t as usize;
+                        [m.texcoords[2 * t], m.texcoords[2 * t + 1]]
+                    })
+                    .collect();
             }
             if has_normals {
-                normals.push(
-                    m.normal_indices[range]
-                        .iter()
-                        .map(|&n| mesh_normals[n as usize])
-                        .collect(),
-                );
+                face.normals = m.normal_indices[range]
+                    .iter()
+                    .map(|&n| mesh_normals[n as usize])
+                    .collect();
             }
+            faces.push(face);
             at += arity as usize;
         }
     }
@@ -343,12 +342,20 @@ pub(crate) fn read(path: &Path) -> Result<Raw, SceneError> {
         .map(|(n, _)| n as u64 + 1)
         .collect();
     let face_lines = (f_lines.len() == faces.len()).then_some(f_lines);
+    // normals and texture coordinates are the mesh's when every face has them
+    for face in &mut faces {
+        if !all_have_normals {
+            face.normals.clear();
+        }
+        if !all_have_uv {
+            face.uv.clear();
+        }
+    }
     Ok(Raw {
         face_lines,
         positions,
+        normals_given: all_have_normals && !faces.is_empty(),
         faces,
-        normals: (all_have_normals && !normals.is_empty()).then_some(normals),
-        uv: (all_have_uv && !uvs.is_empty()).then_some(uvs),
     })
 }
 
@@ -396,8 +403,10 @@ mod tests {
         );
         let raw = read(&p).unwrap();
         assert_eq!(raw.positions.len(), 4);
-        assert_eq!(raw.faces, vec![vec![0, 1, 2, 3], vec![0, 1, 3]]);
-        assert_eq!(raw.normals.unwrap()[1], vec![DVec3::Z; 3]);
+        let faces: Vec<&[u32]> = raw.faces.iter().map(|f| &f.corners[..]).collect();
+        assert_eq!(faces, [&[0, 1, 2, 3][..], &[0, 1, 3]]);
+        assert!(raw.normals_given);
+        assert_eq!(raw.faces[1].normals[..], [DVec3::Z; 3]);
     }
 
     #[test]

@@ -204,8 +204,8 @@ fn every_geometry_source_gives_texture_coordinates() {
     let obj = load(r#""obj": "square.obj""#).unwrap();
     let AnyScene::World(w) = obj else { panic!() };
     assert_eq!(
-        w.meshes[0].faces[0].uv,
-        vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]
+        w.meshes[0].faces[0].uv[..],
+        [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]
     );
     let e = load(r#""obj": "bad.obj""#).unwrap_err().to_string();
     assert!(e.contains("bad.obj:4:"), "{e}");
