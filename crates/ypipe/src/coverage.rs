@@ -45,14 +45,37 @@ impl SliceEdge {
 
     /// `D_E(i) / h`: the fraction of the band's height, integrated over pixel `i`, that
     /// lies right of the edge.
+    ///
+    /// Its `max` and `min` are compares (`maxsd`, `minsd`), not `f64::max`'s NaN-aware
+    /// sequence: nothing here is NaN (a slice's edges are finite), and where the two
+    /// differ, the sign of a zero, it changes no bit of the result (a zero `a` or
+    /// `full_from` is only ever added to or subtracted from a nonzero value, or the term
+    /// is not taken).
+    #[inline]
     fn right_of(&self, i: f64) -> f64 {
+        #[inline(always)]
+        fn larger(a: f64, b: f64) -> f64 {
+            if a > b {
+                a
+            } else {
+                b
+            }
+        }
+        #[inline(always)]
+        fn smaller(a: f64, b: f64) -> f64 {
+            if a < b {
+                a
+            } else {
+                b
+            }
+        }
         let (lo, hi) = (self.lo, self.hi);
-        let (a, b) = (i.max(lo), (i + 1.0).min(hi));
+        let (a, b) = (larger(i, lo), smaller(i + 1.0, hi));
         let mut s = 0.0;
         if b > a {
             s += (b - a) * (a + b - 2.0 * lo) / (2.0 * (hi - lo));
         }
-        let full_from = i.max(hi);
+        let full_from = larger(i, hi);
         if i + 1.0 > full_from {
             s += i + 1.0 - full_from;
         }

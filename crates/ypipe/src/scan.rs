@@ -335,16 +335,17 @@ pub fn scan_slices_of(
         }
         visit(SliceVisit::EndOfRow(row));
         // 4.3: remove the nodes whose trapezium ends in this row; 4.5: update the rest
+        // (in the one pass)
         aet.retain(|e| {
-            let stays = nodes[e.slot].bottom_row() > r;
-            if !stays {
+            let node = &mut nodes[e.slot];
+            if node.bottom_row() > r {
+                node.update_to(r + 1);
+                true
+            } else {
                 free.push(e.slot);
+                false
             }
-            stays
         });
-        for e in &aet {
-            nodes[e.slot].update_to(r + 1);
-        }
     }
 }
 
