@@ -490,3 +490,39 @@ fn a_mesh_whose_visibility_passes_the_budget_is_refused_before_it_is_projected()
     );
     assert!(!dir.join("t.png").exists());
 }
+
+#[test]
+fn renderers_that_project_their_own_triangles_are_refused_before_they_project_them() {
+    let dir = scratch("budget-projection");
+    // the teapot at 64 quads a patch: 261,632 triangles and a mesh of 43.1 MiB; each
+    // renderer's own figure a triangle (woo-chall 1,100 bytes, sbuffer 800, bsp 2,800)
+    for (renderer, needs) in [
+        ("woo-chall", "317.6 MiB"),
+        ("sbuffer", "242.7 MiB"),
+        ("bsp", "741.7 MiB"),
+    ] {
+        let out = cwisim_env(
+            &dir,
+            &[("CWISIM_MAX_MEMORY", "200M")],
+            &[
+                "render",
+                "teapot",
+                "--tessellate",
+                "64",
+                "--threads",
+                "1",
+                "--renderer",
+                renderer,
+                "-o",
+                "t.png",
+            ],
+        );
+        refused(
+            &out,
+            &format!(
+                "projecting the scene's 261632 triangles for {renderer} needs {needs} of memory"
+            ),
+        );
+    }
+    assert!(!dir.join("t.png").exists());
+}

@@ -171,6 +171,28 @@ fn check_visibility_memory(
         .map_err(|e| RenderError::Usage(e.to_string()))
 }
 
+/// Refuses, before a triangle is projected, a scene whose triangles, as a renderer that
+/// projects its own (`woo-chall`, `sbuffer`, `bsp`) holds them, would pass the memory
+/// budget: `bytes_per_triangle` (the renderer's figure, measured on the teapot by
+/// `tests/projection_memory.rs`) for each, beside the built meshes
+/// ([`cwisim_world::mesh::Mesh::held_bytes`]), held all along. Shadows are checked by
+/// their own pass.
+pub(crate) fn check_projection_memory(
+    w: &cwisim_world::WorldScene,
+    bytes_per_triangle: u64,
+    renderer: &str,
+) -> Result<(), RenderError> {
+    let triangles = w.triangle_count() as u64;
+    let meshes: u64 = w.meshes.iter().map(|m| m.held_bytes()).sum();
+    let bytes = meshes.saturating_add(triangles.saturating_mul(bytes_per_triangle));
+    cwisim_scene::budget::Budget::current()
+        .check_memory(
+            &format!("projecting the scene's {triangles} triangles for {renderer}"),
+            bytes,
+        )
+        .map_err(|e| RenderError::Usage(e.to_string()))
+}
+
 /// The lights of world scene `w` that cast shadows under `settings`, refusing a
 /// `--shadows` that would change nothing: `on` in a scene without lights, `off` in one
 /// where no light casts shadows.

@@ -63,7 +63,7 @@ impl SBuffer {
     pub fn new(loaded: LoadedScene, settings: &Settings) -> Result<SBuffer, RenderError> {
         let loaded = loaded.drawn_as(settings)?;
         settings.check().map_err(RenderError::Usage)?;
-        let polys = Polys::new(loaded, settings)?;
+        let polys = Polys::new(loaded, settings, "sbuffer", polys::BYTES_PER_TRIANGLE)?;
         let sampler = Sampler::new(settings.samples, settings.grid, polys.width, polys.height)
             .map_err(RenderError::Usage)?;
         if settings.sbuffer == SbufferMode::Overdraw {

@@ -79,6 +79,12 @@ fn polygon_plane(p: &Polygon, depth: &[f64]) -> Option<[f64; 3]> {
     plane3([a, v[j], v[j + 1]], [depth[0], depth[j], depth[j + 1]])
 }
 
+/// What [`Polys::new`] holds a triangle of a world scene, the meshes aside: the screen
+/// triangles and their polygons (713–743 bytes measured with `sbuffer`'s index on the
+/// teapot and the pot; `tests/projection_memory.rs`), checked against the memory budget
+/// before projecting.
+pub const BYTES_PER_TRIANGLE: u64 = 800;
+
 /// The polygons of a scene, and what making them did.
 pub struct Polys {
     /// Where the scene came from.
@@ -119,7 +125,14 @@ pub struct Polys {
 impl Polys {
     /// The polygons of `loaded`, lit for `settings.shading`, with what the lights that
     /// cast shadows reach of each (`settings.shadows`; their views on `settings.threads`).
-    pub fn new(loaded: LoadedScene, settings: &Settings) -> Result<Polys, RenderError> {
+    /// A world scene is first checked against the memory budget: `renderer` holds
+    /// `bytes_per_triangle` a triangle ([`BYTES_PER_TRIANGLE`] for these polygons alone).
+    pub fn new(
+        loaded: LoadedScene,
+        settings: &Settings,
+        renderer: &str,
+        bytes_per_triangle: u64,
+    ) -> Result<Polys, RenderError> {
         let shading = settings.shading;
         let (mut shadows, mut shadow_time) = (None, Duration::ZERO);
         let start = Instant::now();
@@ -166,6 +179,7 @@ impl Polys {
                 if shading == Shading::Hidden {
                     return Err(hidden());
                 }
+                crate::prepare::check_projection_memory(&w, bytes_per_triangle, renderer)?;
                 let (tris, stats) = cwisim_world::project::project(&w, shading)?;
                 let ch = w.channels();
                 for (k, t) in tris.iter().enumerate() {

@@ -30,6 +30,12 @@ pub struct Shadows {
     pub relit: Vec<Option<ScreenTriangle>>,
 }
 
+/// What [`Triangles::new`] holds a triangle of a world scene, the meshes aside: the
+/// screen triangles, the renderer's own and their index (970–1,030 bytes measured on the
+/// teapot and the pot; `tests/projection_memory.rs`), checked against the memory budget
+/// before projecting.
+pub const BYTES_PER_TRIANGLE: u64 = 1_100;
+
 /// The triangles of a scene, and what making them did.
 pub struct Triangles {
     /// Where the scene came from.
@@ -85,6 +91,7 @@ impl Triangles {
                 (s.width, s.height, s.channels, screen_triangles(&s))
             }
             AnyScene::World(w) => {
+                crate::prepare::check_projection_memory(&w, BYTES_PER_TRIANGLE, "woo-chall")?;
                 let (screen, stats) = cwisim_world::project::project(&w, shading)?;
                 let tris = screen
                     .iter()
