@@ -167,6 +167,12 @@ pub struct EdgeList {
     edges: Vec<ListedEdge>,
 }
 
+// `edge_list` makes the edges in its sort keys' block: the two must stay one size
+const _: () = assert!(
+    std::mem::size_of::<(i64, u32, Side, usize)>() == std::mem::size_of::<ListedEdge>()
+        && std::mem::align_of::<(i64, u32, Side, usize)>() == std::mem::align_of::<ListedEdge>()
+);
+
 /// One edge of an [`EdgeList`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 struct ListedEdge {
@@ -221,10 +227,12 @@ pub fn edge_list(trapezia: &[Trapezium], channels: usize) -> EdgeList {
         })
         .collect();
     keys.sort_unstable();
+    // made in the keys' own block (a key and an edge are both 24 bytes: `collect` from
+    // the vector's `into_iter` reuses it), not beside it
     EdgeList {
         edges: keys
-            .iter()
-            .map(|&(top_row, _, _, edge)| {
+            .into_iter()
+            .map(|(top_row, _, _, edge)| {
                 // `EdgeNode::bottom_row`'s, from the trapezium's bottom
                 let bottom_row = (ceil_i64(trapezia[edge / 2].y_bot) - 1).max(top_row);
                 ListedEdge {
