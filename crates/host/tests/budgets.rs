@@ -526,3 +526,53 @@ fn renderers_that_project_their_own_triangles_are_refused_before_they_project_th
     }
     assert!(!dir.join("t.png").exists());
 }
+
+#[test]
+fn a_bsp_tree_whose_splits_pass_the_budget_is_stopped_as_it_grows() {
+    let dir = scratch("budget-bsp-splits");
+    // 150 triangles across one another at random depths (a fixed sequence): their planes
+    // split them into about 13,000 pieces, far past the figure a triangle checked before
+    // the tree, which a screen scene is not checked with anyway
+    let mut seed = 12345u64;
+    let mut next = || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let polygons: Vec<serde_json::Value> = (0..150)
+        .map(|_| {
+            let vertices: Vec<[f64; 2]> = (0..3).map(|_| [next() * 100.0, next() * 100.0]).collect();
+            let depth: Vec<f64> = (0..3).map(|_| 1.0 + next() * 9.0).collect();
+            serde_json::json!({ "vertices": vertices, "intensity": [[0.5], [0.5], [0.5]], "depth": depth })
+        })
+        .collect();
+    let scene = serde_json::json!({
+        "kind": "screen", "width": 100, "height": 100, "channels": 1, "polygons": polygons
+    });
+    std::fs::write(dir.join("crossing.json"), scene.to_string()).unwrap();
+    let draw = |budget: &str| {
+        cwisim_env(
+            &dir,
+            &[("CWISIM_MAX_MEMORY", budget)],
+            &[
+                "render",
+                "crossing.json",
+                "--renderer",
+                "bsp",
+                "--threads",
+                "1",
+                "-o",
+                "c.png",
+            ],
+        )
+    };
+    refused(
+        &draw("1M"),
+        "bsp's tree of the scene's 150 polygons passes the memory budget of 1.0 MiB: its splits had made 929 pieces",
+    );
+    assert!(!dir.join("c.png").exists());
+    let out = draw("64M");
+    assert!(out.status.success(), "{:?}", text(&out));
+    assert!(dir.join("c.png").exists());
+}

@@ -64,8 +64,14 @@ pub struct Bsp {
 /// polygons, their pieces in the world, the tree and the pieces its planes split off
 /// (1,940–2,540 bytes measured on the teapot and the pot; `tests/projection_memory.rs`),
 /// checked against the memory budget before projecting. A scene whose planes split far
-/// more pieces than these can hold more.
+/// more pieces than these is stopped as its tree grows ([`PIECE_BYTES`]).
 pub const BYTES_PER_TRIANGLE: u64 = 2_800;
+
+/// What each piece of the tree holds, with its polygon for the scan, its rank and its
+/// place in the nodes' lists (740–905 bytes measured on the teapot and the pot;
+/// `tests/projection_memory.rs`): the tree stops, and the scene is refused, once its
+/// splits make more pieces than the memory budget leaves room for beside the polygons.
+pub const PIECE_BYTES: u64 = 1_000;
 
 impl Bsp {
     /// The renderer of `loaded` under `settings`.
@@ -106,7 +112,26 @@ impl Bsp {
             .flat_map(|p| p.world.iter())
             .map(|v| v.abs().max_element())
             .fold(1.0f64, f64::max);
-        let tree = Tree::build(pieces, 1e-9 * scale, channels);
+        // the tree's pieces as its splits make them, against what the budget leaves
+        // beside the polygons
+        let budget = cwisim_scene::budget::Budget::current();
+        let polygons = polys.polys.len() as u64;
+        let held = polygons.saturating_mul(crate::sbuffer::polys::BYTES_PER_TRIANGLE);
+        let max_pieces = budget.memory_bytes.saturating_sub(held) / PIECE_BYTES;
+        let tree = Tree::build_within(
+            pieces,
+            1e-9 * scale,
+            channels,
+            usize::try_from(max_pieces).unwrap_or(usize::MAX),
+        )
+        .map_err(|made| {
+            use cwisim_scene::budget::{human, MEMORY_VAR};
+            RenderError::Usage(format!(
+                "bsp's tree of the scene's {polygons} polygons passes the memory budget of {}: its splits had made {made} pieces ({PIECE_BYTES} bytes each, beside the polygons' {}) when it was stopped (raise it with {MEMORY_VAR}=SIZE, e.g. {MEMORY_VAR}=16G)",
+                human(budget.memory_bytes),
+                human(held),
+            ))
+        })?;
         let order = tree.order(view, settings.bsp_order == BspOrder::FrontToBack);
         let mut rank = vec![0u32; tree.pieces.len()];
         for (r, &k) in order.iter().enumerate() {

@@ -184,6 +184,21 @@ impl Tree {
     /// depth near `log n`, so that it builds in `O(n log n)`, not `O(n²)`. `eps`: the
     /// distance within which a vertex counts as on a plane.
     pub fn build(pieces: Vec<Piece>, eps: f64, channels: usize) -> Tree {
+        match Tree::build_within(pieces, eps, channels, usize::MAX) {
+            Ok(tree) => tree,
+            Err(_) => unreachable!("no more than usize::MAX pieces"),
+        }
+    }
+
+    /// [`Tree::build`], stopped once its splits make more than `max_pieces` pieces:
+    /// `Err` with the pieces made then (`max_pieces + 1`), so that a caller can refuse a
+    /// tree past its memory budget before it grows further.
+    pub fn build_within(
+        pieces: Vec<Piece>,
+        eps: f64,
+        channels: usize,
+        max_pieces: usize,
+    ) -> Result<Tree, usize> {
         let mut tree = Tree {
             pieces,
             nodes: Vec::new(),
@@ -261,6 +276,9 @@ impl Tree {
                         front.push(k);
                         back.push(tree.pieces.len() as u32);
                         tree.pieces.push(b);
+                        if tree.pieces.len() > max_pieces {
+                            return Err(tree.pieces.len());
+                        }
                     }
                 }
             }
@@ -287,7 +305,7 @@ impl Tree {
                 Slot::Back(n) => (Some(*n), false),
             }
         }
-        tree
+        Ok(tree)
     }
 
     fn attach(&mut self, slot: (Option<usize>, bool), node: usize) {
@@ -389,6 +407,12 @@ mod tests {
             world,
             source: 1,
         };
+        // a bound of two pieces stops the split that makes the third
+        assert_eq!(
+            Tree::build_within(vec![tri(4.0, 0), spanning.clone()], 1e-9, 1, 2).err(),
+            Some(3)
+        );
+        assert!(Tree::build_within(vec![tri(4.0, 0), spanning.clone()], 1e-9, 1, 3).is_ok());
         let t = Tree::build(vec![tri(4.0, 0), spanning], 1e-9, 1);
         assert_eq!(t.splits, 1);
         assert_eq!(t.pieces.len(), 3);
