@@ -137,7 +137,7 @@ impl PhongSurfaces {
 /// visibility would hold more than the memory budget: the triangles with their surfaces
 /// (`keep_surfaces`) or without, exact visibility's own figure a triangle
 /// ([`cwisim_world::visibility::exact_memory`]), and the built meshes
-/// ([`cwisim_world::mesh::Mesh::held_bytes`]) while they are held — while the triangles
+/// ([`cwisim_world::WorldScene::mesh_bytes`]) while they are held — while the triangles
 /// are projected, and all along when the surfaces are kept (else they are dropped once
 /// projected).
 fn check_visibility_memory(
@@ -152,7 +152,7 @@ fn check_visibility_memory(
     } else {
         std::mem::size_of::<ScreenTriangle<()>>()
     } as u64;
-    let meshes: u64 = w.meshes.iter().map(|m| m.held_bytes()).sum();
+    let meshes = w.mesh_bytes();
     let projected = triangles.saturating_mul(triangle_bytes);
     let (what, held) = match settings.visibility {
         Visibility::Exact => (
@@ -175,7 +175,7 @@ fn check_visibility_memory(
 /// projects its own (`woo-chall`, `sbuffer`, `bsp`) holds them, would pass the memory
 /// budget: `bytes_per_triangle` (the renderer's figure, measured on the teapot by
 /// `tests/projection_memory.rs`) for each, beside the built meshes
-/// ([`cwisim_world::mesh::Mesh::held_bytes`]), held all along. Shadows are checked by
+/// ([`cwisim_world::WorldScene::mesh_bytes`]), held all along. Shadows are checked by
 /// their own pass.
 pub(crate) fn check_projection_memory(
     w: &cwisim_world::WorldScene,
@@ -183,7 +183,7 @@ pub(crate) fn check_projection_memory(
     renderer: &str,
 ) -> Result<(), RenderError> {
     let triangles = w.triangle_count() as u64;
-    let meshes: u64 = w.meshes.iter().map(|m| m.held_bytes()).sum();
+    let meshes = w.mesh_bytes();
     let bytes = meshes.saturating_add(triangles.saturating_mul(bytes_per_triangle));
     cwisim_scene::budget::Budget::current()
         .check_memory(

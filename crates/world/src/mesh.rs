@@ -485,7 +485,7 @@ fn bezier(b: &BezierSource, k: usize) -> Result<Raw, BuildError> {
         .collect();
     let patches = patches_from(&b.vertices, &indices)
         .map_err(|e| geometry(format!("meshes[{k}].bezier"), e))?;
-    let triangles: usize = patches.len() * 2 * (b.tessellate as usize).pow(2);
+    let triangles = b.triangles();
     let n = b.tessellate;
     cwisim_scene::budget::Budget::current()
         .check_memory(
@@ -493,7 +493,7 @@ fn bezier(b: &BezierSource, k: usize) -> Result<Raw, BuildError> {
                 "tessellating the {} patches {n} × {n} ({triangles} triangles)",
                 patches.len()
             ),
-            triangles as u64 * BEZIER_BUILD_BYTES_PER_TRIANGLE,
+            triangles.saturating_mul(BEZIER_BUILD_BYTES_PER_TRIANGLE),
         )
         .map_err(|e| {
             BuildError::Scene(SceneError::at_field(
@@ -504,7 +504,8 @@ fn bezier(b: &BezierSource, k: usize) -> Result<Raw, BuildError> {
         })?;
     let mut raw = Raw {
         positions: Vec::new(),
-        faces: Vec::with_capacity(triangles),
+        // within MAX_BEZIER_TRIANGLES (validated): it fits a usize
+        faces: Vec::with_capacity(triangles as usize),
         normals_given: true,
         face_lines: None,
     };

@@ -299,12 +299,18 @@ pub struct BezierSource {
 }
 
 /// The finest tessellation of a Bézier patch: 128 × 128 quads (the teapot then has
-/// 1,047,552 triangles: 542 MB to draw with `vanrij` on one thread, PERFORMANCE.md).
+/// 1,047,552 triangles: 509 MB to draw with `vanrij` on one thread, PERFORMANCE.md).
 pub const MAX_TESSELLATION: u32 = 128;
 /// The most triangles a Bézier mesh may tessellate into: 2^22.
 pub const MAX_BEZIER_TRIANGLES: u64 = 1 << 22;
 
 impl BezierSource {
+    /// The triangles its patches tessellate into, two a quad (before degenerate ones are
+    /// dropped): what its limit and the memory budget count.
+    pub fn triangles(&self) -> u64 {
+        self.patches.len() as u64 * 2 * u64::from(self.tessellate) * u64::from(self.tessellate)
+    }
+
     /// Checks counts, indices, coordinates and the tessellation level; every fault names
     /// its JSON path under `field` (`meshes[k].bezier`).
     pub fn validate(&self, field: &str) -> Result<(), SceneError> {
@@ -353,8 +359,7 @@ impl BezierSource {
                 ),
             ));
         }
-        let triangles =
-            self.patches.len() as u64 * 2 * u64::from(self.tessellate) * u64::from(self.tessellate);
+        let triangles = self.triangles();
         if triangles > MAX_BEZIER_TRIANGLES {
             return Err(SceneError::at_field(
                 K::Limit,
@@ -477,6 +482,12 @@ impl WorldScene {
     /// projection makes at most.
     pub fn triangle_count(&self) -> usize {
         self.meshes.iter().map(Mesh::triangle_count).sum()
+    }
+
+    /// The bytes its built meshes hold ([`Mesh::held_bytes`]): what the memory budget
+    /// counts for them while they are held.
+    pub fn mesh_bytes(&self) -> u64 {
+        self.meshes.iter().map(Mesh::held_bytes).sum()
     }
 
     /// The screen scene of `polygons` (what visibility made of this scene), at this

@@ -85,12 +85,12 @@ impl EdgeNode {
 
     /// The first pixel row the node's trapezium touches.
     fn top_row(&self) -> i64 {
-        floor_i64(self.y_top)
+        pixel_rows(self.y_top, self.y_min).0
     }
 
     /// The last pixel row the node's trapezium touches.
     fn bottom_row(&self) -> i64 {
-        (ceil_i64(self.y_min) - 1).max(self.top_row())
+        pixel_rows(self.y_top, self.y_min).1
     }
 
     /// Moves the node to the top of pixel row `row`: the x there is the one kept at the
@@ -173,6 +173,12 @@ const _: () = assert!(
         && std::mem::align_of::<(i64, u32, Side, usize)>() == std::mem::align_of::<ListedEdge>()
 );
 
+/// The first and the last pixel row a trapezium from `y_top` down to `y_bot` touches.
+fn pixel_rows(y_top: f64, y_bot: f64) -> (i64, i64) {
+    let top = floor_i64(y_top);
+    (top, (ceil_i64(y_bot) - 1).max(top))
+}
+
 /// One edge of an [`EdgeList`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 struct ListedEdge {
@@ -219,7 +225,7 @@ pub fn edge_list(trapezia: &[Trapezium], channels: usize) -> EdgeList {
         .iter()
         .enumerate()
         .flat_map(|(k, t)| {
-            let top = floor_i64(t.y_top);
+            let top = pixel_rows(t.y_top, t.y_bot).0;
             [
                 (top, t.id, Side::Left, 2 * k),
                 (top, t.id, Side::Right, 2 * k + 1),
@@ -233,8 +239,8 @@ pub fn edge_list(trapezia: &[Trapezium], channels: usize) -> EdgeList {
         edges: keys
             .into_iter()
             .map(|(top_row, _, _, edge)| {
-                // `EdgeNode::bottom_row`'s, from the trapezium's bottom
-                let bottom_row = (ceil_i64(trapezia[edge / 2].y_bot) - 1).max(top_row);
+                let t = &trapezia[edge / 2];
+                let bottom_row = pixel_rows(t.y_top, t.y_bot).1;
                 ListedEdge {
                     edge,
                     top_row,

@@ -68,7 +68,7 @@ pub struct Bsp {
 pub const BYTES_PER_TRIANGLE: u64 = 2_800;
 
 /// What each piece of the tree holds, with its polygon for the scan, its rank and its
-/// place in the nodes' lists (740–905 bytes measured on the teapot and the pot;
+/// place in the nodes' lists (738–905 bytes measured on the teapot and the pot;
 /// `tests/projection_memory.rs`): the tree stops, and the scene is refused, once its
 /// splits make more pieces than the memory budget leaves room for beside the polygons.
 pub const PIECE_BYTES: u64 = 1_000;
@@ -118,7 +118,7 @@ impl Bsp {
         let polygons = polys.polys.len() as u64;
         let held = polygons.saturating_mul(crate::sbuffer::polys::BYTES_PER_TRIANGLE);
         let max_pieces = budget.memory_bytes.saturating_sub(held) / PIECE_BYTES;
-        let tree = Tree::build_within(
+        let tree = Tree::build(
             pieces,
             1e-9 * scale,
             channels,

@@ -183,17 +183,11 @@ impl Tree {
     /// difference between its two sides (ties: the first) — the balance keeps the tree's
     /// depth near `log n`, so that it builds in `O(n log n)`, not `O(n²)`. `eps`: the
     /// distance within which a vertex counts as on a plane.
-    pub fn build(pieces: Vec<Piece>, eps: f64, channels: usize) -> Tree {
-        match Tree::build_within(pieces, eps, channels, usize::MAX) {
-            Ok(tree) => tree,
-            Err(_) => unreachable!("no more than usize::MAX pieces"),
-        }
-    }
-
-    /// [`Tree::build`], stopped once its splits make more than `max_pieces` pieces:
-    /// `Err` with the pieces made then (`max_pieces + 1`), so that a caller can refuse a
-    /// tree past its memory budget before it grows further.
-    pub fn build_within(
+    ///
+    /// The build stops once its splits make more than `max_pieces` pieces: `Err` with
+    /// the pieces made then (`max_pieces + 1`), so that a caller can refuse a tree past
+    /// its memory budget before it grows further.
+    pub fn build(
         pieces: Vec<Piece>,
         eps: f64,
         channels: usize,
@@ -382,7 +376,13 @@ mod tests {
 
     #[test]
     fn parallel_planes_order_by_the_eye() {
-        let t = Tree::build(vec![tri(5.0, 0), tri(3.0, 1), tri(4.0, 2)], 1e-9, 1);
+        let t = Tree::build(
+            vec![tri(5.0, 0), tri(3.0, 1), tri(4.0, 2)],
+            1e-9,
+            1,
+            usize::MAX,
+        )
+        .unwrap();
         assert_eq!(t.splits, 0);
         let eye = DVec3::ZERO;
         assert_eq!(t.order(View::Eye(eye), true), vec![1, 2, 0]);
@@ -409,11 +409,11 @@ mod tests {
         };
         // a bound of two pieces stops the split that makes the third
         assert_eq!(
-            Tree::build_within(vec![tri(4.0, 0), spanning.clone()], 1e-9, 1, 2).err(),
+            Tree::build(vec![tri(4.0, 0), spanning.clone()], 1e-9, 1, 2).err(),
             Some(3)
         );
-        assert!(Tree::build_within(vec![tri(4.0, 0), spanning.clone()], 1e-9, 1, 3).is_ok());
-        let t = Tree::build(vec![tri(4.0, 0), spanning], 1e-9, 1);
+        assert!(Tree::build(vec![tri(4.0, 0), spanning.clone()], 1e-9, 1, 3).is_ok());
+        let t = Tree::build(vec![tri(4.0, 0), spanning], 1e-9, 1, usize::MAX).unwrap();
         assert_eq!(t.splits, 1);
         assert_eq!(t.pieces.len(), 3);
         let order = t.order(View::Eye(DVec3::ZERO), true);
