@@ -287,7 +287,7 @@ impl Plane {
 
 /// A triangle's `1/depth` as `(gx, gy, c)` (`gx·x + gy·y + c`) and the largest of its
 /// three, or `None` when it cannot be drawn (no area, or not finite).
-fn plane(t: &ScreenTriangle) -> Option<([f64; 3], f64)> {
+fn plane<S>(t: &ScreenTriangle<S>) -> Option<([f64; 3], f64)> {
     let [a, b, c] = t.points;
     let d = t.doubled_area();
     let finite = t.points.iter().flatten().all(|v| v.is_finite())
@@ -303,7 +303,7 @@ fn plane(t: &ScreenTriangle) -> Option<([f64; 3], f64)> {
 }
 
 impl Prepared {
-    fn of(t: &ScreenTriangle) -> Option<Prepared> {
+    fn of<S>(t: &ScreenTriangle<S>) -> Option<Prepared> {
         let (plane, scale) = plane(t)?;
         Some(Prepared::polygon(&t.points, plane, scale))
     }
@@ -408,8 +408,8 @@ struct Scratch {
 /// The visible parts of a strip's pieces `tris` (see the [module docs](self)), in
 /// source order, each with its source's intensity (the first `channels` entries) at its
 /// corners.
-pub fn strip_fragments(
-    tris: &[ScreenTriangle],
+pub fn strip_fragments<S>(
+    tris: &[ScreenTriangle<S>],
     channels: usize,
     stats: &mut SegmentStats,
 ) -> Vec<Fragment> {

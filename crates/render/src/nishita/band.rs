@@ -487,7 +487,8 @@ struct PolyVertex {
     entry: bool,
 }
 
-/// The pieces of one mesh's patches in the band of rows `top .. top + rows`.
+/// The pieces of one mesh's patches in the band of rows `top .. top + rows`, each handed
+/// to `out` as it is made.
 #[allow(clippy::too_many_arguments)]
 pub fn band_pieces(
     view: &View,
@@ -497,7 +498,7 @@ pub fn band_pieces(
     top: u32,
     rows: u32,
     params: &Params,
-    out: &mut Vec<Piece>,
+    out: &mut dyn FnMut(Piece),
     stats: &mut BandStats,
 ) {
     let start = std::time::Instant::now();
@@ -626,7 +627,7 @@ fn emit_part(
     facing: Facing,
     (row, strip): (u32, u32),
     corners: &mut Vec<((f64, f64), Option<DVec3>)>,
-    out: &mut Vec<Piece>,
+    out: &mut dyn FnMut(Piece),
     stats: &mut BandStats,
 ) {
     let tris = triangulate(poly, &mut stats.fans);
@@ -637,7 +638,7 @@ fn emit_part(
         ((u, w), patch.normal(u, w))
     }));
     for t in tris {
-        out.push(Piece {
+        out(Piece {
             screen: t.map(|k| poly[k].screen),
             world: t.map(|k| poly[k].world),
             normals: t.map(|k| corners[k].1),

@@ -90,15 +90,18 @@ const BYTES_PER_PIECE: u64 = 2 * std::mem::size_of::<ScreenTriangle>() as u64
     + std::mem::size_of::<Facing>() as u64
     + std::mem::size_of::<Origin>() as u64;
 
-/// What drawing the patches made, before visibility.
-#[derive(Clone, Debug, Default)]
-pub struct Pieces {
+/// What drawing the patches made, before visibility. `S`: what a triangle keeps of its
+/// surface ([`Surface`], or `()` where nothing reads it: then `facing` and `origin`
+/// are not kept either).
+#[derive(Clone, Debug)]
+pub struct Pieces<S = Surface> {
     /// The pieces as screen triangles (surface points, normals toward the eye, lit
     /// corners), band by band.
-    pub triangles: Vec<ScreenTriangle>,
-    /// For each triangle: how its subpatch faces the eye.
+    pub triangles: Vec<ScreenTriangle<S>>,
+    /// For each triangle: how its subpatch faces the eye (empty where `S` is `()`).
     pub facing: Vec<Facing>,
-    /// For each triangle: its mesh, patch and the patch parameters at its corners.
+    /// For each triangle: its mesh, patch and the patch parameters at its corners (empty
+    /// where `S` is `()`).
     pub origin: Vec<Origin>,
     /// For each triangle: the strip of its band it lies in ([`band::Piece::strip`]).
     pub strip: Vec<u32>,
@@ -108,6 +111,50 @@ pub struct Pieces {
     pub bands: u64,
     /// Patches.
     pub patches: u64,
+}
+
+impl<S> Default for Pieces<S> {
+    fn default() -> Self {
+        Pieces {
+            triangles: Vec::new(),
+            facing: Vec::new(),
+            origin: Vec::new(),
+            strip: Vec::new(),
+            stats: BandStats::default(),
+            bands: 0,
+            patches: 0,
+        }
+    }
+}
+
+/// What the pieces of a band keep of their triangles' surfaces: all of it
+/// ([`Surface`]: Phong and textures read it, per pixel) or nothing (`()`: 192 bytes a
+/// triangle fewer, and no record of each piece's origin).
+pub trait KeptSurface: Copy + Send + Sync + 'static {
+    /// Whether it is the whole surface.
+    const WHOLE: bool;
+    /// What it keeps of `surface`.
+    fn of(surface: Surface) -> Self;
+    /// The triangle with its whole surface, where it kept it.
+    fn whole(t: &ScreenTriangle<Self>) -> Option<ScreenTriangle>;
+}
+
+impl KeptSurface for Surface {
+    const WHOLE: bool = true;
+    fn of(surface: Surface) -> Self {
+        surface
+    }
+    fn whole(t: &ScreenTriangle<Self>) -> Option<ScreenTriangle> {
+        Some(*t)
+    }
+}
+
+impl KeptSurface for () {
+    const WHOLE: bool = false;
+    fn of(_: Surface) -> Self {}
+    fn whole(_: &ScreenTriangle<Self>) -> Option<ScreenTriangle> {
+        None
+    }
 }
 
 /// What drawing the patches of a world scene needs, prepared once: the view, the
@@ -239,12 +286,49 @@ impl<'w> PatchScene<'w> {
     }
 
     /// The pieces of every Bézier mesh in the band of rows `top .. top + rows`, mesh by
-    /// mesh, appended to `out` (its `stats` counting what the band did).
-    pub fn band(&self, top: u32, rows: u32, out: &mut Pieces) -> Result<(), RenderError> {
-        let mut raw = Vec::new();
+    /// mesh, appended to `out` (its `stats` counting what the band did): each made into
+    /// its triangle as it is made, keeping of its surface what `S` keeps.
+    pub fn band<S: KeptSurface>(
+        &self,
+        top: u32,
+        rows: u32,
+        out: &mut Pieces<S>,
+    ) -> Result<(), RenderError> {
         for ((k, patches), known) in self.meshes.iter().zip(&self.facings) {
             let m = &self.w.spec.meshes[*k];
-            raw.clear();
+            // the first piece lit to a value that is not finite, in the order they come
+            let mut unlit: Option<SceneError> = None;
+            let (triangles, facing, origin, strip) = (
+                &mut out.triangles,
+                &mut out.facing,
+                &mut out.origin,
+                &mut out.strip,
+            );
+            let mut take = |p: band::Piece| {
+                if unlit.is_some() {
+                    return;
+                }
+                let Some(t) = triangle(&p, *k as u32, m, &self.camera, &self.lighting) else {
+                    return;
+                };
+                for i in &t.intensity {
+                    if let Err(e) = cwisim_world::lighting::check_lit(i, self.w.channels(), || {
+                        (
+                            format!("meshes[{k}].bezier.patches[{}]", p.patch),
+                            "a piece of the patch".to_string(),
+                        )
+                    }) {
+                        unlit = Some(e);
+                        return;
+                    }
+                }
+                triangles.push(kept(t));
+                if S::WHOLE {
+                    facing.push(p.facing);
+                    origin.push((*k as u32, p.patch, p.uv));
+                }
+                strip.push(p.strip);
+            };
             band_pieces(
                 &self.view,
                 patches,
@@ -253,28 +337,11 @@ impl<'w> PatchScene<'w> {
                 top,
                 rows,
                 &self.params,
-                &mut raw,
+                &mut take,
                 &mut out.stats,
             );
-            out.triangles.reserve(raw.len());
-            out.facing.reserve(raw.len());
-            out.origin.reserve(raw.len());
-            out.strip.reserve(raw.len());
-            for p in &raw {
-                if let Some(t) = triangle(p, *k as u32, m, &self.camera, &self.lighting) {
-                    for i in &t.intensity {
-                        cwisim_world::lighting::check_lit(i, self.w.channels(), || {
-                            (
-                                format!("meshes[{k}].bezier.patches[{}]", p.patch),
-                                "a piece of the patch".to_string(),
-                            )
-                        })?;
-                    }
-                    out.triangles.push(t);
-                    out.facing.push(p.facing);
-                    out.origin.push((*k as u32, p.patch, p.uv));
-                    out.strip.push(p.strip);
-                }
+            if let Some(e) = unlit {
+                return Err(e.into());
             }
         }
         out.bands += 1;
@@ -321,6 +388,18 @@ fn check_budget(
             pieces as u64 * BYTES_PER_PIECE,
         )
         .map_err(|e| RenderError::Usage(e.to_string()))
+}
+
+/// `t` keeping of its surface what `S` keeps.
+fn kept<S: KeptSurface>(t: ScreenTriangle) -> ScreenTriangle<S> {
+    ScreenTriangle {
+        points: t.points,
+        inv_depth: t.inv_depth,
+        intensity: t.intensity,
+        mesh: t.mesh,
+        face: t.face,
+        surface: S::of(t.surface),
+    }
 }
 
 /// A piece as a screen triangle: normals turned toward the eye (two-sided meshes), or

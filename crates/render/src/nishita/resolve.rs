@@ -15,11 +15,11 @@
 //! ([`super::merged::Fragments`]), until the rows are emitted.
 
 use super::merged::Fragments;
-use super::{check_budget, PatchScene, Pieces};
+use super::{check_budget, KeptSurface, PatchScene, Pieces};
 use crate::error::RenderError;
 use crate::settings::Settings;
 use cwisim_scene::PackedPolygons;
-use cwisim_world::face::ScreenTriangle;
+use cwisim_world::face::{ScreenTriangle, Surface};
 use cwisim_world::sweep::{strip_fragments, SegmentStats};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Condvar, Mutex};
@@ -70,16 +70,17 @@ pub struct Resolved {
 
 /// One band made and resolved. `made` counts the pieces of every band made so far (on
 /// any thread): the frame's fragments grow with them, so the memory budget is checked
-/// against that count, as when the frame's pieces were all held at once.
-fn one_band(
+/// against that count, as when the frame's pieces were all held at once. `S`: what the
+/// band's triangles keep of their surfaces (the whole of it, [`Surface`], to keep the
+/// visible ones for Phong).
+fn one_band<S: KeptSurface>(
     scene: &PatchScene,
     top: u32,
     rows: u32,
     settings: &Settings,
-    keep: bool,
     made: &AtomicUsize,
 ) -> Result<Band, RenderError> {
-    let mut pieces = Pieces::default();
+    let mut pieces = Pieces::<S>::default();
     scene.band(top, rows, &mut pieces)?;
     let budget = cwisim_scene::budget::Budget::current();
     let n = pieces.triangles.len();
@@ -87,14 +88,15 @@ fn one_band(
     check_budget(&budget, so_far, top + rows, settings)?;
     let start = Instant::now();
     // strip by strip, each strip's pieces in the order they were made (a stable sort of
-    // their indices: the pieces are large, and moved once)
+    // their indices, then the triangles moved where it puts them, in place)
     let strip_of = std::mem::take(&mut pieces.strip);
     let mut order: Vec<u32> = (0..strip_of.len() as u32).collect();
     order.sort_by_key(|&i| strip_of[i as usize]);
-    let made = std::mem::take(&mut pieces.triangles);
     let strips: Vec<u32> = order.iter().map(|&i| strip_of[i as usize]).collect();
-    let triangles: Vec<ScreenTriangle> = order.iter().map(|&i| made[i as usize]).collect();
-    drop(made);
+    drop(strip_of);
+    let mut triangles = std::mem::take(&mut pieces.triangles);
+    permute(&mut triangles, &order);
+    drop(order);
     let mut band = Band {
         polygons: PackedPolygons::new(scene.channels()),
         count: triangles.len(),
@@ -109,7 +111,7 @@ fn one_band(
             band.groups
                 .push(u64::from(t.mesh) << 32 | u64::from(t.face));
             band.rows.push(top + strips[a] / settings.subscan);
-            if keep {
+            if S::WHOLE {
                 band.sources.push(a + f.source);
             }
             band.polygons.push(&f.polygon).map_err(packing)?;
@@ -117,22 +119,50 @@ fn one_band(
         a = b;
     }
     band.time = start.elapsed();
-    if keep {
+    if S::WHOLE {
         // only the triangles some fragment is part of (the others are wholly hidden:
         // more than half of them on the teapot), the sources renumbered in order
         let mut index = vec![usize::MAX; triangles.len()];
         for s in &mut band.sources {
             if index[*s] == usize::MAX {
                 index[*s] = band.triangles.len();
-                band.triangles.push(triangles[*s]);
+                band.triangles.extend(S::whole(&triangles[*s]));
             }
             *s = index[*s];
         }
     }
-    pieces.facing = Vec::new();
-    pieces.origin = Vec::new();
-    band.pieces = pieces;
+    band.pieces = Pieces {
+        stats: pieces.stats,
+        bands: pieces.bands,
+        patches: pieces.patches,
+        ..Pieces::default()
+    };
     Ok(band)
+}
+
+/// `v` rearranged so that its `i`-th element is the one that was at `order[i]`
+/// (`order` a permutation of `0..v.len()`), in place: each cycle of the permutation
+/// followed once, with one element set aside.
+fn permute<T: Copy>(v: &mut [T], order: &[u32]) {
+    debug_assert_eq!(v.len(), order.len());
+    let mut done = vec![false; v.len()];
+    for start in 0..v.len() {
+        if done[start] {
+            continue;
+        }
+        let first = v[start];
+        let mut j = start;
+        loop {
+            done[j] = true;
+            let k = order[j] as usize;
+            if k == start {
+                v[j] = first;
+                break;
+            }
+            v[j] = v[k];
+            j = k;
+        }
+    }
 }
 
 /// Every band of `scene` made and resolved, on `settings.threads` threads (0: one per
@@ -146,6 +176,14 @@ pub fn resolve(
     let threads =
         cwisim_scene::budget::resolve_threads(settings.threads).clamp(1, bands.len().max(1));
     let made = AtomicUsize::new(0);
+    // the whole surfaces kept only where Phong reads the visible ones
+    let one_band = |top: u32, rows: u32| {
+        if keep {
+            one_band::<Surface>(scene, top, rows, settings, &made)
+        } else {
+            one_band::<()>(scene, top, rows, settings, &made)
+        }
+    };
     let mut out = Resolved {
         fragments: Fragments::default(),
         sources: Vec::new(),
@@ -162,7 +200,7 @@ pub fn resolve(
         // each band joined as soon as it is resolved: one band's fragments are held
         // twice at a time, not the frame's
         for &(top, rows) in &bands {
-            join(&mut out, one_band(scene, top, rows, settings, keep, &made)?);
+            join(&mut out, one_band(top, rows)?);
         }
         shrink(&mut out);
         return Ok(out);
@@ -193,7 +231,7 @@ pub fn resolve(
                     let Some(&(top, rows)) = bands.get(b) else {
                         break;
                     };
-                    let r = one_band(scene, top, rows, settings, keep, &made);
+                    let r = one_band(top, rows);
                     if r.is_err() {
                         // later bands are not needed: the first error in band order wins
                         failed.store(true, Ordering::Relaxed);
@@ -290,4 +328,25 @@ fn shrink(out: &mut Resolved) {
     out.fragments.shrink_to_fit();
     out.sources.shrink_to_fit();
     out.triangles.shrink_to_fit();
+}
+
+#[cfg(test)]
+mod tests {
+    use super::permute;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// In place, it gives what gathering by the order into a new vector gives.
+        #[test]
+        fn permuting_in_place_is_gathering(keys in proptest::collection::vec(0u32..6, 0..200)) {
+            // the order a stable sort of the keys gives, as `one_band` makes it
+            let mut order: Vec<u32> = (0..keys.len() as u32).collect();
+            order.sort_by_key(|&i| keys[i as usize]);
+            let values: Vec<(u32, usize)> = keys.iter().copied().zip(0..).collect();
+            let gathered: Vec<(u32, usize)> = order.iter().map(|&i| values[i as usize]).collect();
+            let mut permuted = values.clone();
+            permute(&mut permuted, &order);
+            prop_assert_eq!(permuted, gathered);
+        }
+    }
 }

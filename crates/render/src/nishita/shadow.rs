@@ -312,11 +312,9 @@ fn light_scan(
 ) -> Result<(Vec<ScreenTriangle>, Vec<Fragment>), RenderError> {
     let light = scene.seen_from(view, side);
     let mut tris: Vec<ScreenTriangle> = Vec::new();
-    let mut raw = Vec::new();
     let budget = cwisim_scene::budget::Budget::current();
     for (top, rows) in light.bands(settings.band) {
         for ((mesh, patches), known) in light.meshes.iter().zip(&light.facings) {
-            raw.clear();
             band_pieces(
                 &light.view,
                 patches,
@@ -325,10 +323,9 @@ fn light_scan(
                 top,
                 rows,
                 &light.params,
-                &mut raw,
+                &mut |p| tris.push(light_piece(&p, *mesh as u32, &view)),
                 &mut stats.bands,
             );
-            tris.extend(raw.iter().map(|p| light_piece(p, *mesh as u32, &view)));
         }
         budget
             .check_memory(
