@@ -41,6 +41,7 @@ use crate::dofill::{
 use cwisim_isa::{Instruction, TraceHeader, TraceWrite, MAX_CHANNELS};
 use cwisim_scene::ScreenScene;
 use std::io;
+use trapezoid::Vector;
 
 pub use cwisim_scene::{Antialias, Shading};
 
@@ -163,34 +164,136 @@ pub fn flat_mean<V: AsRef<[f64]>>(intensity: &[V], channels: usize) -> [f64; MAX
 #[derive(Clone, Debug)]
 pub struct ScanPlan<'s> {
     scene: &'s ScreenScene,
-    trapezia: Vec<trapezoid::Trapezium>,
-    /// The trapezia's edge list, sorted (built once, shared by every band).
-    edges: scan::EdgeList,
-    shades: Vec<Shade>,
+    trapezia: PlannedTrapezia,
+    /// Each polygon's one intensity, when the scene is shaded flat (Gouraud needs none).
+    flat: Option<Vec<Vector>>,
+}
+
+/// A scene with more polygons than this has its trapezia made band by band
+/// ([`ScanPlan::by_bands`]), not for the frame at once: 184 bytes a trapezium and 48
+/// for its two edges in the list, which at 262,144 triangles of a mesh (122,934 visible
+/// fragments, 247,613 trapezia) were 60 MB, the command's peak.
+pub const BANDED_FROM_POLYGONS: usize = 1 << 16;
+
+/// Where a plan's trapezia are.
+#[derive(Clone, Debug)]
+enum PlannedTrapezia {
+    /// The frame's, made once, and their edge list, sorted (shared by every band).
+    Whole {
+        trapezia: Vec<trapezoid::Trapezium>,
+        edges: scan::EdgeList,
+    },
+    /// Made band by band, from the polygons that reach the band.
+    Banded(PolygonRows),
+}
+
+/// What making a band's trapezia needs: each polygon's first Identifier (the trapezia
+/// are numbered in polygon order over the frame, as [`scene_trapezia`] numbers them) and
+/// the pixel rows its trapezia touch, the polygons in order of their first row.
+#[derive(Clone, Debug)]
+struct PolygonRows {
+    /// `first_id[k]`: the Identifier of polygon `k`'s first trapezium (of the next
+    /// polygon's, where it has none).
+    first_id: Vec<u32>,
+    /// `(first row, last row, polygon)` of each polygon with a trapezium, sorted (rows
+    /// of the image: the trapezia are clipped to it).
+    by_top: Vec<(u32, u32, u32)>,
+    /// The frame's trapezia.
+    total: u64,
+}
+
+impl PolygonRows {
+    fn new(scene: &ScreenScene) -> PolygonRows {
+        let (w, h) = (f64::from(scene.width), f64::from(scene.height));
+        let channels = usize::from(scene.channels);
+        let mut first_id = Vec::with_capacity(scene.polygons.len());
+        let mut by_top = Vec::with_capacity(scene.polygons.len());
+        let mut next = 1u32;
+        for (k, p) in scene.polygons.iter().enumerate() {
+            first_id.push(next);
+            let clipped = clip::clip_to_rect_cow(p, 0.0, 0.0, w, h);
+            if clipped.vertices.len() < 3 {
+                continue;
+            }
+            let made = trapezoid::trapezia(&clipped, k as u32, channels, next);
+            if let Some(rows) = made
+                .iter()
+                .map(|t| scan::pixel_rows(t.y_top, t.y_bot))
+                .reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)))
+            {
+                // rows of the image (a clipped trapezium's), so the clamp changes none
+                let row = |r: i64| u32::try_from(r.max(0)).unwrap_or(u32::MAX);
+                by_top.push((row(rows.0), row(rows.1), k as u32));
+            }
+            next += made.len() as u32;
+        }
+        by_top.sort_unstable();
+        PolygonRows {
+            first_id,
+            by_top,
+            total: u64::from(next - 1),
+        }
+    }
+
+    /// The trapezia that touch pixel rows `rows`, numbered as over the frame, in the
+    /// frame's order.
+    fn band(&self, scene: &ScreenScene, rows: &std::ops::Range<u32>) -> Vec<trapezoid::Trapezium> {
+        let (start, end) = (rows.start, rows.end);
+        let reach = self.by_top.partition_point(|&(top, _, _)| top < end);
+        let mut polygons: Vec<u32> = self.by_top[..reach]
+            .iter()
+            .filter(|&&(_, bottom, _)| bottom >= start)
+            .map(|&(_, _, k)| k)
+            .collect();
+        polygons.sort_unstable();
+        let (w, h) = (f64::from(scene.width), f64::from(scene.height));
+        let channels = usize::from(scene.channels);
+        let mut out = Vec::new();
+        for k in polygons {
+            let clipped = clip::clip_to_rect_cow(&scene.polygons[k as usize], 0.0, 0.0, w, h);
+            out.extend(
+                trapezoid::trapezia(&clipped, k, channels, self.first_id[k as usize])
+                    .into_iter()
+                    .filter(|t| {
+                        let (top, bottom) = scan::pixel_rows(t.y_top, t.y_bot);
+                        top < i64::from(end) && bottom >= i64::from(start)
+                    }),
+            );
+        }
+        out
+    }
 }
 
 impl<'s> ScanPlan<'s> {
-    /// The plan of `scene` under `options`.
+    /// The plan of `scene` under `options`: its trapezia made for the frame at once, or,
+    /// past [`BANDED_FROM_POLYGONS`] polygons, band by band ([`ScanPlan::by_bands`]).
+    /// Either way the same stream.
     pub fn new(scene: &'s ScreenScene, options: &Options) -> ScanPlan<'s> {
+        if scene.polygons.len() > BANDED_FROM_POLYGONS {
+            return ScanPlan::by_bands(scene, options);
+        }
         let channels = usize::from(scene.channels);
         let trapezia = scene_trapezia(scene);
         ScanPlan {
             scene,
-            edges: scan::edge_list(&trapezia, channels),
-            trapezia,
-            shades: scene
-                .polygons
-                .iter()
-                .map(|p| match options.shading {
-                    Shading::Flat => Shade::Flat(flat_intensity(p, channels)),
-                    // Phong needs 3D normals per pixel, which screen polygons do not
-                    // carry: `cwisim-render` draws it with its own emitter; here it is
-                    // drawn as Gouraud, from the vertex intensities
-                    // hidden-line drawing is refused before a scene gets here (renderers that
-                    // resolve visibility per sample draw it)
-                    Shading::Gouraud | Shading::Phong | Shading::Hidden => Shade::Gouraud,
-                })
-                .collect(),
+            trapezia: PlannedTrapezia::Whole {
+                edges: scan::edge_list(&trapezia, channels),
+                trapezia,
+            },
+            flat: flat_intensities(scene, options),
+        }
+    }
+
+    /// The plan of `scene` under `options` whose trapezia are made band by band, each
+    /// band's from the polygons that reach it, when [`emit_rows`] emits it: memory
+    /// bounded by the bands being emitted, not by the frame, for what a polygon reaching
+    /// several bands costs (it is cut into trapezia in each). The same stream as
+    /// [`ScanPlan::new`]'s for the frame's trapezia at once, bit for bit.
+    pub fn by_bands(scene: &'s ScreenScene, options: &Options) -> ScanPlan<'s> {
+        ScanPlan {
+            scene,
+            trapezia: PlannedTrapezia::Banded(PolygonRows::new(scene)),
+            flat: flat_intensities(scene, options),
         }
     }
 
@@ -199,8 +302,40 @@ impl<'s> ScanPlan<'s> {
     pub fn scene_stats(&self) -> EmitStats {
         EmitStats {
             polygons: self.scene.polygons.len() as u64,
-            trapezia: self.trapezia.len() as u64,
+            trapezia: match &self.trapezia {
+                PlannedTrapezia::Whole { trapezia, .. } => trapezia.len() as u64,
+                PlannedTrapezia::Banded(rows) => rows.total,
+            },
             ..EmitStats::default()
+        }
+    }
+}
+
+/// Each polygon's one intensity, when `options` shade flat.
+fn flat_intensities(scene: &ScreenScene, options: &Options) -> Option<Vec<Vector>> {
+    let channels = usize::from(scene.channels);
+    match options.shading {
+        Shading::Flat => Some(
+            scene
+                .polygons
+                .iter()
+                .map(|p| flat_intensity(p, channels))
+                .collect(),
+        ),
+        // Phong needs 3D normals per pixel, which screen polygons do not carry:
+        // `cwisim-render` draws it with its own emitter; here it is drawn as Gouraud,
+        // from the vertex intensities (hidden-line drawing is refused before a scene
+        // gets here: renderers that resolve visibility per sample draw it)
+        Shading::Gouraud | Shading::Phong | Shading::Hidden => None,
+    }
+}
+
+impl ScanPlan<'_> {
+    /// How polygon `k` is shaded.
+    fn shade(&self, k: u32) -> Shade {
+        match &self.flat {
+            Some(flat) => Shade::Flat(flat[k as usize]),
+            None => Shade::Gouraud,
         }
     }
 }
@@ -279,19 +414,28 @@ pub fn emit_rows(
 ) -> io::Result<EmitStats> {
     let scene = plan.scene;
     let channels = usize::from(scene.channels);
-    let (trapezia, shades) = (&plan.trapezia, &plan.shades);
+    // the band's own trapezia and edge list, where the plan makes them band by band
+    let band;
+    let (trapezia, edges) = match &plan.trapezia {
+        PlannedTrapezia::Whole { trapezia, edges } => (trapezia, edges),
+        PlannedTrapezia::Banded(polygons) => {
+            let trapezia = polygons.band(scene, &rows);
+            band = (scan::edge_list(&trapezia, channels), trapezia);
+            (&band.1, &band.0)
+        }
+    };
     let mut stats = EmitStats::default();
     let mut result = Ok(());
     let notes = sink.wants_comments();
     let mut fill = RowFill::default();
-    scan::scan_slices_of(trapezia, &plan.edges, rows, |visit| {
+    scan::scan_slices_of(trapezia, edges, rows, |visit| {
         if result.is_err() {
             return;
         }
         match visit {
             scan::SliceVisit::Fill(slice, t) => {
                 let row = slice.row;
-                let shade = &shades[t.polygon as usize];
+                let shade = &plan.shade(t.polygon);
                 let (w, claim) = (scene.width, options.claim);
                 let value = match options.aa {
                     Antialias::Box => Some(BoxValue::Exact),

@@ -174,7 +174,7 @@ const _: () = assert!(
 );
 
 /// The first and the last pixel row a trapezium from `y_top` down to `y_bot` touches.
-fn pixel_rows(y_top: f64, y_bot: f64) -> (i64, i64) {
+pub(crate) fn pixel_rows(y_top: f64, y_bot: f64) -> (i64, i64) {
     let top = floor_i64(y_top);
     (top, (ceil_i64(y_bot) - 1).max(top))
 }

@@ -63,16 +63,18 @@ proptest! {
         cuts.push(24);
         cuts.sort_unstable();
         cuts.dedup();
-        let plan = ScanPlan::new(&scene, &options);
-        let (banded, banded_stats) = text_of(&scene, |w| {
-            let mut stats = plan.scene_stats();
-            for band in cuts.windows(2) {
-                stats.add_band(&emit_rows(&plan, &options, band[0]..band[1], w).expect("emit"));
-            }
-            stats
-        });
-        prop_assert_eq!(whole, banded);
-        prop_assert_eq!(whole_stats, banded_stats);
+        // the frame's trapezia made at once, then band by band: the same stream
+        for plan in [ScanPlan::new(&scene, &options), ScanPlan::by_bands(&scene, &options)] {
+            let (banded, banded_stats) = text_of(&scene, |w| {
+                let mut stats = plan.scene_stats();
+                for band in cuts.windows(2) {
+                    stats.add_band(&emit_rows(&plan, &options, band[0]..band[1], w).expect("emit"));
+                }
+                stats
+            });
+            prop_assert_eq!(&whole, &banded);
+            prop_assert_eq!(&whole_stats, &banded_stats);
+        }
     }
 }
 
