@@ -173,7 +173,7 @@ fn screen_scene() -> impl Strategy<Value = ScreenScene> {
                     }
                     let intensity = (0..3)
                         .map(|_| (0..ch).map(|_| *next.next().expect("cycles")).collect())
-                        .collect();
+                        .collect::<Vec<Vec<f64>>>();
                     Polygon::new(v.to_vec(), intensity)
                 })
                 .collect();

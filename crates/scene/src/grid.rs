@@ -47,7 +47,9 @@ pub fn warped_grid(n: u32, size: u32) -> ScreenScene {
             for tri in [[0, 1, 2], [0, 2, 3]] {
                 polygons.push(Polygon::new(
                     tri.iter().map(|&c| corners[c].0).collect(),
-                    tri.iter().map(|&c| vec![corners[c].1]).collect(),
+                    tri.iter()
+                        .map(|&c| crate::VertexIntensity::from_slice(&[corners[c].1]))
+                        .collect::<Vec<_>>(),
                 ));
             }
         }

@@ -52,6 +52,7 @@ pub use error::{describe_json, json_error, locate_error, read_kind, SceneError, 
 pub use packed::PackedPolygons;
 pub use screen::{
     check_intensity, load_scene, parse_scene, read_scene_text, Polygon, Scene, ScreenScene,
+    VertexIntensity,
 };
 pub use settings::{Antialias, Shading};
 

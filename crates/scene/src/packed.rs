@@ -8,7 +8,7 @@
 //! fragments until it emits their rows (nishita: 100,680 fragments on the teapot) keeps
 //! them packed and unpacks a few rows' worth at a time.
 
-use crate::Polygon;
+use crate::{Polygon, VertexIntensity};
 use std::ops::Range;
 
 /// Polygons of `channels` intensity values per vertex, packed: [`get`](Self::get) gives
@@ -128,12 +128,12 @@ impl PackedPolygons {
             let (a, b) = span(&self.ends, k);
             let (da, db) = span(&self.depth_ends, k);
             if slot == out.len() {
-                out.push(Polygon::new(Vec::new(), Vec::new()));
+                out.push(Polygon::new(Vec::new(), Vec::<VertexIntensity>::new()));
             }
             let p = &mut out[slot];
             p.vertices.clear();
             p.vertices.extend_from_slice(&self.vertices[a..b]);
-            p.intensity.resize_with(b - a, Vec::new);
+            p.intensity.resize_with(b - a, VertexIntensity::new);
             for (i, v) in p.intensity.iter_mut().zip(a..b) {
                 i.clear();
                 i.extend_from_slice(&self.intensity[v * self.channels..(v + 1) * self.channels]);
@@ -199,7 +199,7 @@ mod tests {
             )
                 .prop_map(move |(vertices, intensity, depth)| Polygon {
                     vertices,
-                    intensity,
+                    intensity: intensity.into_iter().map(Into::into).collect(),
                     depth: with_depth.then_some(depth),
                 })
         })

@@ -5,7 +5,12 @@ use crate::error::{describe, json_kind, locate_error, read_kind, SceneError, Sce
 use crate::predicates::simplicity_fault;
 use crate::{MAX_CHANNELS, MAX_COORDINATE, MAX_INTENSITY, MAX_SIDE, MAX_VALUES, SCENE_KINDS};
 use serde::{Deserialize, Serialize};
+use smallvec::SmallVec;
 use std::path::Path;
+
+/// One vertex's intensity: `channels` values, held in place (up to [`MAX_CHANNELS`], every
+/// scene's channels), not in a heap block of their own.
+pub type VertexIntensity = SmallVec<[f64; cwisim_isa::MAX_CHANNELS]>;
 
 /// A polygon with an intensity vector per vertex.
 ///
@@ -16,7 +21,7 @@ pub struct Polygon {
     /// The vertices `[x, y]`, in either orientation.
     pub vertices: Vec<[f64; 2]>,
     /// `intensity[vertex][channel]`: one vector per vertex.
-    pub intensity: Vec<Vec<f64>>,
+    pub intensity: Vec<VertexIntensity>,
     /// One depth per vertex, when the scene carries depth: smaller is nearer, and depth
     /// is affine in screen space over the polygon (a plane), so that renderers that
     /// resolve visibility can compare polygons at any point. Renderers that do not
@@ -26,11 +31,12 @@ pub struct Polygon {
 }
 
 impl Polygon {
-    /// A polygon with one intensity vector per vertex.
-    pub fn new(vertices: Vec<[f64; 2]>, intensity: Vec<Vec<f64>>) -> Self {
+    /// A polygon with one intensity vector per vertex (each a [`VertexIntensity`], or
+    /// anything that becomes one: a `Vec<f64>`, a slice).
+    pub fn new<I: Into<VertexIntensity>>(vertices: Vec<[f64; 2]>, intensity: Vec<I>) -> Self {
         Polygon {
             vertices,
-            intensity,
+            intensity: intensity.into_iter().map(Into::into).collect(),
             depth: None,
         }
     }
@@ -40,7 +46,7 @@ impl Polygon {
         let n = vertices.len();
         Polygon {
             vertices,
-            intensity: vec![intensity.to_vec(); n],
+            intensity: vec![VertexIntensity::from_slice(intensity); n],
             depth: None,
         }
     }

@@ -993,9 +993,9 @@ pub fn shadowed_by(
                     let v = shaded
                         .intensity_at(p, channels)
                         .expect("a visible triangle has nonzero area");
-                    v[..channels].to_vec()
+                    cwisim_scene::VertexIntensity::from_slice(&v[..channels])
                 })
-                .collect();
+                .collect::<Vec<_>>();
             out.fragments.push(Fragment {
                 source: k,
                 polygon: Polygon::new(contour, intensity),

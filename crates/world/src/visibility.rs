@@ -190,9 +190,9 @@ impl Fragment {
                 let v = tri
                     .intensity_at(p, channels)
                     .expect("a visible part's triangle has area");
-                v[..channels].to_vec()
+                cwisim_scene::VertexIntensity::from_slice(&v[..channels])
             })
-            .collect();
+            .collect::<Vec<_>>();
         Fragment {
             source,
             polygon: Polygon::new(vertices, intensity),
@@ -607,7 +607,10 @@ pub fn front_to_back_fragments<S>(tris: &[ScreenTriangle<S>], channels: usize) -
                 source: k,
                 polygon: Polygon::new(
                     t.points.to_vec(),
-                    t.intensity.iter().map(|i| i[..channels].to_vec()).collect(),
+                    t.intensity
+                        .iter()
+                        .map(|i| cwisim_scene::VertexIntensity::from_slice(&i[..channels]))
+                        .collect::<Vec<_>>(),
                 ),
             }
         })

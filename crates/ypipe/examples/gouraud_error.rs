@@ -29,7 +29,7 @@ fn scene(width: u32, height: u32, polygons: Vec<Polygon>) -> ScreenScene {
 fn tri(v: [[f64; 2]; 3], i: [f64; 3]) -> Polygon {
     Polygon {
         vertices: v.to_vec(),
-        intensity: i.iter().map(|x| vec![*x]).collect(),
+        intensity: i.iter().map(|x| vec![*x].into()).collect(),
         depth: None,
     }
 }

@@ -305,7 +305,7 @@ fn spans_at(edges: &[Edge], y: f64) -> Vec<Span> {
 ///
 /// If `p.intensity.len() != p.vertices.len()`, or the intensity vectors differ in length.
 pub fn gouraud_at(p: &Polygon, x: f64, y: f64) -> Option<Vec<f64>> {
-    let channels = p.intensity.iter().map(Vec::len).min().unwrap_or(0);
+    let channels = p.intensity.iter().map(|i| i.len()).min().unwrap_or(0);
     assert!(
         p.intensity.iter().all(|i| i.len() == channels),
         "gouraud_at: intensity vectors of one length"

@@ -423,7 +423,7 @@ mod tests {
     fn overlapping_trapezia_need_the_identifier() {
         let tri = |v: [[f64; 2]; 3]| Polygon {
             vertices: v.to_vec(),
-            intensity: vec![vec![1.0]; 3],
+            intensity: vec![vec![1.0].into(); 3],
             depth: None,
         };
         let mut ts = trapezia(&tri([[2.0, 0.0], [10.0, 0.0], [6.0, 8.0]]), 0, 1, 1);
@@ -480,7 +480,7 @@ mod tests {
     fn figure_26_pairs_across_triangles_on_xmax_alone() {
         let tri = |v: [[f64; 2]; 3]| Polygon {
             vertices: v.to_vec(),
-            intensity: vec![vec![1.0]; 3],
+            intensity: vec![vec![1.0].into(); 3],
             depth: None,
         };
         let polygons = [
@@ -539,7 +539,7 @@ mod tests {
     fn the_scans_slices_are_slice_of_bit_for_bit() {
         let mut next = crate::test_rng::uniform(0x0DDB_1A5E_5BAD_5EEDu64);
         let poly = |v: Vec<[f64; 2]>| Polygon {
-            intensity: vec![vec![0.5]; v.len()],
+            intensity: vec![vec![0.5].into(); v.len()],
             vertices: v,
             depth: None,
         };

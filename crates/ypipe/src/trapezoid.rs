@@ -150,7 +150,7 @@ mod tests {
     fn poly(v: &[[f64; 2]]) -> Polygon {
         Polygon {
             vertices: v.to_vec(),
-            intensity: vec![vec![1.0]; v.len()],
+            intensity: vec![vec![1.0].into(); v.len()],
             depth: None,
         }
     }

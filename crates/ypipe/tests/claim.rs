@@ -74,7 +74,7 @@ fn flat(vertices: Vec<[f64; 2]>, i: &[f64]) -> Polygon {
     let n = vertices.len();
     Polygon {
         vertices,
-        intensity: vec![i.to_vec(); n],
+        intensity: vec![i.into(); n],
         depth: None,
     }
 }
@@ -127,7 +127,7 @@ fn polygon() -> impl Strategy<Value = (Polygon, u8)> {
             let vertices = star(cx, cy, &radii, phase);
             let c = usize::from(channels);
             let intensity = (0..vertices.len())
-                .map(|v| values[v * 3..v * 3 + c].to_vec())
+                .map(|v| values[v * 3..v * 3 + c].into())
                 .collect();
             (
                 Polygon {
@@ -266,10 +266,10 @@ fn point_sampling_with_claims_shows_the_front_polygon() {
     let back = Polygon {
         vertices: vec![[9.4, 0.6], [27.7, 8.3], [14.9, 19.2], [1.3, 16.6]],
         intensity: vec![
-            vec![0.1, 0.5, 0.7],
-            vec![0.6, 0.3, 0.2],
-            vec![0.4, 0.9, 0.1],
-            vec![0.2, 0.1, 0.8],
+            vec![0.1, 0.5, 0.7].into(),
+            vec![0.6, 0.3, 0.2].into(),
+            vec![0.4, 0.9, 0.1].into(),
+            vec![0.2, 0.1, 0.8].into(),
         ],
         depth: None,
     };
@@ -288,7 +288,7 @@ proptest! {
         // same channel count for both
         let one = |p: &Polygon| Polygon {
             vertices: p.vertices.clone(),
-            intensity: p.intensity.iter().map(|i| vec![i[0]]).collect(),
+            intensity: p.intensity.iter().map(|i| vec![i[0]].into()).collect(),
             depth: None,
         };
         check_point_sampled_visibility(&one(&front), &one(&back), 1);

@@ -13,7 +13,7 @@ fn grey(vertices: Vec<[f64; 2]>) -> Polygon {
     let n = vertices.len();
     Polygon {
         vertices,
-        intensity: vec![vec![1.0]; n],
+        intensity: vec![vec![1.0].into(); n],
         depth: None,
     }
 }
@@ -131,7 +131,7 @@ proptest! {
         let gx = ((i[1] - i[0]) * (verts[2][1] - verts[0][1]) - (i[2] - i[0]) * (verts[1][1] - verts[0][1])) / det;
         let gy = ((i[2] - i[0]) * (verts[1][0] - verts[0][0]) - (i[1] - i[0]) * (verts[2][0] - verts[0][0])) / det;
         let grad = gx.hypot(gy);
-        let p = Polygon { vertices: verts, intensity: i.iter().map(|x| vec![*x]).collect(), depth: None };
+        let p = Polygon { vertices: verts, intensity: i.iter().map(|x| vec![*x].into()).collect(), depth: None };
         let s = scene(24, 16, vec![p]);
         let centre = Options { aa: cwisim_ypipe::Antialias::BoxCentre, ..Options::default() };
         let (img, _) = render(&s, &centre);

@@ -14,7 +14,7 @@ fn grey(vertices: Vec<[f64; 2]>) -> Polygon {
     let n = vertices.len();
     Polygon {
         vertices,
-        intensity: vec![vec![1.0]; n],
+        intensity: vec![vec![1.0].into(); n],
         depth: None,
     }
 }

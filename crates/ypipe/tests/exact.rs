@@ -23,7 +23,7 @@ fn linear(v: Vec<[f64; 2]>, f: &[[f64; 3]]) -> Polygon {
     let i = v
         .iter()
         .map(|p| f.iter().map(|c| c[0] + c[1] * p[0] + c[2] * p[1]).collect())
-        .collect();
+        .collect::<Vec<Vec<f64>>>();
     Polygon::new(v, i)
 }
 

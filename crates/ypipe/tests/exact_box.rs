@@ -37,7 +37,7 @@ fn planar(v: Vec<[f64; 2]>, planes: &[[f64; 3]], floor: f64) -> Polygon {
                 .map(|(f, l)| at(p, f) + l)
                 .collect()
         })
-        .collect();
+        .collect::<Vec<Vec<f64>>>();
     Polygon::new(v, intensity)
 }
 

@@ -4,7 +4,7 @@
 
 use super::measure::flattened;
 use crate::prepare::{PhongSurfaces, PolygonLights, PolygonScene};
-use cwisim_scene::{Polygon, ScreenScene, Shading};
+use cwisim_scene::{Polygon, ScreenScene, Shading, VertexIntensity};
 use cwisim_world::shadow::LightSet;
 
 /// Polygon `k` (`p`) of `scene` as every light would shade it: its triangle's own
@@ -20,10 +20,12 @@ fn unshadowed(scene: &PolygonScene, k: usize, p: &Polygon) -> Polygon {
         .vertices
         .iter()
         .map(|&v| {
-            t.intensity_at(v, channels)
-                .map_or_else(|| vec![0.0; channels], |i| i[..channels].to_vec())
+            t.intensity_at(v, channels).map_or_else(
+                || VertexIntensity::from_elem(0.0, channels),
+                |i| VertexIntensity::from_slice(&i[..channels]),
+            )
         })
-        .collect();
+        .collect::<Vec<_>>();
     Polygon::new(p.vertices.clone(), intensity)
 }
 

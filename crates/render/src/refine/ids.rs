@@ -12,7 +12,7 @@
 
 use crate::error::RenderError;
 use cwisim_isa::TraceHeader;
-use cwisim_scene::{Polygon, ScreenScene};
+use cwisim_scene::{Polygon, ScreenScene, VertexIntensity};
 use cwisim_xproc::{EngineWriter, LineOut, LineSink, Machine, Timing};
 use cwisim_ypipe::{emit_rows, ScanPlan};
 
@@ -47,7 +47,10 @@ impl IdView {
             .enumerate()
             .map(|(k, p)| Polygon {
                 vertices: p.vertices.clone(),
-                intensity: vec![vec![(k + 1) as f64 * SCALE, SCALE]; p.vertices.len()],
+                intensity: vec![
+                    VertexIntensity::from_slice(&[(k + 1) as f64 * SCALE, SCALE]);
+                    p.vertices.len()
+                ],
                 depth: None,
             })
             .collect();

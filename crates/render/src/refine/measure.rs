@@ -2,14 +2,15 @@
 //! Gouraud test), and the 3 × 3 range of a frame's output (the anti-aliasing test).
 
 use crate::settings::Threshold;
-use cwisim_scene::Polygon;
+use cwisim_scene::{Polygon, VertexIntensity};
 use cwisim_xproc::Image;
 
 /// The polygon at one intensity: the mean of its vertex intensities, per channel (the
 /// flat value every renderer takes, `cwisim_ypipe::flat_mean`).
 pub fn flattened(p: &Polygon) -> Polygon {
-    let channels = p.intensity.first().map_or(0, Vec::len);
-    let mean = cwisim_ypipe::flat_mean(&p.intensity, channels)[..channels].to_vec();
+    let channels = p.intensity.first().map_or(0, |i| i.len());
+    let mean =
+        VertexIntensity::from_slice(&cwisim_ypipe::flat_mean(&p.intensity, channels)[..channels]);
     Polygon {
         vertices: p.vertices.clone(),
         intensity: vec![mean; p.intensity.len()],
@@ -20,7 +21,7 @@ pub fn flattened(p: &Polygon) -> Polygon {
 /// The polygon's vertex-intensity range: the largest, over channels, of max − min over
 /// its vertices (the Gouraud test's measure).
 pub fn intensity_range(p: &Polygon) -> f64 {
-    let channels = p.intensity.first().map_or(0, Vec::len);
+    let channels = p.intensity.first().map_or(0, |i| i.len());
     (0..channels)
         .map(|c| {
             let (lo, hi) = p
