@@ -299,7 +299,7 @@ pub struct BezierSource {
 }
 
 /// The finest tessellation of a Bézier patch: 128 × 128 quads (the teapot then has
-/// 1,047,552 triangles: 483 MB to draw with `vanrij` on one thread, PERFORMANCE.md).
+/// 1,047,552 triangles: 445 MB to draw with `vanrij` on one thread, PERFORMANCE.md).
 pub const MAX_TESSELLATION: u32 = 128;
 /// The most triangles a Bézier mesh may tessellate into: 2^22.
 pub const MAX_BEZIER_TRIANGLES: u64 = 1 << 22;

@@ -140,8 +140,8 @@ const MAX_CHANNELS: usize = std::mem::size_of::<Vector>() / std::mem::size_of::<
 
 /// What [`exact_fragments_on`] holds a triangle at its peak on one thread, beyond the
 /// triangles themselves: their planes, boxes and index, a flag or two, and the fragments
-/// it returns. 262–274 bytes were measured on the teapot at 4 to 32 quads a patch
-/// (`tests/visibility_memory.rs` holds it to this). Surfaces stacked deep hold more: a
+/// it returns. 250–282 bytes were measured on the teapot at 4 to 16 quads a patch on one
+/// thread, 268–299 on two (`tests/visibility_memory.rs` holds it to this). Surfaces stacked deep hold more: a
 /// triangle's candidates and pieces grow with the layers over it (about 580 bytes a
 /// triangle under 16 layers).
 pub const PAIRS_BYTES_PER_TRIANGLE: u64 = 300;
@@ -324,12 +324,21 @@ pub fn exact_fragments_on<S: Sync>(
             })
             .collect()
     };
+    // what only the chunks read, given back before their fragments are joined (the
+    // frame's fragments and these were the pass's peak together)
+    drop((usable, planes, grid, index, later_copy));
     let mut stats = VisibilityStats {
         triangles: n as u64,
         ..VisibilityStats::default()
     };
-    let mut fragments = Vec::with_capacity(tallies.iter().map(|t| t.fragments.len()).sum());
-    for t in tallies {
+    // joined into the first chunk's vector (on one thread, the only one: nothing copied)
+    let total: usize = tallies.iter().map(|t| t.fragments.len()).sum();
+    let mut fragments = Vec::new();
+    for (k, mut t) in tallies.into_iter().enumerate() {
+        if k == 0 {
+            fragments = std::mem::take(&mut t.fragments);
+            fragments.reserve_exact(total - fragments.len());
+        }
         stats.occluding_pairs += t.stats.occluding_pairs;
         stats.hidden += t.stats.hidden;
         stats.copies_hidden += t.stats.copies_hidden;

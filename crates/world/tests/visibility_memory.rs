@@ -35,6 +35,11 @@ fn pairs_hold_what_the_budget_check_counts_a_triangle() {
                 "{} triangles on {threads} thread(s): {peak} B at the peak, {allowed} B counted",
                 tris.len()
             );
+            eprintln!(
+                "{} triangles, {threads} thread(s): {:.0} B a triangle at the peak",
+                tris.len(),
+                peak as f64 / tris.len() as f64
+            );
             largest = largest.max(peak as f64 / tris.len() as f64);
         }
     }
