@@ -49,6 +49,18 @@ pub struct Surface {
 }
 
 impl<S> ScreenTriangle<S> {
+    /// The same triangle keeping of its surface what `keep` makes of it.
+    pub fn map_surface<T>(self, keep: impl FnOnce(S) -> T) -> ScreenTriangle<T> {
+        ScreenTriangle {
+            points: self.points,
+            inv_depth: self.inv_depth,
+            intensity: self.intensity,
+            mesh: self.mesh,
+            face: self.face,
+            surface: keep(self.surface),
+        }
+    }
+
     /// Twice the signed area (positive: counter-clockwise with y downward, i.e. clockwise
     /// as seen on the screen).
     pub fn doubled_area(&self) -> f64 {

@@ -141,9 +141,9 @@ const MAX_CHANNELS: usize = std::mem::size_of::<Vector>() / std::mem::size_of::<
 /// What [`exact_fragments_on`] holds a triangle at its peak on one thread, beyond the
 /// triangles themselves: their planes, boxes and index, a flag or two, and the fragments
 /// it returns. 250–282 bytes were measured on the teapot at 4 to 16 quads a patch on one
-/// thread, 268–299 on two (`tests/visibility_memory.rs` holds it to this). Surfaces stacked deep hold more: a
-/// triangle's candidates and pieces grow with the layers over it (about 580 bytes a
-/// triangle under 16 layers).
+/// thread, 268–299 on two (`tests/visibility_memory.rs` holds it to this). Surfaces
+/// stacked deep hold more: a triangle's candidates and pieces grow with the layers over
+/// it (about 580 bytes a triangle under 16 layers).
 pub const PAIRS_BYTES_PER_TRIANGLE: u64 = 300;
 
 /// What each thread past the first adds a triangle (its stamps in the index).

@@ -125,17 +125,32 @@ pub fn polygon_trapezia(
     height: u32,
     channels: usize,
 ) -> Vec<trapezoid::Trapezium> {
-    let (w, h) = (f64::from(width), f64::from(height));
     let mut out = Vec::new();
     for (k, p) in polygons.iter().enumerate() {
-        let clipped = clip::clip_to_rect_cow(p, 0.0, 0.0, w, h);
-        if clipped.vertices.len() < 3 {
-            continue;
-        }
         let first = out.len() as u32 + 1;
-        out.extend(trapezoid::trapezia(&clipped, k as u32, channels, first));
+        out.extend(clipped_trapezia(
+            p, k as u32, width, height, channels, first,
+        ));
     }
     out
+}
+
+/// The trapezia of polygon `p` (index `k`) clipped to the image `width × height`,
+/// numbered from `first`: none where nothing of it is inside.
+fn clipped_trapezia(
+    p: &cwisim_scene::Polygon,
+    k: u32,
+    width: u32,
+    height: u32,
+    channels: usize,
+    first: u32,
+) -> Vec<trapezoid::Trapezium> {
+    let (w, h) = (f64::from(width), f64::from(height));
+    let clipped = clip::clip_to_rect_cow(p, 0.0, 0.0, w, h);
+    if clipped.vertices.len() < 3 {
+        return Vec::new();
+    }
+    trapezoid::trapezia(&clipped, k, channels, first)
 }
 
 fn flat_intensity(p: &cwisim_scene::Polygon, channels: usize) -> [f64; MAX_CHANNELS] {
@@ -204,18 +219,13 @@ struct PolygonRows {
 
 impl PolygonRows {
     fn new(scene: &ScreenScene) -> PolygonRows {
-        let (w, h) = (f64::from(scene.width), f64::from(scene.height));
         let channels = usize::from(scene.channels);
         let mut first_id = Vec::with_capacity(scene.polygons.len());
         let mut by_top = Vec::with_capacity(scene.polygons.len());
         let mut next = 1u32;
         for (k, p) in scene.polygons.iter().enumerate() {
             first_id.push(next);
-            let clipped = clip::clip_to_rect_cow(p, 0.0, 0.0, w, h);
-            if clipped.vertices.len() < 3 {
-                continue;
-            }
-            let made = trapezoid::trapezia(&clipped, k as u32, channels, next);
+            let made = clipped_trapezia(p, k as u32, scene.width, scene.height, channels, next);
             if let Some(rows) = made
                 .iter()
                 .map(|t| scan::pixel_rows(t.y_top, t.y_bot))
@@ -246,13 +256,12 @@ impl PolygonRows {
             .map(|&(_, _, k)| k)
             .collect();
         polygons.sort_unstable();
-        let (w, h) = (f64::from(scene.width), f64::from(scene.height));
         let channels = usize::from(scene.channels);
         let mut out = Vec::new();
         for k in polygons {
-            let clipped = clip::clip_to_rect_cow(&scene.polygons[k as usize], 0.0, 0.0, w, h);
+            let (p, first) = (&scene.polygons[k as usize], self.first_id[k as usize]);
             out.extend(
-                trapezoid::trapezia(&clipped, k, channels, self.first_id[k as usize])
+                clipped_trapezia(p, k, scene.width, scene.height, channels, first)
                     .into_iter()
                     .filter(|t| {
                         let (top, bottom) = scan::pixel_rows(t.y_top, t.y_bot);
@@ -309,6 +318,14 @@ impl<'s> ScanPlan<'s> {
             ..EmitStats::default()
         }
     }
+
+    /// How polygon `k` is shaded.
+    fn shade(&self, k: u32) -> Shade {
+        match &self.flat {
+            Some(flat) => Shade::Flat(flat[k as usize]),
+            None => Shade::Gouraud,
+        }
+    }
 }
 
 /// Each polygon's one intensity, when `options` shade flat.
@@ -327,16 +344,6 @@ fn flat_intensities(scene: &ScreenScene, options: &Options) -> Option<Vec<Vector
         // from the vertex intensities (hidden-line drawing is refused before a scene
         // gets here: renderers that resolve visibility per sample draw it)
         Shading::Gouraud | Shading::Phong | Shading::Hidden => None,
-    }
-}
-
-impl ScanPlan<'_> {
-    /// How polygon `k` is shaded.
-    fn shade(&self, k: u32) -> Shade {
-        match &self.flat {
-            Some(flat) => Shade::Flat(flat[k as usize]),
-            None => Shade::Gouraud,
-        }
     }
 }
 

@@ -322,7 +322,7 @@ impl<'w> PatchScene<'w> {
                         return;
                     }
                 }
-                triangles.push(kept(t));
+                triangles.push(t.map_surface(S::of));
                 if S::WHOLE {
                     facing.push(p.facing);
                     origin.push((*k as u32, p.patch, p.uv));
@@ -388,18 +388,6 @@ fn check_budget(
             pieces as u64 * BYTES_PER_PIECE,
         )
         .map_err(|e| RenderError::Usage(e.to_string()))
-}
-
-/// `t` keeping of its surface what `S` keeps.
-fn kept<S: KeptSurface>(t: ScreenTriangle) -> ScreenTriangle<S> {
-    ScreenTriangle {
-        points: t.points,
-        inv_depth: t.inv_depth,
-        intensity: t.intensity,
-        mesh: t.mesh,
-        face: t.face,
-        surface: S::of(t.surface),
-    }
 }
 
 /// A piece as a screen triangle: normals turned toward the eye (two-sided meshes), or
